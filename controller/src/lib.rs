@@ -1,0 +1,155 @@
+//! The paper's reinforcement-learning neuroadaptive controller under deferred
+//! constraints, as pure math (SPEC §3–§12).
+//!
+//! Where it sits: the `controller` process (or `testbed sim`'s in-process
+//! loop) reads a joint state and the reference at the state's sim time, calls
+//! [`Controller::step`] with the control period, and publishes `tau` and the
+//! [`Diagnostics`]. No clock, no I/O, no IPC: the same inputs give the same
+//! outputs bit for bit, which is what makes lockstep runs and replays exact.
+//!
+//! ```
+//! use controller::{Controller, ControllerInput, ControllerParams};
+//! let mut c = Controller::new(ControllerParams::default(), 2).unwrap();
+//! let mut diag = c.diagnostics();
+//! let input = ControllerInput {
+//!     t: 0.0, q: &[0.6, 1.8], qd: &[0.0, 0.0],
+//!     q_d: &[0.0, 1.0], qd_d: &[2.0, 0.0], kc: &[0.5, 0.55], kc_dot: &[0.05, 0.0],
+//! };
+//! c.step(1e-3, &input, &mut diag);
+//! assert!(diag.tau.iter().all(|t| t.is_finite()));
+//! assert!(diag.fault.is_none());
+//! ```
+//!
+//! Limitations: the RBF centres lie on the diagonal of the input space, as in
+//! the paper (SPEC §8); with them the actor's contribution stays small and
+//! the loop behaves as feedback plus barrier.
+
+mod law;
+mod params;
+mod rbf;
+mod shifting;
+mod weight_update;
+
+pub use law::{Controller, ControllerInput, barrier_lyapunov};
+pub use params::{BarrierMode, ControllerParams, Integrator};
+pub use rbf::Rbf;
+pub use shifting::shifting;
+pub use weight_update::{advance_euler, advance_exact};
+
+/// Why a controller cannot be built.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ControllerError {
+    /// A parameter is out of range or not a number.
+    #[error("{key} = {value} is invalid: it must be {need}")]
+    InvalidParameter {
+        /// The scenario key, e.g. `controller.beta`.
+        key: String,
+        /// The value given.
+        value: String,
+        /// What it must be.
+        need: String,
+    },
+    /// Zero joints.
+    #[error("the controller needs at least one joint")]
+    NoJoints,
+}
+
+/// Why a step published zero torque instead of the law's output (SPEC §10).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// A state or reference value was NaN or infinite.
+    NonFiniteInput,
+    /// An input slice did not have one entry per joint.
+    WrongLength,
+    /// The envelope k_c was zero or negative.
+    EnvelopeNotPositive,
+    /// The law produced a NaN or infinite value.
+    NonFiniteOutput,
+}
+
+impl Fault {
+    /// A stable numeric code for the wire and logs (0 means no fault).
+    pub fn code(self) -> u32 {
+        match self {
+            Fault::NonFiniteInput => 1,
+            Fault::WrongLength => 2,
+            Fault::EnvelopeNotPositive => 3,
+            Fault::NonFiniteOutput => 4,
+        }
+    }
+}
+
+/// Everything the controller publishes each step (SPEC §12), except compute
+/// time, which the process shell measures. Per-joint vectors have length n.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagnostics {
+    /// Sim time of the joint state acted on, s.
+    pub t: f64,
+    /// γ(t).
+    pub gamma: f64,
+    /// γ̇(t).
+    pub gamma_dot: f64,
+    /// Z1 = q − q_d.
+    pub z1: Vec<f64>,
+    /// Z1γ = γ Z1.
+    pub z1g: Vec<f64>,
+    /// Z2 = q̇ − α.
+    pub z2: Vec<f64>,
+    /// Virtual control α.
+    pub alpha: Vec<f64>,
+    /// The bound each joint's barrier used (k_c,i, or min_i k_c,i in norm mode).
+    pub kc: Vec<f64>,
+    /// D before the guard's clamp (negative once the error leaves the envelope).
+    pub d: Vec<f64>,
+    /// Torque τ = actor + feedback + barrier (zero on a fault).
+    pub tau: Vec<f64>,
+    /// Actor term (Ŵ_aᵀ S_a)_i.
+    pub tau_actor: Vec<f64>,
+    /// Feedback term −K2 Z2_i.
+    pub tau_feedback: Vec<f64>,
+    /// Barrier term −γ Z1γ_i / (β D_i).
+    pub tau_barrier: Vec<f64>,
+    /// Critic value Ĵ = Ŵ_cᵀ S_c.
+    pub j_hat: f64,
+    /// TD error δ.
+    pub delta: f64,
+    /// Instantaneous cost r.
+    pub r: f64,
+    /// ‖Ŵ_a‖ per joint (column norm) before this step's update.
+    pub wa_norm: Vec<f64>,
+    /// ‖Ŵ_c‖ before this step's update.
+    pub wc_norm: f64,
+    /// The guard clamped D this step.
+    pub barrier_breached: bool,
+    /// Set when the step published zero torque.
+    pub fault: Option<Fault>,
+}
+
+impl Diagnostics {
+    /// A zeroed buffer for `n` joints.
+    pub fn new(n: usize) -> Self {
+        let z = || vec![0.0; n];
+        Self {
+            t: 0.0,
+            gamma: 0.0,
+            gamma_dot: 0.0,
+            z1: z(),
+            z1g: z(),
+            z2: z(),
+            alpha: z(),
+            kc: z(),
+            d: z(),
+            tau: z(),
+            tau_actor: z(),
+            tau_feedback: z(),
+            tau_barrier: z(),
+            j_hat: 0.0,
+            delta: 0.0,
+            r: 0.0,
+            wa_norm: z(),
+            wc_norm: 0.0,
+            barrier_breached: false,
+            fault: None,
+        }
+    }
+}
