@@ -89,8 +89,19 @@ fn tau_is_the_sum_of_its_three_terms_and_actor_uses_the_weights() {
         let expected: f64 = (0..nn).map(|k| wa[j * nn + k] * sa[k]).sum();
         assert!(expected != 0.0);
         close(d.tau_actor[j], expected, 1e-12);
-        close(d.wa_norm[j], wa[j * nn..(j + 1) * nn].iter().map(|w| w * w).sum::<f64>().sqrt(), 1e-14);
-        assert_eq!(d.tau[j], d.tau_actor[j] + d.tau_feedback[j] + d.tau_barrier[j]);
+        close(
+            d.wa_norm[j],
+            wa[j * nn..(j + 1) * nn]
+                .iter()
+                .map(|w| w * w)
+                .sum::<f64>()
+                .sqrt(),
+            1e-14,
+        );
+        assert_eq!(
+            d.tau[j],
+            d.tau_actor[j] + d.tau_feedback[j] + d.tau_barrier[j]
+        );
         assert_eq!(d.tau_feedback[j], -15.0 * d.z2[j]);
     }
 }
@@ -129,7 +140,14 @@ fn non_finite_input_gives_zero_torque_and_skips_the_update() {
     c.step(1e-3, &ControllerInput { kc: &kc, ..input() }, &mut d);
     assert_eq!(d.fault, Some(Fault::EnvelopeNotPositive));
     let short = [0.1];
-    c.step(1e-3, &ControllerInput { q: &short, ..input() }, &mut d);
+    c.step(
+        1e-3,
+        &ControllerInput {
+            q: &short,
+            ..input()
+        },
+        &mut d,
+    );
     assert_eq!(d.fault, Some(Fault::WrongLength));
     // A good step afterwards works again.
     c.step(1e-3, &input(), &mut d);

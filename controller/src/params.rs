@@ -132,9 +132,18 @@ impl ControllerParams {
         ];
         for (key, value, bound) in checks {
             let (ok, need) = match bound {
-                Positive => (value.is_finite() && value > 0.0, "a finite number > 0".to_string()),
-                NonNegative => (value.is_finite() && value >= 0.0, "a finite number ≥ 0".to_string()),
-                Above(min) => (value.is_finite() && value > min, format!("a finite number > {min}")),
+                Positive => (
+                    value.is_finite() && value > 0.0,
+                    "a finite number > 0".to_string(),
+                ),
+                NonNegative => (
+                    value.is_finite() && value >= 0.0,
+                    "a finite number ≥ 0".to_string(),
+                ),
+                Above(min) => (
+                    value.is_finite() && value > min,
+                    format!("a finite number > {min}"),
+                ),
                 OpenUnit => (value > 0.0 && value < 1.0, "a number in (0, 1)".to_string()),
                 Finite => (value.is_finite(), "a finite number".to_string()),
             };
@@ -173,21 +182,67 @@ mod tests {
         let p = ControllerParams::default();
         p.validate().unwrap();
         assert_eq!((p.tc, p.k1, p.k2, p.beta), (2.0, 15.0, 15.0, 10.0));
-        assert_eq!((p.sigma_a, p.sigma_c, p.eta_a, p.eta_c), (50.0, 50.0, 0.01, 0.5));
-        assert_eq!((p.neurons, p.center_min, p.center_max, p.width), (10, -5.0, 5.0, 1.0));
+        assert_eq!(
+            (p.sigma_a, p.sigma_c, p.eta_a, p.eta_c),
+            (50.0, 50.0, 0.01, 0.5)
+        );
+        assert_eq!(
+            (p.neurons, p.center_min, p.center_max, p.width),
+            (10, -5.0, 5.0, 1.0)
+        );
     }
 
     #[test]
     fn nan_and_out_of_range_name_the_key() {
-        let p = ControllerParams { beta: f64::NAN, ..Default::default() };
-        assert!(p.validate().unwrap_err().to_string().contains("controller.beta"));
-        let p = ControllerParams { k1: 1.0, ..Default::default() };
-        assert!(p.validate().unwrap_err().to_string().contains("controller.k1"));
-        let p = ControllerParams { breach_epsilon: f64::NAN, ..Default::default() };
-        assert!(p.validate().unwrap_err().to_string().contains("controller.breach_epsilon"));
-        let p = ControllerParams { center_min: 6.0, ..Default::default() };
-        assert!(p.validate().unwrap_err().to_string().contains("controller.center_min"));
-        let p = ControllerParams { neurons: 0, ..Default::default() };
-        assert!(p.validate().unwrap_err().to_string().contains("controller.neurons"));
+        let p = ControllerParams {
+            beta: f64::NAN,
+            ..Default::default()
+        };
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("controller.beta")
+        );
+        let p = ControllerParams {
+            k1: 1.0,
+            ..Default::default()
+        };
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("controller.k1")
+        );
+        let p = ControllerParams {
+            breach_epsilon: f64::NAN,
+            ..Default::default()
+        };
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("controller.breach_epsilon")
+        );
+        let p = ControllerParams {
+            center_min: 6.0,
+            ..Default::default()
+        };
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("controller.center_min")
+        );
+        let p = ControllerParams {
+            neurons: 0,
+            ..Default::default()
+        };
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("controller.neurons")
+        );
     }
 }

@@ -48,7 +48,10 @@ mod tests {
     fn rk4(w: &[f64], s: &[f64], c: f64, sigma: f64, eta: f64, dt: f64, sub: usize) -> Vec<f64> {
         let f = |w: &[f64]| -> Vec<f64> {
             let g = dot(s, w) + c;
-            w.iter().zip(s).map(|(wi, si)| -sigma * g * si - sigma * eta * wi).collect()
+            w.iter()
+                .zip(s)
+                .map(|(wi, si)| -sigma * g * si - sigma * eta * wi)
+                .collect()
         };
         let h = dt / sub as f64;
         let mut w = w.to_vec();

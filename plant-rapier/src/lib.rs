@@ -1,1 +1,163 @@
-//! placeholder
+//! The simulated arm: a Rapier multibody (f64) built from a URDF.
+//!
+//! Where it sits: the `plant-rapier` process (or `testbed sim`'s in-process
+//! loop) owns a [`Plant`], publishes its joint state each period and steps it
+//! with the latest torque held over the period. The controller never sees
+//! anything in here: M, C and G live only in Rapier.
+//!
+//! ```
+//! use plant_rapier::{ArmModel, Plant, PlantConfig, TWO_LINK_URDF};
+//! let model = ArmModel::from_urdf_str(TWO_LINK_URDF).unwrap();
+//! let mut plant = Plant::new(&model, &PlantConfig::default()).unwrap();
+//! plant.set_state(&[0.0, 0.0], &[0.0, 0.0]).unwrap();
+//! plant.step(&[0.0, 0.0], 1e-3).unwrap();
+//! let (q, _qd) = plant.state();
+//! assert!(q[0] < 0.0); // a horizontal arm starts to fall
+//! ```
+//!
+//! Conventions: gravity points along -z (URDF is z-up); joint order is the
+//! order of the actuated joints in the URDF file; q = 0 is the URDF's zero
+//! pose. Joint damping, friction and armature are zero: whatever the plant
+//! should add on top is added explicitly.
+//!
+//! Limitations: inertia only, no contact (links have no colliders);
+//! floating, planar and spherical joints and `<mimic>` are refused.
+
+mod config;
+mod model;
+mod plant;
+
+pub use config::PlantConfig;
+pub use model::{ArmModel, JointInfo, JointKind, LinkInfo, Origin};
+pub use plant::Plant;
+
+/// The paper's two-link arm (SPEC §1), embedded so the default scenario
+/// needs no files.
+pub const TWO_LINK_URDF: &str = include_str!("../../robots/two_link.urdf");
+
+/// Why an arm cannot be built or stepped. Each variant names what is wrong.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum PlantError {
+    /// The text is not a URDF document.
+    #[error("not a valid URDF: {0}")]
+    Parse(String),
+    /// Two links or two joints share a name.
+    #[error("two {what}s are named '{name}'")]
+    Duplicate {
+        /// "link" or "joint".
+        what: &'static str,
+        /// The shared name.
+        name: String,
+    },
+    /// No `<link>` at all.
+    #[error("the URDF has no links")]
+    NoLinks,
+    /// A joint names a link that does not exist.
+    #[error("joint '{joint}': {role} link '{link}' does not exist")]
+    MissingLink {
+        /// The joint.
+        joint: String,
+        /// "parent" or "child".
+        role: &'static str,
+        /// The missing link name.
+        link: String,
+    },
+    /// A link is the child of two joints.
+    #[error("link '{link}' is the child of two joints, '{first}' and '{second}'")]
+    TwoParents {
+        /// The link.
+        link: String,
+        /// First joint.
+        first: String,
+        /// Second joint.
+        second: String,
+    },
+    /// Every link has a parent: the joints form a loop.
+    #[error("the URDF has no root link (every link is some joint's child): the joints form a loop")]
+    NoRoot,
+    /// More than one link has no parent.
+    #[error("the URDF has several root links ({}); an arm needs exactly one", .0.join(", "))]
+    ManyRoots(Vec<String>),
+    /// A link cannot be reached from the root.
+    #[error("link '{link}' is on a loop of joints and cannot be reached from the root")]
+    Cycle {
+        /// A link on the loop.
+        link: String,
+    },
+    /// A joint kind the plant cannot simulate.
+    #[error(
+        "joint '{joint}' is {kind}; only revolute, continuous, prismatic and fixed joints are supported"
+    )]
+    UnsupportedJoint {
+        /// The joint.
+        joint: String,
+        /// Its kind.
+        kind: String,
+    },
+    /// `<mimic>` joints are not supported.
+    #[error(
+        "joint '{joint}' has <mimic>; mimic joints are not supported (make it an independent joint or fixed)"
+    )]
+    Mimic {
+        /// The joint.
+        joint: String,
+    },
+    /// An actuated joint with a zero axis.
+    #[error("joint '{joint}' has a zero-length axis")]
+    ZeroAxis {
+        /// The joint.
+        joint: String,
+    },
+    /// Lower limit above upper.
+    #[error("joint '{joint}': limit lower {lower} is above upper {upper}")]
+    BadLimits {
+        /// The joint.
+        joint: String,
+        /// Lower limit.
+        lower: f64,
+        /// Upper limit.
+        upper: f64,
+    },
+    /// Mass or inertia that no rigid body has.
+    #[error("link '{link}': {reason}")]
+    BadInertia {
+        /// The link.
+        link: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Only fixed joints.
+    #[error("the URDF has no actuated (revolute, continuous or prismatic) joint")]
+    NoActuatedJoints,
+    /// A NaN or infinite number.
+    #[error("{field}: {value} is not a finite number")]
+    NotFinite {
+        /// Where it was found.
+        field: String,
+        /// The value.
+        value: f64,
+    },
+    /// A vector with the wrong number of entries.
+    #[error("{field} has {got} entries but the arm has {expected} actuated joints")]
+    WrongLength {
+        /// Which vector.
+        field: &'static str,
+        /// Joints of the arm.
+        expected: usize,
+        /// Entries given.
+        got: usize,
+    },
+    /// A plant setting out of range.
+    #[error("{key} = {value} is invalid: it must be {need}")]
+    InvalidConfig {
+        /// The scenario key.
+        key: String,
+        /// The value.
+        value: String,
+        /// What it must be.
+        need: String,
+    },
+    /// Rapier did something this crate did not expect.
+    #[error("physics engine: {0}")]
+    Engine(String),
+}

@@ -1,0 +1,330 @@
+//! The Rapier multibody built from an [`ArmModel`], stepped with joint torques.
+
+use rapier3d_f64::glamx::EulerRot;
+use rapier3d_f64::prelude::*;
+
+use crate::model::{ArmModel, JointKind, Origin};
+use crate::{PlantConfig, PlantError};
+
+/// Where one actuated joint lives inside the Rapier multibody.
+#[derive(Debug, Clone)]
+struct Dof {
+    link_id: usize,
+    assembly_id: usize,
+    /// Index into the joint's 6-vector of coordinates (LinX = 0, AngX = 3).
+    coord: usize,
+    prismatic: bool,
+    parent: RigidBodyHandle,
+    child: RigidBodyHandle,
+    /// Joint axis in the parent body's frame.
+    axis_in_parent: Vector,
+}
+
+/// An arm simulated by Rapier in double precision.
+pub struct Plant {
+    world: PhysicsWorld,
+    multibody: MultibodyJointHandle,
+    dofs: Vec<Dof>,
+    names: Vec<String>,
+    substeps: u32,
+    bodies: Vec<RigidBodyHandle>,
+}
+
+impl std::fmt::Debug for Plant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Plant")
+            .field("joints", &self.names)
+            .field("substeps", &self.substeps)
+            .finish_non_exhaustive()
+    }
+}
+
+fn pose(o: &Origin) -> Pose {
+    Pose::from_parts(
+        Vector::new(o.xyz[0], o.xyz[1], o.xyz[2]),
+        Rotation::from_euler(EulerRot::ZYX, o.rpy[2], o.rpy[1], o.rpy[0]),
+    )
+}
+
+impl Plant {
+    /// Builds the multibody for `model` at q = 0, q̇ = 0.
+    pub fn new(model: &ArmModel, config: &PlantConfig) -> Result<Self, PlantError> {
+        config.validate()?;
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::new(config.gravity[0], config.gravity[1], config.gravity[2]);
+        // One solver pass per call; accuracy comes from stepping `substeps`
+        // times per period with the torque re-applied about the current axes.
+        world.integration_parameters.num_solver_iterations = 1;
+
+        // World pose of every link at q = 0, parents first.
+        let mut link_pose = vec![Pose::IDENTITY; model.links.len()];
+        for &ji in &model.topological {
+            let j = &model.joints[ji];
+            link_pose[j.child] = link_pose[j.parent] * pose(&j.origin);
+        }
+        let mut handles = Vec::with_capacity(model.links.len());
+        for (i, link) in model.links.iter().enumerate() {
+            let builder = if i == model.root {
+                RigidBodyBuilder::fixed()
+            } else {
+                RigidBodyBuilder::dynamic()
+            };
+            let inertial = pose(&link.inertial_origin);
+            let [ixx, ixy, ixz, iyy, iyz, izz] = link.inertia;
+            let tensor = Matrix::from_cols(
+                Vector::new(ixx, ixy, ixz),
+                Vector::new(ixy, iyy, iyz),
+                Vector::new(ixz, iyz, izz),
+            );
+            // URDF gives the tensor in the inertial frame; Rapier wants it in the link frame.
+            let r = Matrix::from_quat(inertial.rotation);
+            let in_link = r * tensor * r.transpose();
+            let mprops =
+                MassProperties::with_inertia_matrix(inertial.translation, link.mass, in_link);
+            let body = builder
+                .pose(link_pose[i])
+                .additional_mass_properties(mprops)
+                .can_sleep(false)
+                .build();
+            handles.push(world.bodies.insert(body));
+        }
+
+        let mut multibody = None;
+        for &ji in &model.topological {
+            let j = &model.joints[ji];
+            let axis = Vector::new(j.axis[0], j.axis[1], j.axis[2]);
+            let locked = match j.kind {
+                JointKind::Revolute | JointKind::Continuous => JointAxesMask::LOCKED_REVOLUTE_AXES,
+                JointKind::Prismatic => JointAxesMask::LOCKED_PRISMATIC_AXES,
+                JointKind::Fixed => JointAxesMask::LOCKED_FIXED_AXES,
+            };
+            // One frame built from the axis, on both sides, so that the joint's
+            // local X is the URDF axis and q = 0 is the URDF zero pose.
+            let basis = if j.kind == JointKind::Fixed {
+                Pose::IDENTITY
+            } else {
+                Pose::from_rotation(GenericJoint::complete_ang_frame(axis))
+            };
+            let mut builder = GenericJointBuilder::new(locked)
+                .local_frame1(pose(&j.origin) * basis)
+                .local_frame2(basis)
+                .contacts_enabled(false);
+            if let Some((lo, hi)) = j.limits {
+                let axis_id = if j.kind == JointKind::Prismatic {
+                    JointAxis::LinX
+                } else {
+                    JointAxis::AngX
+                };
+                builder = builder.limits(axis_id, [lo, hi]);
+            }
+            let handle = world
+                .multibody_joints
+                .insert(handles[j.parent], handles[j.child], builder.build(), true)
+                .ok_or_else(|| PlantError::Engine(format!("Rapier refused joint '{}'", j.name)))?;
+            multibody.get_or_insert(handle);
+        }
+        let multibody = multibody.ok_or(PlantError::NoActuatedJoints)?;
+
+        let PhysicsWorld {
+            bodies,
+            multibody_joints,
+            ..
+        } = &mut world;
+        let (mb, _) = multibody_joints
+            .get_mut(multibody)
+            .ok_or_else(|| PlantError::Engine("multibody vanished after insertion".into()))?;
+        // The root is fixed: this drops the free root DOFs Rapier counts at first.
+        mb.forward_kinematics(bodies, true);
+        mb.update_rigid_bodies(bodies, true);
+        mb.set_self_contacts_enabled(false);
+        // Rapier gives every DOF a default joint damping of 0.1: the arm has none.
+        mb.damping_mut().fill(0.0);
+        mb.frictions_mut().fill(0.0);
+        mb.armature_mut().fill(0.0);
+
+        let mut dofs = Vec::with_capacity(model.dof());
+        for &ji in &model.actuated {
+            let j = &model.joints[ji];
+            let child = handles[j.child];
+            let link = multibody_joints.rigid_body_link(child).ok_or_else(|| {
+                PlantError::Engine(format!("joint '{}' is not in the multibody", j.name))
+            })?;
+            let (mb, _) = multibody_joints
+                .get(multibody)
+                .ok_or_else(|| PlantError::Engine("multibody vanished".into()))?;
+            let l = mb
+                .link(link.id)
+                .ok_or_else(|| PlantError::Engine(format!("no link for joint '{}'", j.name)))?;
+            let prismatic = j.kind == JointKind::Prismatic;
+            let frame1 = l.joint().data.local_frame1;
+            dofs.push(Dof {
+                link_id: link.id,
+                assembly_id: l.assembly_id(),
+                coord: if prismatic { 0 } else { 3 },
+                prismatic,
+                parent: handles[j.parent],
+                child,
+                axis_in_parent: frame1.rotation * Vector::X,
+            });
+        }
+        let ndofs = multibody_joints
+            .get(multibody)
+            .map(|(mb, _)| mb.ndofs())
+            .unwrap_or(0);
+        if ndofs != dofs.len() {
+            return Err(PlantError::Engine(format!(
+                "the multibody has {ndofs} degrees of freedom but the URDF {} actuated joints",
+                dofs.len()
+            )));
+        }
+        Ok(Self {
+            world,
+            multibody,
+            names: model.joint_names(),
+            dofs,
+            substeps: config.substeps,
+            bodies: handles,
+        })
+    }
+
+    /// Number of actuated joints.
+    pub fn dof(&self) -> usize {
+        self.dofs.len()
+    }
+
+    /// Actuated joint names in order (the order of q, q̇ and τ).
+    pub fn joint_names(&self) -> &[String] {
+        &self.names
+    }
+
+    /// Substeps per control period.
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+
+    fn mb(&self) -> &Multibody {
+        // The handle was checked at construction and joints are never removed.
+        match self.world.multibody_joints.get(self.multibody) {
+            Some((mb, _)) => mb,
+            None => unreachable!("multibody handle checked at construction"),
+        }
+    }
+
+    /// Joint positions and velocities into `q` and `qd` (length `dof()`).
+    pub fn state_into(&self, q: &mut [f64], qd: &mut [f64]) {
+        let mb = self.mb();
+        let v = mb.generalized_velocity();
+        for (i, d) in self.dofs.iter().enumerate() {
+            q[i] = mb
+                .link(d.link_id)
+                .map_or(f64::NAN, |l| l.joint().coords()[d.coord]);
+            qd[i] = v[d.assembly_id];
+        }
+    }
+
+    /// Joint positions and velocities as new vectors.
+    pub fn state(&self) -> (Vec<f64>, Vec<f64>) {
+        let (mut q, mut qd) = (vec![0.0; self.dof()], vec![0.0; self.dof()]);
+        self.state_into(&mut q, &mut qd);
+        (q, qd)
+    }
+
+    /// Puts the arm at `q`, `qd`.
+    pub fn set_state(&mut self, q: &[f64], qd: &[f64]) -> Result<(), PlantError> {
+        self.check("q", q)?;
+        self.check("qd", qd)?;
+        let PhysicsWorld {
+            bodies,
+            multibody_joints,
+            ..
+        } = &mut self.world;
+        let Some((mb, _)) = multibody_joints.get_mut(self.multibody) else {
+            return Err(PlantError::Engine("multibody vanished".into()));
+        };
+        for (i, d) in self.dofs.iter().enumerate() {
+            if let Some(link) = mb.link_mut(d.link_id) {
+                let now = link.joint().coords()[d.coord];
+                link.joint.apply_displacement(&[q[i] - now]);
+            }
+        }
+        mb.forward_kinematics(bodies, false);
+        mb.update_rigid_bodies(bodies, true);
+        let mut v = mb.generalized_velocity_mut();
+        for (i, d) in self.dofs.iter().enumerate() {
+            v[d.assembly_id] = qd[i];
+        }
+        Ok(())
+    }
+
+    /// Advances the arm by `dt` seconds with joint torques (forces for
+    /// prismatic joints) `tau` held constant (zero-order hold).
+    pub fn step(&mut self, tau: &[f64], dt: f64) -> Result<(), PlantError> {
+        self.check("tau", tau)?;
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(PlantError::NotFinite {
+                field: "dt".into(),
+                value: dt,
+            });
+        }
+        self.world.integration_parameters.dt = dt / f64::from(self.substeps);
+        for _ in 0..self.substeps {
+            self.apply_torques(tau);
+            self.world.step();
+        }
+        Ok(())
+    }
+
+    /// Rapier has no generalized-force input for multibody joints: a joint
+    /// torque is an equal and opposite torque about the joint's current
+    /// world axis on child and parent (a force pair at one point for a
+    /// prismatic joint). User forces persist across steps, so reset first.
+    fn apply_torques(&mut self, tau: &[f64]) {
+        let bodies = &mut self.world.bodies;
+        for h in &self.bodies {
+            if let Some(b) = bodies.get_mut(*h) {
+                b.reset_forces(false);
+                b.reset_torques(false);
+            }
+        }
+        for (d, &t) in self.dofs.iter().zip(tau) {
+            let Some(parent) = bodies.get(d.parent) else {
+                continue;
+            };
+            let axis = parent.position().rotation * d.axis_in_parent;
+            if d.prismatic {
+                let Some(child) = bodies.get_mut(d.child) else {
+                    continue;
+                };
+                let point = child.center_of_mass();
+                child.add_force_at_point(axis * t, point, true);
+                if let Some(p) = bodies.get_mut(d.parent) {
+                    p.add_force_at_point(-axis * t, point, true);
+                }
+            } else {
+                if let Some(child) = bodies.get_mut(d.child) {
+                    child.add_torque(axis * t, true);
+                }
+                if let Some(p) = bodies.get_mut(d.parent) {
+                    p.add_torque(-axis * t, true);
+                }
+            }
+        }
+    }
+
+    fn check(&self, field: &'static str, v: &[f64]) -> Result<(), PlantError> {
+        if v.len() != self.dof() {
+            return Err(PlantError::WrongLength {
+                field,
+                expected: self.dof(),
+                got: v.len(),
+            });
+        }
+        match v.iter().position(|x| !x.is_finite()) {
+            Some(i) => Err(PlantError::NotFinite {
+                field: format!("{field}[{i}] ({})", self.names[i]),
+                value: v[i],
+            }),
+            None => Ok(()),
+        }
+    }
+}
