@@ -1,1 +1,16 @@
-fn main() {}
+//! `testbed`: run the paper's controller on a simulated arm.
+
+mod cli;
+mod report;
+
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    match cli::run() {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("testbed: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

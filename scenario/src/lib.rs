@@ -1,1 +1,464 @@
-//! placeholder
+//! The scenario file: one TOML document that says everything about a run.
+//!
+//! Where it sits: `testbed` reads a scenario (or the built-in paper
+//! scenario), validates it against the robot, and hands each process its
+//! part: `[plant]` and `[initial]` to the plant, `[reference]` and
+//! `[envelope]` to the trajectory, `[controller]` to the controller.
+//! Every key is optional and defaults to the paper's value; unknown keys,
+//! NaN and out-of-range values are errors naming the key.
+//!
+//! ```
+//! let s = scenario::Scenario::from_toml_str("[controller]\nk1 = 20.0\n", "inline").unwrap();
+//! assert_eq!(s.controller.k1, 20.0);
+//! assert_eq!(s.duration_s, 20.0); // the paper's default
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use controller::{ControllerError, ControllerParams};
+use plant_rapier::{ArmModel, PlantConfig, PlantError};
+use serde::{Deserialize, Serialize};
+use trajectory::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError};
+
+/// The paper's scenario as shipped in `scenarios/paper.toml`.
+pub const PAPER_TOML: &str = include_str!("../../scenarios/paper.toml");
+
+/// Why a scenario cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("{file}: {cause}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The cause.
+        cause: std::io::Error,
+    },
+    /// The scenario's robot cannot be used.
+    #[error("{file}: robot: {cause}")]
+    Robot {
+        /// The scenario file.
+        file: String,
+        /// What is wrong with the robot's URDF.
+        cause: Box<ScenarioError>,
+    },
+    /// Not TOML, or a key that does not exist, or a value of the wrong type.
+    #[error("{file}: {message}")]
+    Toml {
+        /// The file.
+        file: String,
+        /// The parser's message (it names the key and line).
+        message: String,
+    },
+    /// A value out of range.
+    #[error("{file}: {key} = {value} is invalid: it must be {need}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// The key.
+        key: String,
+        /// The value.
+        value: String,
+        /// What it must be.
+        need: String,
+    },
+    /// A controller parameter is out of range.
+    #[error("{file}: {cause}")]
+    Controller {
+        /// The file.
+        file: String,
+        /// The cause.
+        cause: ControllerError,
+    },
+    /// The reference or envelope is unusable.
+    #[error("{file}: {cause}")]
+    Trajectory {
+        /// The file.
+        file: String,
+        /// The cause.
+        cause: TrajectoryError,
+    },
+    /// The plant settings or the robot are unusable.
+    #[error("{file}: {cause}")]
+    Plant {
+        /// The file (the scenario for `[plant]`, the URDF for the robot).
+        file: String,
+        /// The cause.
+        cause: PlantError,
+    },
+}
+
+/// The initial joint state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Initial {
+    /// q(0) per joint (default: the paper's [0.60, 1.80], rad).
+    pub q: Vec<f64>,
+    /// q̇(0) per joint (default: zeros, rad/s).
+    pub qd: Vec<f64>,
+}
+
+impl Default for Initial {
+    fn default() -> Self {
+        Self {
+            q: vec![0.60, 1.80],
+            qd: vec![0.0, 0.0],
+        }
+    }
+}
+
+/// A whole scenario. Every table defaults to the paper's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Scenario {
+    /// A short name for summaries and logs (default: "paper").
+    pub name: String,
+    /// URDF path relative to the scenario file (default: the built-in two-link arm).
+    pub robot: Option<String>,
+    /// Length of the run (default: 20, s).
+    pub duration_s: f64,
+    /// Control and plant rate (default: 1000, Hz).
+    pub rate_hz: f64,
+    /// Initial state.
+    pub initial: Initial,
+    /// Reference q_d(t).
+    pub reference: ReferenceConfig,
+    /// Envelope k_c(t).
+    pub envelope: EnvelopeConfig,
+    /// Controller parameters (SPEC §11).
+    pub controller: ControllerParams,
+    /// Plant integration settings.
+    pub plant: PlantConfig,
+}
+
+impl Default for Scenario {
+    fn default() -> Self {
+        Self {
+            name: "paper".into(),
+            robot: None,
+            duration_s: 20.0,
+            rate_hz: 1000.0,
+            initial: Initial::default(),
+            reference: ReferenceConfig::paper(),
+            envelope: EnvelopeConfig::paper(),
+            controller: ControllerParams::default(),
+            plant: PlantConfig::default(),
+        }
+    }
+}
+
+/// The robot a scenario runs: its URDF text and where it came from.
+#[derive(Debug, Clone)]
+pub struct RobotSource {
+    /// The URDF file, or None for the built-in two-link arm.
+    pub path: Option<PathBuf>,
+    /// The URDF text.
+    pub urdf: String,
+    /// The checked model.
+    pub model: ArmModel,
+}
+
+impl RobotSource {
+    /// A label for messages: the path, or "built-in two_link.urdf".
+    pub fn label(&self) -> String {
+        match &self.path {
+            Some(p) => p.display().to_string(),
+            None => "built-in two_link.urdf".into(),
+        }
+    }
+
+    /// Loads and checks a URDF file.
+    pub fn from_file(path: &Path) -> Result<Self, ScenarioError> {
+        let file = path.display().to_string();
+        let urdf = std::fs::read_to_string(path).map_err(|cause| ScenarioError::Io {
+            file: file.clone(),
+            cause,
+        })?;
+        let model =
+            ArmModel::from_urdf_str(&urdf).map_err(|cause| ScenarioError::Plant { file, cause })?;
+        Ok(Self {
+            path: Some(path.to_path_buf()),
+            urdf,
+            model,
+        })
+    }
+
+    /// The paper's two-link arm.
+    pub fn builtin() -> Self {
+        let urdf = plant_rapier::TWO_LINK_URDF.to_string();
+        match ArmModel::from_urdf_str(&urdf) {
+            Ok(model) => Self {
+                path: None,
+                urdf,
+                model,
+            },
+            // The embedded file is checked by this crate's tests.
+            Err(e) => unreachable!("built-in two_link.urdf is invalid: {e}"),
+        }
+    }
+}
+
+/// A scenario checked against its robot: everything a run needs.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The scenario as loaded.
+    pub scenario: Scenario,
+    /// Where the scenario came from ("built-in paper scenario" or a path).
+    pub source: String,
+    /// The scenario's TOML text, for logs.
+    pub toml: String,
+    /// The robot.
+    pub robot: RobotSource,
+    /// The checked reference and envelope.
+    pub reference: Reference,
+    /// Control period in integer nanoseconds.
+    pub period_ns: u64,
+    /// Number of control steps.
+    pub steps: u64,
+}
+
+impl Plan {
+    /// Control period in seconds (exactly `period_ns` / 1e9).
+    pub fn dt(&self) -> f64 {
+        self.period_ns as f64 / 1e9
+    }
+
+    /// Sim time of step `k` in nanoseconds.
+    pub fn t_ns(&self, k: u64) -> u64 {
+        k * self.period_ns
+    }
+}
+
+/// Seconds from integer nanoseconds; the one conversion every process uses,
+/// so that in-process and multi-process runs compute the same bits.
+pub fn ns_to_s(ns: u64) -> f64 {
+    ns as f64 / 1e9
+}
+
+impl Scenario {
+    /// Parses TOML; `file` names the source in errors.
+    pub fn from_toml_str(text: &str, file: &str) -> Result<Self, ScenarioError> {
+        let s: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Toml {
+            file: file.to_string(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        s.validate(file)?;
+        Ok(s)
+    }
+
+    /// Checks the values that do not depend on the robot.
+    pub fn validate(&self, file: &str) -> Result<(), ScenarioError> {
+        let invalid = |key: &str, value: f64, need: &str| ScenarioError::Invalid {
+            file: file.to_string(),
+            key: key.to_string(),
+            value: value.to_string(),
+            need: need.to_string(),
+        };
+        if !(self.duration_s.is_finite() && self.duration_s > 0.0 && self.duration_s <= 1e6) {
+            return Err(invalid(
+                "duration_s",
+                self.duration_s,
+                "a number of seconds in (0, 1e6]",
+            ));
+        }
+        if !(self.rate_hz >= 1.0 && self.rate_hz <= 100_000.0) {
+            return Err(invalid(
+                "rate_hz",
+                self.rate_hz,
+                "a rate from 1 to 100000 Hz",
+            ));
+        }
+        for (key, v) in [
+            ("initial.q", &self.initial.q),
+            ("initial.qd", &self.initial.qd),
+        ] {
+            if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+                return Err(invalid(&format!("{key}[{i}]"), *x, "a finite number"));
+            }
+        }
+        self.controller
+            .validate()
+            .map_err(|cause| ScenarioError::Controller {
+                file: file.to_string(),
+                cause,
+            })?;
+        self.plant
+            .validate()
+            .map_err(|cause| ScenarioError::Plant {
+                file: file.to_string(),
+                cause,
+            })?;
+        Reference::new(&self.reference, &self.envelope).map_err(|cause| {
+            ScenarioError::Trajectory {
+                file: file.to_string(),
+                cause,
+            }
+        })?;
+        Ok(())
+    }
+}
+
+/// Command-line values that replace the scenario's own.
+#[derive(Debug, Clone, Default)]
+pub struct Overrides {
+    /// Replaces `duration_s`.
+    pub duration_s: Option<f64>,
+}
+
+/// Loads a scenario file (or the built-in paper scenario when `path` is
+/// None), applies `overrides`, loads its robot, and checks that they fit.
+pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, ScenarioError> {
+    let (toml_text, source, base) = match path {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|cause| ScenarioError::Io {
+                file: p.display().to_string(),
+                cause,
+            })?;
+            let base = p.parent().map(Path::to_path_buf).unwrap_or_default();
+            (text, p.display().to_string(), Some(base))
+        }
+        None => (
+            PAPER_TOML.to_string(),
+            "built-in paper scenario".to_string(),
+            None,
+        ),
+    };
+    let mut scenario = Scenario::from_toml_str(&toml_text, &source)?;
+    if let Some(d) = overrides.duration_s {
+        scenario.duration_s = d;
+        scenario.validate(&format!("{source} with --duration {d}"))?;
+    }
+    let robot = match (&scenario.robot, &base) {
+        (Some(rel), Some(base)) => RobotSource::from_file(&base.join(rel)),
+        (Some(rel), None) => RobotSource::from_file(Path::new(rel)),
+        (None, _) => Ok(RobotSource::builtin()),
+    }
+    .map_err(|cause| ScenarioError::Robot {
+        file: source.clone(),
+        cause: Box::new(cause),
+    })?;
+    plan(scenario, source, toml_text, robot)
+}
+
+/// Checks a parsed scenario against a robot and fixes the time grid.
+pub fn plan(
+    scenario: Scenario,
+    source: String,
+    toml: String,
+    robot: RobotSource,
+) -> Result<Plan, ScenarioError> {
+    let dof = robot.model.dof();
+    let mismatch = |key: &str, got: usize| ScenarioError::Invalid {
+        file: source.clone(),
+        key: key.to_string(),
+        value: format!("{got} entries"),
+        need: format!(
+            "one entry per actuated joint of {} ({dof}: {})",
+            robot.label(),
+            robot.model.joint_names().join(", ")
+        ),
+    };
+    for (key, len) in [
+        ("initial.q", scenario.initial.q.len()),
+        ("initial.qd", scenario.initial.qd.len()),
+        ("reference.joints", scenario.reference.joints.len()),
+        ("envelope.joints", scenario.envelope.joints.len()),
+    ] {
+        if len != dof {
+            return Err(mismatch(key, len));
+        }
+    }
+    let reference = Reference::new(&scenario.reference, &scenario.envelope).map_err(|cause| {
+        ScenarioError::Trajectory {
+            file: source.clone(),
+            cause,
+        }
+    })?;
+    let period_ns = (1e9 / scenario.rate_hz).round() as u64;
+    let steps = (scenario.duration_s * 1e9 / period_ns as f64).round() as u64;
+    Ok(Plan {
+        scenario,
+        source,
+        toml,
+        robot,
+        reference,
+        period_ns,
+        steps,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shipped_paper_toml_is_the_default() {
+        let s = Scenario::from_toml_str(PAPER_TOML, "paper.toml").unwrap();
+        assert_eq!(s, Scenario::default());
+        let plan = load(None, &Overrides::default()).unwrap();
+        assert_eq!((plan.period_ns, plan.steps), (1_000_000, 20_000));
+        assert_eq!(plan.robot.model.joint_names(), ["joint1", "joint2"]);
+    }
+
+    #[test]
+    fn empty_file_is_the_paper_scenario() {
+        assert_eq!(
+            Scenario::from_toml_str("", "x").unwrap(),
+            Scenario::default()
+        );
+    }
+
+    fn err(text: &str) -> String {
+        Scenario::from_toml_str(text, "bad.toml")
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn errors_name_the_file_and_key() {
+        assert!(err("[controller]\nk3 = 1.0\n").contains("unknown field `k3`"));
+        assert!(err("[controller]\nk3 = 1.0\n").starts_with("bad.toml"));
+        assert!(err("duration_s = nan\n").contains("duration_s = NaN is invalid"));
+        assert!(err("rate_hz = 0.0\n").contains("rate_hz"));
+        assert!(err("[controller]\nbeta = -1.0\n").contains("controller.beta"));
+        assert!(err("[controller]\nbeta = \"ten\"\n").contains("beta"));
+        assert!(err("[initial]\nq = [0.6, inf]\n").contains("initial.q[1]"));
+        assert!(err("[plant]\nsubsteps = 0\n").contains("plant.substeps"));
+        assert!(err("[envelope]\njoints = [{offset = 0.05, sin = 0.1, omega = 1.0}, {offset = 1.0}]\n[reference]\njoints = [{}, {}]\n")
+            .contains("envelope.joints[0]"));
+        assert!(err("[controller]\nintegrator = \"rk45\"\n").contains("integrator"));
+    }
+
+    #[test]
+    fn lengths_are_checked_against_the_robot() {
+        let s = Scenario::from_toml_str(
+            "[initial]\nq = [0.1, 0.2, 0.3]\nqd = [0, 0, 0]\n",
+            "three.toml",
+        )
+        .unwrap();
+        let e = plan(
+            s,
+            "three.toml".into(),
+            String::new(),
+            RobotSource::builtin(),
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "three.toml: initial.q = 3 entries is invalid: it must be one entry per actuated joint of built-in two_link.urdf (2: joint1, joint2)"
+        );
+    }
+
+    #[test]
+    fn missing_robot_file_names_the_path() {
+        let dir = std::env::temp_dir().join(format!("scenario-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("s.toml");
+        std::fs::write(&f, "robot = \"nope.urdf\"\n").unwrap();
+        let e = load(Some(&f), &Overrides::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("nope.urdf"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

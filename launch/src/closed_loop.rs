@@ -1,0 +1,98 @@
+//! The closed loop in one process: plant, reference and controller stepped
+//! in turn, as fast as the machine allows. `testbed sim` is this loop; the
+//! multi-process lockstep mode must reproduce it bit for bit.
+
+use controller::{Controller, ControllerError, ControllerInput};
+use plant_rapier::{Plant, PlantError};
+use scenario::{Plan, ns_to_s};
+use trajectory::ReferenceSample;
+
+use crate::record::StepRecord;
+
+/// Why the loop stopped early.
+#[derive(Debug, thiserror::Error)]
+pub enum LoopError {
+    /// The plant could not be built or stepped.
+    #[error("plant ({robot}): {cause}")]
+    Plant {
+        /// The robot's label.
+        robot: String,
+        /// The cause.
+        cause: PlantError,
+    },
+    /// The controller could not be built.
+    #[error("controller: {0}")]
+    Controller(#[from] ControllerError),
+    /// The step consumer failed (e.g. the CSV file could not be written).
+    #[error("writing step {step}: {cause}")]
+    Sink {
+        /// The step being written.
+        step: u64,
+        /// The cause.
+        cause: std::io::Error,
+    },
+}
+
+/// Runs `plan` to the end, handing every step to `on_step`.
+pub fn run(
+    plan: &Plan,
+    mut on_step: impl FnMut(&StepRecord<'_>) -> std::io::Result<()>,
+) -> Result<(), LoopError> {
+    let robot = plan.robot.label();
+    let plant_err = |cause| LoopError::Plant {
+        robot: robot.clone(),
+        cause,
+    };
+    let s = &plan.scenario;
+    let mut plant = Plant::new(&plan.robot.model, &s.plant).map_err(plant_err)?;
+    plant
+        .set_state(&s.initial.q, &s.initial.qd)
+        .map_err(plant_err)?;
+    let n = plant.dof();
+    let mut controller = Controller::new(s.controller.clone(), n)?;
+    let mut diag = controller.diagnostics();
+    let mut reference = ReferenceSample::new(n);
+    let dt = plan.dt();
+
+    let (mut q, mut qd) = plant.state();
+    let (mut q_next, mut qd_next) = (vec![0.0; n], vec![0.0; n]);
+    let mut qdd = vec![0.0; n];
+    for k in 0..plan.steps {
+        let t = ns_to_s(plan.t_ns(k));
+        plan.reference.sample_into(t, &mut reference);
+        let input = ControllerInput {
+            t,
+            q: &q,
+            qd: &qd,
+            q_d: &reference.q_d,
+            qd_d: &reference.qd_d,
+            kc: &reference.kc,
+            kc_dot: &reference.kc_dot,
+        };
+        controller.step(dt, &input, &mut diag);
+        plant.step(&diag.tau, dt).map_err(plant_err)?;
+        plant.state_into(&mut q_next, &mut qd_next);
+        for i in 0..n {
+            qdd[i] = (qd_next[i] - qd[i]) / dt;
+        }
+        let record = StepRecord {
+            t,
+            q: &q,
+            qd: &qd,
+            qdd: &qdd,
+            tau: &diag.tau,
+            q_d: &reference.q_d,
+            kc: &reference.kc,
+            z1: &diag.z1,
+            z1g: &diag.z1g,
+            z2: &diag.z2,
+            wa_norm: &diag.wa_norm,
+            barrier_breached: diag.barrier_breached,
+            fault: diag.fault.is_some(),
+        };
+        on_step(&record).map_err(|cause| LoopError::Sink { step: k, cause })?;
+        std::mem::swap(&mut q, &mut q_next);
+        std::mem::swap(&mut qd, &mut qd_next);
+    }
+    Ok(())
+}

@@ -1,0 +1,6 @@
+//! System tests: the `testbed` binary as a user runs it.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+mod sim_cli;
+mod util;
