@@ -65,6 +65,9 @@ pub enum Fault {
     EnvelopeNotPositive,
     /// The law produced a NaN or infinite value.
     NonFiniteOutput,
+    /// The process shell had no reference sample to give (real time, before
+    /// the trajectory's first sample arrived).
+    NoReference,
 }
 
 impl Fault {
@@ -75,6 +78,7 @@ impl Fault {
             Fault::WrongLength => 2,
             Fault::EnvelopeNotPositive => 3,
             Fault::NonFiniteOutput => 4,
+            Fault::NoReference => 5,
         }
     }
 }

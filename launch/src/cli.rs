@@ -1,16 +1,20 @@
 //! Command-line parsing and dispatch.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use launch::mode::Mode;
+use launch::node::{self, NodeArgs};
+use launch::run::{self, RunError, RunOptions};
 use launch::{closed_loop, csv_out, summary::SummaryBuilder};
 use scenario::Overrides;
+use wire::NodeKind;
 
 use crate::report::{self, SimReport};
 
@@ -27,10 +31,38 @@ struct Cli {
 enum Command {
     /// Run the closed loop in one process, as fast as the machine allows.
     Sim(SimArgs),
+    /// Run the stack as separate processes over iceoryx2 shared memory.
+    Run(RunArgs),
+    /// Run one node of a stack (the launcher starts these; start one by hand
+    /// with `testbed run --external <node>` to debug or replace it).
+    Node {
+        /// Which node.
+        #[arg(value_enum)]
+        name: NodeName,
+        #[command(flatten)]
+        args: NodeArgs,
+    },
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum NodeName {
+    Plant,
+    Trajectory,
+    Controller,
+}
+
+impl NodeName {
+    fn kind(self) -> NodeKind {
+        match self {
+            NodeName::Plant => NodeKind::Plant,
+            NodeName::Trajectory => NodeKind::Trajectory,
+            NodeName::Controller => NodeKind::Controller,
+        }
+    }
 }
 
 #[derive(Debug, Args)]
-struct SimArgs {
+struct ScenarioArgs {
     /// Scenario file (TOML) [default: the built-in paper scenario, scenarios/paper.toml].
     #[arg(long, value_name = "FILE")]
     scenario: Option<PathBuf>,
@@ -45,19 +77,70 @@ struct SimArgs {
     csv: Option<PathBuf>,
 }
 
+#[derive(Debug, Args)]
+struct SimArgs {
+    #[command(flatten)]
+    common: ScenarioArgs,
+}
+
+#[derive(Debug, Args)]
+struct RunArgs {
+    #[command(flatten)]
+    common: ScenarioArgs,
+    /// Timing mode.
+    #[arg(long, value_enum, default_value = "realtime")]
+    mode: Mode,
+    /// Control rate in Hz instead of the scenario's rate_hz.
+    #[arg(long, value_name = "HZ")]
+    rate: Option<f64>,
+    /// Do not start this node; wait for one started by hand (repeatable).
+    #[arg(long, value_enum, value_name = "NODE")]
+    external: Vec<NodeName>,
+    /// Folder for run folders.
+    #[arg(long, value_name = "DIR", default_value = "runs")]
+    runs_dir: PathBuf,
+}
+
+/// Exit status of a run stopped by Ctrl-C (128 + SIGINT).
+const EXIT_INTERRUPTED: u8 = 130;
+
 /// Parses the command line and runs it.
 pub fn run() -> Result<ExitCode> {
     let cli = Cli::parse();
     match cli.command {
         Command::Sim(args) => sim(args),
+        Command::Run(args) => run_stack(args),
+        Command::Node { name, args } => {
+            node::run(name.kind(), &args)
+                .with_context(|| format!("{} node", name.kind().name()))?;
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
 
-fn sim(args: SimArgs) -> Result<ExitCode> {
+fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario::Plan> {
     let overrides = Overrides {
-        duration_s: args.duration,
+        duration_s: common.duration,
+        rate_hz: rate,
     };
-    let plan = scenario::load(args.scenario.as_deref(), &overrides)?;
+    Ok(scenario::load(common.scenario.as_deref(), &overrides)?)
+}
+
+fn print_report(report: &SimReport, json: bool) -> Result<()> {
+    if json {
+        println!("{}", serde_json::to_string_pretty(report)?);
+    } else {
+        print!("{}", report::table(report));
+    }
+    if !report.summary.finite {
+        eprintln!("testbed: warning: the run produced non-finite values or controller faults");
+    }
+    Ok(())
+}
+
+fn sim(args: SimArgs) -> Result<ExitCode> {
+    let args = args.common;
+    let plan = load(&args, None)?;
     let mut csv = match &args.csv {
         Some(path) => {
             let file = File::create(path)
@@ -89,15 +172,33 @@ fn sim(args: SimArgs) -> Result<ExitCode> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     result.with_context(|| format!("running {}", plan.source))?;
+    print_report(&SimReport::new(&plan, summary.finish(), wall), args.json)?;
+    Ok(ExitCode::SUCCESS)
+}
 
-    let report = SimReport::new(&plan, summary.finish(), wall);
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        print!("{}", report::table(&report));
-    }
-    if !report.summary.finite {
-        eprintln!("testbed: warning: the run produced non-finite values or controller faults");
-    }
+fn run_stack(args: RunArgs) -> Result<ExitCode> {
+    let plan = load(&args.common, args.rate)?;
+    let source = plan.source.clone();
+    let opts = RunOptions {
+        plan: plan.clone(),
+        mode: args.mode,
+        csv: args.common.csv.clone(),
+        external: args.external.iter().map(|n| n.kind()).collect(),
+        runs_dir: args.runs_dir.clone(),
+        progress: std::io::stderr().is_terminal(),
+    };
+    let outcome = match run::run(opts) {
+        Ok(o) => o,
+        Err(RunError::Interrupted) => {
+            eprintln!("testbed: interrupted; all nodes stopped");
+            return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        }
+        Err(e) => return Err(e).with_context(|| format!("running {source}")),
+    };
+    let mut report = SimReport::new(&plan, outcome.summary, outcome.wall_time_s);
+    report.timing = Some(outcome.timing);
+    report.run_dir = Some(outcome.run_dir.display().to_string());
+    report.missing_rows = Some(outcome.missing_rows);
+    print_report(&report, args.common.json)?;
     Ok(ExitCode::SUCCESS)
 }

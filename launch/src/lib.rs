@@ -1,11 +1,18 @@
-//! The `testbed` command's internals: the in-process closed loop, the run
-//! summary, and CSV output.
+//! The `testbed` command's internals: the in-process closed loop, the node
+//! processes, the launcher, the run summary and CSV output.
 //!
 //! Where it sits: at the top. `testbed sim` loads a [`scenario::Plan`], runs
 //! [`closed_loop::run`] and feeds each [`record::StepRecord`] to a
-//! [`summary::SummaryBuilder`] and, if asked, a CSV file.
+//! [`summary::SummaryBuilder`]. `testbed run` spawns the [`node`] processes
+//! (plant, trajectory, controller) that talk over iceoryx2 ([`wire`]), and
+//! [`run`] supervises them and assembles the same records from the topics.
 
+pub mod assemble;
+pub mod clock;
 pub mod closed_loop;
 pub mod csv_out;
+pub mod mode;
+pub mod node;
 pub mod record;
+pub mod run;
 pub mod summary;

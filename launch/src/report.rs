@@ -2,6 +2,7 @@
 
 use std::fmt::Write;
 
+use launch::run::timing::{Percentiles, TimingSummary};
 use launch::summary::Summary;
 use scenario::Plan;
 use serde::Serialize;
@@ -24,6 +25,15 @@ pub struct SimReport {
     pub wall_time_s: f64,
     /// Sim time per wall time.
     pub realtime_factor: f64,
+    /// Timing of a multi-process run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub timing: Option<TimingSummary>,
+    /// The run's folder (multi-process runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub run_dir: Option<String>,
+    /// Rows that could not be rebuilt because samples were dropped (multi-process runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub missing_rows: Option<u64>,
 }
 
 impl SimReport {
@@ -37,8 +47,15 @@ impl SimReport {
             realtime_factor: sim_s / wall_time_s.max(1e-9),
             summary,
             wall_time_s,
+            timing: None,
+            run_dir: None,
+            missing_rows: None,
         }
     }
+}
+
+fn percentiles(p: &Percentiles) -> String {
+    format!("p50 {:8.1}  p99 {:8.1}  max {:8.1}", p.p50, p.p99, p.max)
 }
 
 fn opt(v: Option<f64>, prec: usize) -> String {
@@ -105,5 +122,33 @@ pub fn table(r: &SimReport) -> String {
         s.fault_steps,
         if s.finite { "yes" } else { "NO" }
     );
+    if let Some(t) = &r.timing {
+        let _ = writeln!(
+            out,
+            "\ntiming ({} at {} Hz): {} cycles, {} deadline misses",
+            t.mode.as_str(),
+            t.rate_hz,
+            t.cycles,
+            t.deadline_misses
+        );
+        let _ = writeln!(
+            out,
+            "  period jitter us  {}",
+            percentiles(&t.period_jitter_us)
+        );
+        let _ = writeln!(out, "  wake late us      {}", percentiles(&t.wake_late_us));
+        let _ = writeln!(out, "  round trip us     {}", percentiles(&t.round_trip_us));
+        let _ = writeln!(
+            out,
+            "  controller us     {}",
+            percentiles(&t.controller_compute_us)
+        );
+    }
+    if let Some(m) = r.missing_rows.filter(|m| *m > 0) {
+        let _ = writeln!(out, "rows lost to dropped samples: {m}");
+    }
+    if let Some(d) = &r.run_dir {
+        let _ = writeln!(out, "run folder: {d}");
+    }
     out
 }

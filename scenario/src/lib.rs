@@ -205,7 +205,7 @@ pub struct Plan {
     pub scenario: Scenario,
     /// Where the scenario came from ("built-in paper scenario" or a path).
     pub source: String,
-    /// The scenario's TOML text, for logs.
+    /// The scenario's TOML text as written by its author, for logs.
     pub toml: String,
     /// The robot.
     pub robot: RobotSource,
@@ -218,6 +218,22 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// The scenario as it will run (overrides applied, robot path made
+    /// absolute), as TOML: what the node processes of a run load.
+    pub fn effective_toml(&self) -> Result<String, ScenarioError> {
+        let mut s = self.scenario.clone();
+        s.robot = self.robot.path.as_ref().map(|p| {
+            std::path::absolute(p)
+                .unwrap_or_else(|_| p.clone())
+                .display()
+                .to_string()
+        });
+        toml::to_string(&s).map_err(|e| ScenarioError::Toml {
+            file: self.source.clone(),
+            message: format!("cannot write the effective scenario: {e}"),
+        })
+    }
+
     /// Control period in seconds (exactly `period_ns` / 1e9).
     pub fn dt(&self) -> f64 {
         self.period_ns as f64 / 1e9
@@ -303,6 +319,8 @@ impl Scenario {
 pub struct Overrides {
     /// Replaces `duration_s`.
     pub duration_s: Option<f64>,
+    /// Replaces `rate_hz`.
+    pub rate_hz: Option<f64>,
 }
 
 /// Loads a scenario file (or the built-in paper scenario when `path` is
@@ -327,6 +345,10 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
     if let Some(d) = overrides.duration_s {
         scenario.duration_s = d;
         scenario.validate(&format!("{source} with --duration {d}"))?;
+    }
+    if let Some(r) = overrides.rate_hz {
+        scenario.rate_hz = r;
+        scenario.validate(&format!("{source} with --rate {r}"))?;
     }
     let robot = match (&scenario.robot, &base) {
         (Some(rel), Some(base)) => RobotSource::from_file(&base.join(rel)),

@@ -1,0 +1,139 @@
+//! Rebuilds [`StepRecord`]s from the messages of a multi-process run.
+//!
+//! Row k needs joint state k (q, q̇), joint state k+1 (the torque the plant
+//! applied over the step and q̇ for the mean acceleration) and the
+//! controller diagnostics of step k (the reference it used, Z1, Z2, ‖Ŵa‖).
+//! The arithmetic is the in-process loop's, so a lockstep run gives the
+//! same bits as `testbed sim`.
+
+use std::collections::BTreeMap;
+
+use scenario::ns_to_s;
+use wire::{ControllerDiagnostics, JointState};
+
+use crate::record::StepRecord;
+
+/// A diagnostics sample missing this many steps behind the newest state is
+/// given up on (real time only: a lossless run never drops one).
+const GIVE_UP_AFTER: u64 = 1000;
+
+/// Collects states and diagnostics and emits complete rows in step order.
+#[derive(Debug)]
+pub struct RecordAssembler {
+    n: usize,
+    dt: f64,
+    steps: u64,
+    next: u64,
+    newest_state: Option<u64>,
+    states: BTreeMap<u64, JointState>,
+    diags: BTreeMap<u64, ControllerDiagnostics>,
+    missing: u64,
+    qdd: Vec<f64>,
+}
+
+impl RecordAssembler {
+    /// For `n` joints, period `dt` s and `steps` rows.
+    pub fn new(n: usize, dt: f64, steps: u64) -> Self {
+        Self {
+            n,
+            dt,
+            steps,
+            next: 0,
+            newest_state: None,
+            states: BTreeMap::new(),
+            diags: BTreeMap::new(),
+            missing: 0,
+            qdd: vec![0.0; n],
+        }
+    }
+
+    /// Adds a joint state.
+    pub fn push_state(&mut self, s: JointState) {
+        let seq = s.header.seq;
+        if seq >= self.next {
+            self.newest_state = Some(self.newest_state.map_or(seq, |n| n.max(seq)));
+            self.states.insert(seq, s);
+        }
+    }
+
+    /// Adds a diagnostics sample.
+    pub fn push_diag(&mut self, d: ControllerDiagnostics) {
+        if d.header.seq >= self.next {
+            self.diags.insert(d.header.seq, d);
+        }
+    }
+
+    /// The next row to be emitted (= rows emitted so far, plus those given up).
+    pub fn next_step(&self) -> u64 {
+        self.next
+    }
+
+    /// Rows given up because their data never came.
+    pub fn missing(&self) -> u64 {
+        self.missing
+    }
+
+    /// True once every row has been emitted or given up.
+    pub fn complete(&self) -> bool {
+        self.next >= self.steps
+    }
+
+    /// Emits every row that is complete, in order.
+    pub fn emit(
+        &mut self,
+        mut on_step: impl FnMut(&StepRecord<'_>) -> std::io::Result<()>,
+    ) -> std::io::Result<()> {
+        while self.next < self.steps {
+            let k = self.next;
+            let (Some(s), Some(s1)) = (self.states.get(&k), self.states.get(&(k + 1))) else {
+                if self.stale(k) {
+                    self.skip(k);
+                    continue;
+                }
+                break;
+            };
+            let Some(d) = self.diags.get(&k) else {
+                if self.stale(k) {
+                    self.skip(k);
+                    continue;
+                }
+                break;
+            };
+            let n = self.n;
+            for i in 0..n {
+                self.qdd[i] = (s1.qd[i] - s.qd[i]) / self.dt;
+            }
+            let record = StepRecord {
+                t: ns_to_s(s.header.t_ns),
+                q: &s.q[..n],
+                qd: &s.qd[..n],
+                qdd: &self.qdd,
+                tau: &s1.tau_applied[..n],
+                q_d: &d.q_d[..n],
+                kc: &d.kc_in[..n],
+                z1: &d.z1[..n],
+                z1g: &d.z1g[..n],
+                z2: &d.z2[..n],
+                wa_norm: &d.wa_norm[..n],
+                barrier_breached: d.barrier_breached != 0,
+                fault: d.fault != 0,
+            };
+            on_step(&record)?;
+            self.states.remove(&k);
+            self.diags.remove(&k);
+            self.next += 1;
+        }
+        Ok(())
+    }
+
+    fn stale(&self, k: u64) -> bool {
+        self.newest_state.is_some_and(|n| n > k + GIVE_UP_AFTER)
+    }
+
+    fn skip(&mut self, k: u64) {
+        self.states.remove(&k);
+        self.diags.remove(&k);
+        self.missing += 1;
+        self.next += 1;
+    }
+}

@@ -1,0 +1,413 @@
+//! `testbed run`: the launcher. It turns a validated plan into running
+//! processes, starts them together, watches them, and stops them in order.
+
+pub mod collect;
+pub mod spawn;
+pub mod timing;
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use scenario::Plan;
+use wire::{
+    Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, MAX_DOF, NODE_DONE, NODE_FAILED,
+    NODE_READY, NodeKind, NodeStatus, RunPrefix, Topic, WireError, monotonic_ns,
+};
+
+use crate::mode::Mode;
+use crate::summary::Summary;
+use collect::Collector;
+use spawn::{Children, describe};
+use timing::TimingSummary;
+
+/// The nodes `testbed run` starts, in start order.
+pub const NODES: [NodeKind; 3] = [NodeKind::Plant, NodeKind::Trajectory, NodeKind::Controller];
+
+/// How long nodes may take to connect.
+const START_TIMEOUT: Duration = Duration::from_secs(30);
+/// How long a node started by hand (`--external`) may take to connect.
+const EXTERNAL_START_TIMEOUT: Duration = Duration::from_secs(300);
+/// A run whose row count does not move for this long is declared stuck.
+const STALL_TIMEOUT: Duration = Duration::from_secs(20);
+/// How long nodes may take to report DONE once every row is in.
+const DONE_TIMEOUT: Duration = Duration::from_secs(5);
+/// Grace period between STOP, SIGTERM and SIGKILL.
+const STOP_GRACE: Duration = Duration::from_secs(2);
+/// How often the launcher wakes to drain topics and check its children.
+const TICK: Duration = Duration::from_millis(10);
+
+/// Everything `testbed run` needs, validated.
+#[derive(Debug)]
+pub struct RunOptions {
+    /// The scenario, checked against its robot.
+    pub plan: Plan,
+    /// Timing mode.
+    pub mode: Mode,
+    /// Write one row per step here.
+    pub csv: Option<PathBuf>,
+    /// Nodes the user starts by hand instead of the launcher.
+    pub external: Vec<NodeKind>,
+    /// Folder under which the run's folder is made.
+    pub runs_dir: PathBuf,
+    /// Show a progress bar (real time, on a terminal).
+    pub progress: bool,
+}
+
+/// What a finished run produced.
+#[derive(Debug)]
+pub struct RunOutcome {
+    /// The step figures.
+    pub summary: Summary,
+    /// The timing figures.
+    pub timing: TimingSummary,
+    /// The run's folder (holds the scenario it ran).
+    pub run_dir: PathBuf,
+    /// Wall time from START to the last row, s.
+    pub wall_time_s: f64,
+    /// Rows that could not be rebuilt because samples were dropped.
+    pub missing_rows: u64,
+}
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The bus failed.
+    #[error(transparent)]
+    Wire(#[from] WireError),
+    /// A file could not be written.
+    #[error("{0}: {1}")]
+    Output(String, std::io::Error),
+    /// A node could not be started.
+    #[error("cannot start the {node} node: {cause}")]
+    Spawn {
+        /// Which node.
+        node: &'static str,
+        /// The cause.
+        cause: std::io::Error,
+    },
+    /// A node died or exited before the run was over.
+    #[error("the {node} node {how}{}", if .stderr.is_empty() { String::new() } else { format!("; its last words:\n{}", .stderr) })]
+    NodeFailed {
+        /// Which node.
+        node: &'static str,
+        /// How it ended.
+        how: String,
+        /// The last lines it wrote to stderr.
+        stderr: String,
+    },
+    /// Nodes did not connect in time.
+    #[error("nodes did not report ready within {secs} s: {}", .missing.join(", "))]
+    StartTimeout {
+        /// The nodes that did not connect.
+        missing: Vec<&'static str>,
+        /// The limit.
+        secs: u64,
+    },
+    /// No progress for too long.
+    #[error("the run stalled at step {step} of {steps} (nothing for {secs} s)")]
+    Stalled {
+        /// Rows done.
+        step: u64,
+        /// Rows expected.
+        steps: u64,
+        /// The limit.
+        secs: u64,
+    },
+    /// Ctrl-C or SIGTERM.
+    #[error("interrupted; all nodes stopped")]
+    Interrupted,
+    /// The arm has more joints than the wire carries.
+    #[error("the robot has {dof} actuated joints; the wire carries at most {MAX_DOF}")]
+    TooManyJoints {
+        /// Joints of the arm.
+        dof: usize,
+    },
+}
+
+/// A fresh folder name for a run: UTC-free, sortable, unique on this machine.
+fn run_id() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    format!("{secs}-{}", std::process::id())
+}
+
+/// The arguments of `testbed node <kind>` for this run.
+pub fn node_args(
+    prefix: &RunPrefix,
+    scenario: &Path,
+    mode: Mode,
+    parent: Option<u32>,
+) -> Vec<String> {
+    let mut args = vec![
+        "--prefix".to_string(),
+        prefix.as_str().to_string(),
+        "--scenario".to_string(),
+        scenario.display().to_string(),
+        "--mode".to_string(),
+        mode.as_str().to_string(),
+    ];
+    if let Some(pid) = parent {
+        args.push("--parent-pid".into());
+        args.push(pid.to_string());
+    }
+    args
+}
+
+/// Runs the stack to the end.
+pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
+    let plan = &opts.plan;
+    let dof = plan.robot.model.dof();
+    if dof > MAX_DOF {
+        return Err(RunError::TooManyJoints { dof });
+    }
+    let run_dir = opts.runs_dir.join(run_id());
+    std::fs::create_dir_all(&run_dir)
+        .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?;
+    let scenario_file = std::path::absolute(run_dir.join("scenario.toml"))
+        .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?;
+    let toml = plan.effective_toml().map_err(|e| {
+        RunError::Output(
+            scenario_file.display().to_string(),
+            std::io::Error::other(e.to_string()),
+        )
+    })?;
+    std::fs::write(&scenario_file, toml)
+        .map_err(|e| RunError::Output(scenario_file.display().to_string(), e))?;
+
+    let prefix = RunPrefix::unique();
+    // Domains that killed launchers left behind.
+    for stale in RunPrefix::stale_domains(&prefix) {
+        let _ = stale.remove_domain_if_unused();
+    }
+    let bus = Bus::new(&prefix, "launcher")?;
+    let status = bus.subscriber::<NodeStatus>(Topic::Status)?;
+    let control = bus.publisher::<Control>(Topic::Control, Delivery::DropWhenFull)?;
+    let csv = match &opts.csv {
+        Some(path) => {
+            let file =
+                File::create(path).map_err(|e| RunError::Output(path.display().to_string(), e))?;
+            let mut w = BufWriter::new(file);
+            std::io::Write::write_all(
+                &mut w,
+                format!("{}\n", crate::csv_out::header(dof)).as_bytes(),
+            )
+            .map_err(|e| RunError::Output(path.display().to_string(), e))?;
+            Some((w, path.display().to_string()))
+        }
+        None => None,
+    };
+    let mut collector = Collector::new(&bus, plan, csv)?;
+
+    let exe = std::env::current_exe().map_err(|cause| RunError::Spawn {
+        node: "plant",
+        cause,
+    })?;
+    let mut children = Children::default();
+    let args = node_args(&prefix, &scenario_file, opts.mode, Some(std::process::id()));
+    for kind in NODES {
+        if opts.external.contains(&kind) {
+            eprintln!(
+                "testbed: waiting for the {} node; start it with:\n  testbed node {} {}",
+                kind.name(),
+                kind.name(),
+                node_args(&prefix, &scenario_file, opts.mode, None).join(" ")
+            );
+            continue;
+        }
+        let child = spawn::spawn(&exe, kind, &args).map_err(|cause| RunError::Spawn {
+            node: kind.name(),
+            cause,
+        })?;
+        children.push(child);
+    }
+
+    let result = supervise(
+        &opts,
+        &bus,
+        &status,
+        &control,
+        &mut collector,
+        &mut children,
+    );
+    // Whatever happened: STOP, grace, SIGTERM, SIGKILL, reap.
+    let _ = control.send(control_msg(CONTROL_STOP, 0));
+    children.stop(STOP_GRACE);
+    let finished = collector.finish(opts.mode, plan.scenario.rate_hz);
+    let missing_rows = collector.missing_rows();
+    // Close every port of this process, then remove what is left of the
+    // run's domain (including what a killed node left behind).
+    drop((collector, status, control, bus));
+    let _ = prefix.remove_domain_if_unused();
+    let wall_time_s = result?;
+    let (summary, timing) = finished?;
+    Ok(RunOutcome {
+        summary,
+        timing,
+        run_dir,
+        wall_time_s,
+        missing_rows,
+    })
+}
+
+fn control_msg(command: u32, epoch_wall_ns: u64) -> Control {
+    Control {
+        header: Header {
+            seq: 0,
+            t_ns: 0,
+            wall_ns: monotonic_ns(),
+        },
+        command,
+        reserved: 0,
+        epoch_wall_ns,
+    }
+}
+
+/// Waits for READY, sends START, drains until every row is in. Returns the
+/// wall time of the run proper.
+fn supervise(
+    opts: &RunOptions,
+    bus: &Bus,
+    status: &wire::TopicSubscriber<NodeStatus>,
+    control: &wire::TopicPublisher<Control>,
+    collector: &mut Collector,
+    children: &mut Children,
+) -> Result<f64, RunError> {
+    let plan = &opts.plan;
+    let mut ready: Vec<NodeKind> = Vec::new();
+    let mut done: Vec<NodeKind> = Vec::new();
+    let limit = if opts.external.is_empty() {
+        START_TIMEOUT
+    } else {
+        EXTERNAL_START_TIMEOUT
+    };
+    let start_wait = Instant::now();
+    while ready.len() < NODES.len() {
+        tick(bus)?;
+        read_status(status, &mut ready, &mut done)?;
+        check_children(children)?;
+        if start_wait.elapsed() > limit {
+            return Err(RunError::StartTimeout {
+                missing: NODES
+                    .iter()
+                    .filter(|k| !ready.contains(k))
+                    .map(|k| k.name())
+                    .collect(),
+                secs: limit.as_secs(),
+            });
+        }
+    }
+
+    // Step 0 a little in the future, so every node is waiting for it.
+    let epoch = monotonic_ns() + 20_000_000;
+    control.send(control_msg(CONTROL_START, epoch))?;
+    let started = Instant::now();
+    let bar = progress_bar(opts);
+    let mut last_rows = 0;
+    let mut last_change = Instant::now();
+    loop {
+        tick(bus)?;
+        collector.drain()?;
+        read_status(status, &mut ready, &mut done)?;
+        if collector.complete() {
+            break;
+        }
+        check_children(children)?;
+        let rows = collector.rows();
+        if let Some(b) = &bar {
+            b.set_position(rows);
+        }
+        if rows != last_rows {
+            last_rows = rows;
+            last_change = Instant::now();
+        } else if last_change.elapsed() > STALL_TIMEOUT {
+            return Err(RunError::Stalled {
+                step: rows,
+                steps: plan.steps,
+                secs: STALL_TIMEOUT.as_secs(),
+            });
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let wall = started.elapsed().as_secs_f64();
+    // Let every node finish its part (the trajectory publishes a last
+    // sample after the plant's last state) before STOP.
+    let finishing = Instant::now();
+    while NODES
+        .iter()
+        .any(|k| !done.contains(k) && !opts.external.contains(k))
+        && finishing.elapsed() < DONE_TIMEOUT
+    {
+        tick(bus)?;
+        collector.drain()?;
+        read_status(status, &mut ready, &mut done)?;
+        check_children(children)?;
+    }
+    Ok(wall)
+}
+
+/// Sleeps one tick; a SIGINT or SIGTERM turns into `Interrupted`.
+fn tick(bus: &Bus) -> Result<(), RunError> {
+    bus.wait(TICK).map_err(|e| match e {
+        WireError::Terminated => RunError::Interrupted,
+        other => RunError::Wire(other),
+    })
+}
+
+fn read_status(
+    status: &wire::TopicSubscriber<NodeStatus>,
+    ready: &mut Vec<NodeKind>,
+    done: &mut Vec<NodeKind>,
+) -> Result<(), RunError> {
+    while let Some(s) = status.receive()? {
+        let Some(kind) = NodeKind::from_u32(s.node) else {
+            continue;
+        };
+        let list = match s.state {
+            NODE_READY => &mut *ready,
+            NODE_DONE => &mut *done,
+            NODE_FAILED => {
+                return Err(RunError::NodeFailed {
+                    node: kind.name(),
+                    how: "reported a failure".into(),
+                    stderr: String::new(),
+                });
+            }
+            _ => continue,
+        };
+        if !list.contains(&kind) {
+            list.push(kind);
+        }
+    }
+    let _ = status.drain_events();
+    Ok(())
+}
+
+/// Any child that exits before the run is over has failed.
+fn check_children(children: &mut Children) -> Result<(), RunError> {
+    match children.first_exited() {
+        Some((kind, status, stderr)) => Err(RunError::NodeFailed {
+            node: kind.name(),
+            how: describe(status),
+            stderr,
+        }),
+        None => Ok(()),
+    }
+}
+
+fn progress_bar(opts: &RunOptions) -> Option<indicatif::ProgressBar> {
+    if !opts.progress || opts.mode != Mode::Realtime {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(opts.plan.steps);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{spinner} real time {elapsed_precise} [{bar:40}] step {pos}/{len}",
+    ) {
+        bar.set_style(style);
+    }
+    Some(bar)
+}

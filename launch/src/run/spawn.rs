@@ -1,0 +1,186 @@
+//! Node processes: spawning, watching, stopping.
+//!
+//! Children get their own process group (a Ctrl-C in the terminal reaches
+//! only the launcher, which then stops them in order) and their stderr is
+//! forwarded line by line with the node's name, keeping the last lines for
+//! the error message if the node dies. Whatever path the launcher leaves by,
+//! [`Children`]'s `Drop` kills and reaps what is still running.
+
+use std::collections::VecDeque;
+use std::io::{BufRead, BufReader};
+use std::os::unix::process::{CommandExt, ExitStatusExt};
+use std::path::Path;
+use std::process::{ExitStatus, Stdio};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use nix::sys::signal::{Signal, kill};
+use nix::unistd::Pid;
+use wire::NodeKind;
+
+const TAIL_LINES: usize = 20;
+
+/// One running node process.
+pub struct Child {
+    /// Which node.
+    pub kind: NodeKind,
+    process: std::process::Child,
+    tail: Arc<Mutex<VecDeque<String>>>,
+    forwarder: Option<JoinHandle<()>>,
+    exited: Option<ExitStatus>,
+}
+
+impl Child {
+    /// The process id.
+    pub fn pid(&self) -> u32 {
+        self.process.id()
+    }
+
+    /// The last lines the node wrote to stderr.
+    pub fn stderr_tail(&self) -> String {
+        // Let the forwarder finish reading what the process wrote before it exited.
+        let lines = self
+            .tail
+            .lock()
+            .map(|t| t.iter().cloned().collect::<Vec<_>>());
+        lines.unwrap_or_default().join("\n")
+    }
+
+    fn poll(&mut self) -> Option<ExitStatus> {
+        if self.exited.is_none() {
+            self.exited = self.process.try_wait().ok().flatten();
+        }
+        self.exited
+    }
+
+    fn join_forwarder(&mut self) {
+        if let Some(h) = self.forwarder.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// Spawns `testbed node <kind> <args…>` from the running executable.
+pub fn spawn(exe: &Path, kind: NodeKind, args: &[String]) -> std::io::Result<Child> {
+    let mut process = std::process::Command::new(exe)
+        .arg("node")
+        .arg(kind.name())
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .process_group(0)
+        .spawn()?;
+    let tail = Arc::new(Mutex::new(VecDeque::with_capacity(TAIL_LINES)));
+    let forwarder = process.stderr.take().map(|stderr| {
+        let tail = Arc::clone(&tail);
+        let name = kind.name();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                eprintln!("[{name}] {line}");
+                if let Ok(mut t) = tail.lock() {
+                    if t.len() == TAIL_LINES {
+                        t.pop_front();
+                    }
+                    t.push_back(line);
+                }
+            }
+        })
+    });
+    Ok(Child {
+        kind,
+        process,
+        tail,
+        forwarder,
+        exited: None,
+    })
+}
+
+/// How a process ended, in words.
+pub fn describe(status: ExitStatus) -> String {
+    match (status.code(), status.signal()) {
+        (Some(code), _) => format!("exited with status {code}"),
+        (None, Some(sig)) => match Signal::try_from(sig) {
+            Ok(s) => format!("was killed by signal {sig} ({})", s.as_str()),
+            Err(_) => format!("was killed by signal {sig}"),
+        },
+        _ => "ended".to_string(),
+    }
+}
+
+/// All node processes of a run.
+#[derive(Default)]
+pub struct Children(Vec<Child>);
+
+impl Children {
+    /// Adds a spawned child.
+    pub fn push(&mut self, child: Child) {
+        self.0.push(child);
+    }
+
+    /// The first child that has exited, with its status and stderr tail.
+    pub fn first_exited(&mut self) -> Option<(NodeKind, ExitStatus, String)> {
+        for c in &mut self.0 {
+            if let Some(status) = c.poll() {
+                c.join_forwarder();
+                return Some((c.kind, status, c.stderr_tail()));
+            }
+        }
+        None
+    }
+
+    /// Waits up to `grace` for every child to exit (after STOP was sent),
+    /// then SIGTERM, another `grace`, then SIGKILL. Returns the children
+    /// that needed a signal.
+    pub fn stop(&mut self, grace: Duration) -> Vec<(NodeKind, &'static str)> {
+        let mut forced = Vec::new();
+        if !self.wait_all(grace) {
+            for c in &mut self.0 {
+                if c.poll().is_none() {
+                    let _ = kill(Pid::from_raw(c.pid() as i32), Signal::SIGTERM);
+                    forced.push((c.kind, "SIGTERM"));
+                }
+            }
+            if !self.wait_all(grace) {
+                for c in &mut self.0 {
+                    if c.poll().is_none() {
+                        let _ = c.process.kill();
+                        let _ = c.process.wait();
+                        forced.push((c.kind, "SIGKILL"));
+                    }
+                }
+            }
+        }
+        for c in &mut self.0 {
+            let _ = c.process.wait();
+            c.join_forwarder();
+        }
+        forced
+    }
+
+    fn wait_all(&mut self, limit: Duration) -> bool {
+        let start = Instant::now();
+        loop {
+            if self.0.iter_mut().all(|c| c.poll().is_some()) {
+                return true;
+            }
+            if start.elapsed() >= limit {
+                return false;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}
+
+impl Drop for Children {
+    fn drop(&mut self) {
+        for c in &mut self.0 {
+            if c.poll().is_none() {
+                let _ = c.process.kill();
+            }
+            let _ = c.process.wait();
+            c.join_forwarder();
+        }
+    }
+}

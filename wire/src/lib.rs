@@ -1,0 +1,30 @@
+//! The wire contract between the testbed's processes.
+//!
+//! Where it sits: between every pair of processes. The plant publishes
+//! [`JointState`], the trajectory [`ReferenceSample`], the controller
+//! [`Command`] and [`ControllerDiagnostics`], the plant [`Timing`]; the
+//! launcher sends [`Control`] and every node reports [`NodeStatus`]. All are
+//! fixed-size `#[repr(C)]` values exchanged zero-copy over iceoryx2 shared
+//! memory, each topic paired with an event service so receivers sleep until
+//! data arrives.
+//!
+//! Rules every message follows: per-joint data lives in fixed arrays of
+//! [`MAX_DOF`] entries with a `dof` field saying how many are used; every
+//! sample starts with a [`Header`] carrying a sequence number, the sim time
+//! in integer nanoseconds and a monotonic wall-clock timestamp; type names
+//! carry a version (iceoryx2 only compares name, size and alignment, so a
+//! changed layout must change the name).
+//!
+//! Services live under a per-run prefix ([`RunPrefix`]), so two runs, or two
+//! tests, never see each other.
+
+mod domain;
+mod messages;
+mod topics;
+
+pub use domain::DomainNodes;
+pub use messages::*;
+pub use topics::{
+    Bus, Delivery, RunPrefix, SUBSCRIBER_BUFFER, Topic, TopicPublisher, TopicSubscriber, WireError,
+    monotonic_ns,
+};

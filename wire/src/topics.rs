@@ -1,0 +1,389 @@
+//! Topics, their QoS, and the per-run prefix: the one place where service
+//! names and quality of service are decided.
+
+use std::fmt::Debug;
+use std::time::Duration;
+
+use iceoryx2::port::BackpressureAction;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+
+/// A pub/sub topic and its paired event service (same name).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Topic {
+    /// Plant → controller, logger: [`crate::JointState`].
+    JointState,
+    /// Trajectory → controller, logger: [`crate::ReferenceSample`].
+    Reference,
+    /// Controller → plant, logger: [`crate::Command`].
+    Command,
+    /// Controller → logger: [`crate::ControllerDiagnostics`].
+    Diagnostics,
+    /// Plant → logger: [`crate::Timing`].
+    Timing,
+    /// Launcher → nodes: [`crate::Control`].
+    Control,
+    /// Nodes → launcher: [`crate::NodeStatus`].
+    Status,
+}
+
+impl Topic {
+    /// Every topic.
+    pub const ALL: [Topic; 7] = [
+        Topic::JointState,
+        Topic::Reference,
+        Topic::Command,
+        Topic::Diagnostics,
+        Topic::Timing,
+        Topic::Control,
+        Topic::Status,
+    ];
+
+    /// Service name (under the run prefix).
+    pub fn name(self) -> &'static str {
+        match self {
+            Topic::JointState => "testbed/joint_state",
+            Topic::Reference => "testbed/reference",
+            Topic::Command => "testbed/command",
+            Topic::Diagnostics => "testbed/diagnostics",
+            Topic::Timing => "testbed/timing",
+            Topic::Control => "testbed/control",
+            Topic::Status => "testbed/status",
+        }
+    }
+
+    /// Status has one publisher per node; every other topic has one owner.
+    fn max_publishers(self) -> usize {
+        match self {
+            Topic::Status => 8,
+            _ => 1,
+        }
+    }
+}
+
+/// Samples a subscriber can hold before the publisher waits or drops:
+/// about 50 ms of a lockstep run, so batch readers (logger, launcher) that
+/// wake every 10 ms never hold the loop back.
+pub const SUBSCRIBER_BUFFER: usize = 2048;
+/// Subscribers per topic: the process that uses it, the logger, the
+/// launcher, and one spare for a debugging tool.
+const MAX_SUBSCRIBERS: usize = 4;
+/// Nodes that may open one service: four processes, the launcher, spares.
+const MAX_NODES: usize = 10;
+/// How long a lossless publisher waits for a full subscriber before giving up.
+const LOSSLESS_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// What a publisher does when a subscriber's buffer is full.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Delivery {
+    /// Wait until there is room (lockstep: no sample is ever lost), failing
+    /// after 10 s so a stuck reader cannot hang the run.
+    Lossless,
+    /// Skip that subscriber for this sample (real time: never wait); the
+    /// receiver sees the gap in sequence numbers.
+    DropWhenFull,
+}
+
+/// Why a bus operation failed.
+#[derive(Debug, thiserror::Error)]
+pub enum WireError {
+    /// The prefix is not a valid file-name fragment.
+    #[error("invalid run prefix '{0}': use letters, digits, '_' or '-' (at most 40)")]
+    BadPrefix(String),
+    /// iceoryx2 refused something.
+    #[error("{what} ({topic}): {cause}")]
+    Ipc {
+        /// What was attempted.
+        what: &'static str,
+        /// The topic or node.
+        topic: String,
+        /// iceoryx2's error.
+        cause: String,
+    },
+    /// A SIGINT or SIGTERM arrived.
+    #[error("interrupted by a termination request")]
+    Terminated,
+}
+
+fn ipc(what: &'static str, topic: impl Into<String>) -> impl FnOnce(String) -> WireError {
+    let topic = topic.into();
+    move |cause| WireError::Ipc { what, topic, cause }
+}
+
+/// The prefix that keeps one run's shared memory apart from every other's.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RunPrefix(String);
+
+impl RunPrefix {
+    /// The prefix every testbed run starts with (used to find stale runs).
+    pub const STEM: &'static str = "tbrun";
+
+    /// A prefix no other run on this machine uses: process id and start time.
+    pub fn unique() -> Self {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        Self(format!(
+            "{}{:x}x{:x}_",
+            Self::STEM,
+            std::process::id(),
+            nanos & 0xffff_ffff_ffff
+        ))
+    }
+
+    /// Checks a prefix given on a command line.
+    pub fn parse(s: &str) -> Result<Self, WireError> {
+        let ok = !s.is_empty()
+            && s.len() <= 40
+            && s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+        if ok {
+            Ok(Self(s.to_string()))
+        } else {
+            Err(WireError::BadPrefix(s.to_string()))
+        }
+    }
+
+    /// The prefix text.
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+
+    /// The iceoryx2 configuration for this run.
+    pub fn config(&self) -> Result<Config, WireError> {
+        let mut config = Config::default();
+        config.global.prefix = FileName::new(self.0.as_bytes())
+            .map_err(|e| ipc("prefix", self.0.clone())(format!("{e:?}")))?;
+        Ok(config)
+    }
+}
+
+/// CLOCK_MONOTONIC in nanoseconds: the wall clock every process shares.
+pub fn monotonic_ns() -> u64 {
+    match nix::time::clock_gettime(nix::time::ClockId::CLOCK_MONOTONIC) {
+        Ok(ts) => ts.tv_sec() as u64 * 1_000_000_000 + ts.tv_nsec() as u64,
+        Err(_) => 0,
+    }
+}
+
+/// One process's connection to a run: an iceoryx2 node under the run prefix.
+pub struct Bus {
+    node: Node<ipc::Service>,
+    prefix: RunPrefix,
+}
+
+impl Debug for Bus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Bus({})", self.prefix.as_str())
+    }
+}
+
+/// A publisher with its notifier and a sequence counter.
+pub struct TopicPublisher<T: Debug + ZeroCopySend + Copy + 'static> {
+    topic: Topic,
+    publisher: Publisher<ipc::Service, T, ()>,
+    notifier: Notifier<ipc::Service>,
+}
+
+/// A subscriber with its listener.
+pub struct TopicSubscriber<T: Debug + ZeroCopySend + Copy + 'static> {
+    topic: Topic,
+    subscriber: Subscriber<ipc::Service, T, ()>,
+    listener: Listener<ipc::Service>,
+}
+
+impl Bus {
+    /// Creates this process's node; `name` appears in iceoryx2's node list.
+    pub fn new(prefix: &RunPrefix, name: &str) -> Result<Self, WireError> {
+        let config = prefix.config()?;
+        let node_name =
+            NodeName::new(name).map_err(|e| ipc("node name", name)(format!("{e:?}")))?;
+        let node = NodeBuilder::new()
+            .name(&node_name)
+            .config(&config)
+            .create::<ipc::Service>()
+            .map_err(|e| ipc("create node", name)(format!("{e:?}")))?;
+        Ok(Self {
+            node,
+            prefix: prefix.clone(),
+        })
+    }
+
+    /// The iceoryx2 node.
+    pub fn node(&self) -> &Node<ipc::Service> {
+        &self.node
+    }
+
+    /// The run prefix.
+    pub fn prefix(&self) -> &RunPrefix {
+        &self.prefix
+    }
+
+    /// Sleeps up to `timeout`; `Err(Terminated)` once SIGINT or SIGTERM arrived.
+    pub fn wait(&self, timeout: Duration) -> Result<(), WireError> {
+        self.node.wait(timeout).map_err(|_| WireError::Terminated)
+    }
+
+    /// Removes what crashed processes of this run left in shared memory.
+    pub fn cleanup_dead_nodes(&self) -> u64 {
+        self.node.try_cleanup_dead_nodes().cleanups
+    }
+
+    fn service<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        topic: Topic,
+    ) -> Result<
+        iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>,
+        WireError,
+    > {
+        let name: ServiceName = topic
+            .name()
+            .try_into()
+            .map_err(|e| ipc("service name", topic.name())(format!("{e:?}")))?;
+        // Never overwrite: a full buffer makes the publisher wait (lossless)
+        // or skip that reader (drop), both visible, never a silent loss.
+        self.node
+            .service_builder(&name)
+            .publish_subscribe::<T>()
+            .enable_safe_overflow(false)
+            .history_size(0)
+            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
+            .max_publishers(topic.max_publishers())
+            .max_subscribers(MAX_SUBSCRIBERS)
+            .max_nodes(MAX_NODES)
+            .open_or_create()
+            .map_err(|e| ipc("open topic", topic.name())(format!("{e:?}")))
+    }
+
+    fn event(
+        &self,
+        topic: Topic,
+    ) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, WireError> {
+        let name: ServiceName = topic
+            .name()
+            .try_into()
+            .map_err(|e| ipc("service name", topic.name())(format!("{e:?}")))?;
+        self.node
+            .service_builder(&name)
+            .event()
+            .max_notifiers(topic.max_publishers().max(2))
+            .max_listeners(MAX_SUBSCRIBERS)
+            .max_nodes(MAX_NODES)
+            .open_or_create()
+            .map_err(|e| ipc("open event", topic.name())(format!("{e:?}")))
+    }
+
+    /// A publisher on `topic`.
+    pub fn publisher<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        topic: Topic,
+        delivery: Delivery,
+    ) -> Result<TopicPublisher<T>, WireError> {
+        let service = self.service::<T>(topic)?;
+        let builder = service.publisher_builder();
+        let builder = match delivery {
+            Delivery::Lossless => builder
+                .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+                .set_backpressure_handler(|info: &iceoryx2::port::BackpressureInfo| {
+                    if info.elapsed_time < LOSSLESS_TIMEOUT {
+                        BackpressureAction::Retry
+                    } else {
+                        BackpressureAction::DiscardDataAndFail
+                    }
+                }),
+            Delivery::DropWhenFull => {
+                builder.backpressure_strategy(BackpressureStrategy::DiscardData)
+            }
+        };
+        let publisher = builder
+            .create()
+            .map_err(|e| ipc("create publisher", topic.name())(format!("{e:?}")))?;
+        let notifier = self
+            .event(topic)?
+            .notifier_builder()
+            .create()
+            .map_err(|e| ipc("create notifier", topic.name())(format!("{e:?}")))?;
+        Ok(TopicPublisher {
+            topic,
+            publisher,
+            notifier,
+        })
+    }
+
+    /// A subscriber on `topic`.
+    pub fn subscriber<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        topic: Topic,
+    ) -> Result<TopicSubscriber<T>, WireError> {
+        let service = self.service::<T>(topic)?;
+        let subscriber = service
+            .subscriber_builder()
+            .buffer_size(SUBSCRIBER_BUFFER)
+            .create()
+            .map_err(|e| ipc("create subscriber", topic.name())(format!("{e:?}")))?;
+        let listener = self
+            .event(topic)?
+            .listener_builder()
+            .create()
+            .map_err(|e| ipc("create listener", topic.name())(format!("{e:?}")))?;
+        Ok(TopicSubscriber {
+            topic,
+            subscriber,
+            listener,
+        })
+    }
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> TopicPublisher<T> {
+    /// Publishes `value` and wakes the listeners. Returns how many
+    /// subscribers received it.
+    pub fn send(&self, value: T) -> Result<usize, WireError> {
+        let sample = self
+            .publisher
+            .loan_uninit()
+            .map_err(|e| ipc("loan", self.topic.name())(format!("{e:?}")))?;
+        let delivered = sample
+            .write_payload(value)
+            .send()
+            .map_err(|e| ipc("send", self.topic.name())(format!("{e:?}")))?;
+        self.notifier
+            .notify()
+            .map_err(|e| ipc("notify", self.topic.name())(format!("{e:?}")))?;
+        Ok(delivered)
+    }
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
+    /// The next buffered sample, if any.
+    pub fn receive(&self) -> Result<Option<T>, WireError> {
+        match self.subscriber.receive() {
+            Ok(Some(sample)) => Ok(Some(*sample)),
+            Ok(None) => Ok(None),
+            Err(e) => Err(ipc("receive", self.topic.name())(format!("{e:?}"))),
+        }
+    }
+
+    /// The listener to attach to a WaitSet.
+    pub fn listener(&self) -> &Listener<ipc::Service> {
+        &self.listener
+    }
+
+    /// Consumes pending wake-ups (a WaitSet spins until they are drained).
+    pub fn drain_events(&self) -> Result<(), WireError> {
+        self.listener
+            .try_wait(|_| {})
+            .map(|_| ())
+            .map_err(|e| ipc("listener", self.topic.name())(format!("{e:?}")))
+    }
+
+    /// Blocks until a wake-up arrives or `timeout` passes.
+    pub fn wait_event(&self, timeout: Duration) -> Result<(), WireError> {
+        self.listener
+            .timed_wait(|_| {}, timeout)
+            .map(|_| ())
+            .map_err(|e| ipc("listener", self.topic.name())(format!("{e:?}")))
+    }
+}
