@@ -109,7 +109,10 @@ pub fn table(r: &SimReport) -> String {
             j.max_actor_weight_norm
         );
     }
-    let verdict = if s.constraint_satisfied_after_tc {
+    let ends_before_tc = s.joints.iter().all(|j| j.min_margin_after_tc.is_none());
+    let verdict = if ends_before_tc {
+        "not judged (the run ends before T_c)"
+    } else if s.constraint_satisfied_after_tc {
         "satisfied"
     } else {
         "VIOLATED"

@@ -40,3 +40,78 @@ pub fn fails(cmd: &mut Command) -> String {
 pub fn json(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("stdout is one JSON object")
 }
+
+/// Waits for `child` at most `secs` seconds (a watchdog, not a timing
+/// assertion): kills it and fails the test if it does not end.
+pub fn wait_bounded(child: &mut std::process::Child, secs: u64) -> std::process::ExitStatus {
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("try_wait") {
+            return status;
+        }
+        if start.elapsed().as_secs() >= secs {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("process {} did not end within {secs} s", child.id());
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
+/// Node processes started by launcher `pid`: (node name, pid, run prefix).
+pub fn nodes_of(launcher: u32) -> Vec<(String, u32, String)> {
+    let mut out = Vec::new();
+    let Ok(entries) = std::fs::read_dir("/proc") else {
+        return out;
+    };
+    let marker = launcher.to_string();
+    for e in entries.flatten() {
+        let Ok(pid) = e.file_name().to_string_lossy().parse::<u32>() else {
+            continue;
+        };
+        let Ok(raw) = std::fs::read(e.path().join("cmdline")) else {
+            continue;
+        };
+        let args: Vec<String> = raw
+            .split(|b| *b == 0)
+            .map(|a| String::from_utf8_lossy(a).to_string())
+            .collect();
+        let is_child = args
+            .windows(2)
+            .any(|w| w[0] == "--parent-pid" && w[1] == marker);
+        let pos = args.iter().position(|a| a == "node");
+        if let (true, Some(i)) = (is_child, pos) {
+            let prefix = args
+                .windows(2)
+                .find(|w| w[0] == "--prefix")
+                .map(|w| w[1].clone())
+                .unwrap_or_default();
+            out.push((args[i + 1].clone(), pid, prefix));
+        }
+    }
+    out
+}
+
+/// Polls until launcher `pid` has started all three nodes; returns them.
+pub fn wait_for_nodes(launcher: u32) -> Vec<(String, u32, String)> {
+    for _ in 0..1500 {
+        let nodes = nodes_of(launcher);
+        if nodes.len() == 3 {
+            return nodes;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    panic!("launcher {launcher} did not start its nodes");
+}
+
+/// Files in /dev/shm that belong to run prefix `prefix`.
+pub fn shm_files(prefix: &str) -> Vec<String> {
+    std::fs::read_dir("/dev/shm")
+        .map(|d| {
+            d.flatten()
+                .map(|e| e.file_name().to_string_lossy().to_string())
+                .filter(|n| !prefix.is_empty() && n.starts_with(prefix))
+                .collect()
+        })
+        .unwrap_or_default()
+}

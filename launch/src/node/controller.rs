@@ -36,12 +36,7 @@ impl RefSource {
         while let Some(r) = sub.receive()? {
             recent.push(r);
         }
-        // Keep a short history: the newest sample at or before t wins.
-        recent.sort_by_key(|r| r.header.t_ns);
-        let pick = recent.iter().rev().find(|r| r.header.t_ns <= t_ns).copied();
-        let keep_from = recent.len().saturating_sub(8);
-        recent.drain(..keep_from);
-        let Some(r) = pick else {
+        let Some(r) = pick_reference(recent, t_ns) else {
             return Ok(false);
         };
         let b = &mut self.buf;
@@ -54,6 +49,17 @@ impl RefSource {
         b.kc_dot.copy_from_slice(&r.kc_dot[..n]);
         Ok(true)
     }
+}
+
+/// The newest sample at or before `t_ns`, dropping the older ones. Samples
+/// after `t_ns` are kept: when the plant runs late, the trajectory's timer is
+/// ahead of it and those samples are needed for the next states.
+fn pick_reference(recent: &mut Vec<ReferenceSample>, t_ns: u64) -> Option<ReferenceSample> {
+    recent.sort_by_key(|r| r.header.t_ns);
+    let i = recent.iter().rposition(|r| r.header.t_ns <= t_ns)?;
+    let r = recent[i];
+    recent.drain(..i);
+    Some(r)
 }
 
 /// Runs the controller node.
@@ -171,5 +177,49 @@ fn diag_msg(header: Header, d: &Diagnostics, r: &RefBuf, compute_ns: u64) -> Con
         tau_feedback: joints(&d.tau_feedback),
         tau_barrier: joints(&d.tau_barrier),
         wa_norm: joints(&d.wa_norm),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(t_ns: u64) -> ReferenceSample {
+        ReferenceSample {
+            header: Header {
+                seq: t_ns,
+                t_ns,
+                wall_ns: 0,
+            },
+            dof: 1,
+            reserved: 0,
+            q_d: [0.0; wire::MAX_DOF],
+            qd_d: [0.0; wire::MAX_DOF],
+            qdd_d: [0.0; wire::MAX_DOF],
+            kc: [1.0; wire::MAX_DOF],
+            kc_dot: [0.0; wire::MAX_DOF],
+        }
+    }
+
+    #[test]
+    fn newest_sample_not_after_the_state_wins() {
+        let mut recent: Vec<_> = [3, 1, 2, 5].map(sample).to_vec();
+        assert_eq!(pick_reference(&mut recent, 4).unwrap().header.t_ns, 3);
+        assert_eq!(
+            recent.iter().map(|r| r.header.t_ns).collect::<Vec<_>>(),
+            [3, 5]
+        );
+        assert!(pick_reference(&mut vec![sample(7)], 6).is_none());
+    }
+
+    /// Regression: with the plant 20 periods behind the trajectory, the
+    /// controller once kept only the newest 8 samples, all later than the
+    /// state, and faulted with no reference.
+    #[test]
+    fn reference_is_found_when_the_plant_runs_late() {
+        let mut recent: Vec<_> = (0..40).map(sample).collect();
+        for k in 0..40 {
+            assert_eq!(pick_reference(&mut recent, k).unwrap().header.t_ns, k);
+        }
     }
 }

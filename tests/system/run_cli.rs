@@ -1,0 +1,235 @@
+//! `testbed run`: real processes over iceoryx2.
+
+use std::process::Stdio;
+use std::time::Duration;
+
+use nix::sys::signal::{Signal, kill};
+use nix::unistd::Pid;
+
+use crate::util::{fails, json, nodes_of, ok, shm_files, testbed, wait_bounded, wait_for_nodes};
+
+fn sim_csv(dir: &std::path::Path, duration: &str) -> Vec<u8> {
+    let path = dir.join(format!("sim-{duration}.csv"));
+    ok(testbed()
+        .args(["sim", "--duration", duration, "--csv"])
+        .arg(&path));
+    std::fs::read(path).unwrap()
+}
+
+/// The lockstep stack computes exactly what the in-process loop computes.
+#[test]
+fn lockstep_equals_sim_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("lockstep.csv");
+    let out = ok(testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--duration",
+            "2.5",
+            "--json",
+            "--runs-dir",
+        ])
+        .arg(dir.path())
+        .arg("--csv")
+        .arg(&csv));
+    let run = json(&out);
+    assert!(
+        std::fs::read(&csv).unwrap() == sim_csv(dir.path(), "2.5"),
+        "lockstep CSV differs from sim"
+    );
+    let sim = json(&ok(testbed().args(["sim", "--duration", "2.5", "--json"])));
+    for key in [
+        "joints",
+        "steps",
+        "dt_s",
+        "finite",
+        "constraint_satisfied_after_tc",
+        "barrier_breached_steps",
+    ] {
+        assert_eq!(run[key], sim[key], "{key}");
+    }
+    assert_eq!(run["timing"]["mode"], "lockstep");
+    assert_eq!(run["timing"]["cycles"], 2500);
+    assert_eq!(run["missing_rows"], 0);
+}
+
+#[test]
+fn short_realtime_run_reports_timing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = ok(testbed()
+        .args(["run", "--duration", "1", "--json", "--runs-dir"])
+        .arg(dir.path()));
+    let s = json(&out);
+    assert_eq!(s["steps"], 1000);
+    assert_eq!(s["finite"], true, "{s}");
+    assert_eq!(s["missing_rows"], 0);
+    let t = &s["timing"];
+    assert_eq!(t["mode"], "realtime");
+    assert_eq!(t["rate_hz"], 1000.0);
+    assert_eq!(t["cycles"], 1000);
+    assert!(t["deadline_misses"].as_u64().unwrap() < 1000);
+    for k in ["period_jitter_us", "round_trip_us", "controller_compute_us"] {
+        for p in ["p50", "p99", "max"] {
+            assert!(t[k][p].as_f64().unwrap() >= 0.0, "{k}.{p} in {t}");
+        }
+        assert!(t[k]["p50"].as_f64().unwrap() <= t[k]["max"].as_f64().unwrap());
+    }
+    // Every cycle either got its command in time (and has a round trip) or
+    // is a counted miss.
+    let misses = t["deadline_misses"].as_u64().unwrap();
+    assert_eq!(
+        t["round_trip_us"]["count"].as_u64().unwrap() + misses,
+        1000,
+        "{t}"
+    );
+}
+
+/// kill -9 of any node: the launcher names it, stops the rest, exits
+/// non-zero, and leaves no process and no shared memory; the next run works.
+#[test]
+fn killing_any_node_fails_the_run_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    for victim in ["plant", "trajectory", "controller"] {
+        let mut launcher = testbed()
+            .args(["run", "--duration", "60", "--runs-dir"])
+            .arg(dir.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let nodes = wait_for_nodes(launcher.id());
+        std::thread::sleep(Duration::from_millis(500));
+        let (_, pid, prefix) = nodes.iter().find(|n| n.0 == victim).unwrap().clone();
+        kill(Pid::from_raw(pid as i32), Signal::SIGKILL).unwrap();
+        let status = wait_bounded(&mut launcher, 20);
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
+        assert!(!status.success(), "{victim}: launcher exited 0");
+        assert!(
+            err.contains(&format!("the {victim} node was killed by signal 9")),
+            "{victim}: {err}"
+        );
+        assert!(
+            nodes_of(launcher.id()).is_empty(),
+            "{victim}: nodes left running"
+        );
+        assert_eq!(
+            shm_files(&prefix),
+            Vec::<String>::new(),
+            "{victim}: shared memory left"
+        );
+        // A run right after the killed one starts normally.
+        ok(testbed()
+            .args([
+                "run",
+                "--mode",
+                "lockstep",
+                "--duration",
+                "0.3",
+                "--runs-dir",
+            ])
+            .arg(dir.path()));
+    }
+}
+
+#[test]
+fn ctrl_c_stops_everything() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut launcher = testbed()
+        .args(["run", "--duration", "60", "--runs-dir"])
+        .arg(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let nodes = wait_for_nodes(launcher.id());
+    std::thread::sleep(Duration::from_millis(300));
+    kill(Pid::from_raw(launcher.id() as i32), Signal::SIGINT).unwrap();
+    let status = wait_bounded(&mut launcher, 20);
+    assert_eq!(status.code(), Some(130));
+    assert!(nodes_of(launcher.id()).is_empty());
+    assert_eq!(shm_files(&nodes[0].2), Vec::<String>::new());
+}
+
+/// A node whose launcher disappears exits by itself.
+#[test]
+fn nodes_exit_when_the_launcher_is_killed() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut launcher = testbed()
+        .args(["run", "--duration", "60", "--runs-dir"])
+        .arg(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let pid = launcher.id();
+    wait_for_nodes(pid);
+    kill(Pid::from_raw(pid as i32), Signal::SIGKILL).unwrap();
+    wait_bounded(&mut launcher, 5);
+    for _ in 0..500 {
+        if nodes_of(pid).is_empty() {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    panic!(
+        "nodes of killed launcher still running: {:?}",
+        nodes_of(pid)
+    );
+}
+
+/// Two runs at the same time use separate shared memory and both get
+/// exactly the in-process result.
+#[test]
+fn two_runs_at_once_do_not_interfere() {
+    let dir = tempfile::tempdir().unwrap();
+    let spawn = |duration: &str| {
+        testbed()
+            .args([
+                "run",
+                "--mode",
+                "lockstep",
+                "--duration",
+                duration,
+                "--runs-dir",
+            ])
+            .arg(dir.path())
+            .arg("--csv")
+            .arg(dir.path().join(format!("run-{duration}.csv")))
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let mut a = spawn("1.5");
+    let mut b = spawn("2");
+    assert!(wait_bounded(&mut a, 120).success());
+    assert!(wait_bounded(&mut b, 120).success());
+    for d in ["1.5", "2"] {
+        let run = std::fs::read(dir.path().join(format!("run-{d}.csv"))).unwrap();
+        assert!(
+            run == sim_csv(dir.path(), d),
+            "run of {d} s differs from sim"
+        );
+    }
+}
+
+#[test]
+fn bad_run_settings_fail_before_anything_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let err = fails(
+        testbed()
+            .args(["run", "--rate", "0", "--runs-dir"])
+            .arg(dir.path()),
+    );
+    assert!(err.contains("--rate") && err.contains("rate_hz"), "{err}");
+    let err = fails(testbed().args(["run", "--mode", "fast"]));
+    assert!(err.contains("fast"), "{err}");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "a run folder was made"
+    );
+}
