@@ -110,6 +110,7 @@ impl RecordAssembler {
                 qdd: &self.qdd,
                 tau: &s1.tau_applied[..n],
                 q_d: &d.q_d[..n],
+                qd_d: &d.qd_d[..n],
                 kc: &d.kc_in[..n],
                 z1: &d.z1[..n],
                 z1g: &d.z1g[..n],

@@ -16,7 +16,7 @@ use launch::{closed_loop, csv_out, summary::SummaryBuilder};
 use scenario::Overrides;
 use wire::NodeKind;
 
-use crate::report::{self, SimReport};
+use crate::report::{self, Report};
 
 /// Run the paper's RL neuroadaptive controller under deferred constraints on
 /// a simulated arm.
@@ -33,6 +33,8 @@ enum Command {
     Sim(SimArgs),
     /// Run the stack as separate processes over iceoryx2 shared memory.
     Run(RunArgs),
+    /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
+    Replay(ReplayArgs),
     /// Run one node of a stack (the launcher starts these; start one by hand
     /// with `testbed run --external <node>` to debug or replace it).
     Node {
@@ -49,6 +51,7 @@ enum NodeName {
     Plant,
     Trajectory,
     Controller,
+    Logger,
 }
 
 impl NodeName {
@@ -57,6 +60,7 @@ impl NodeName {
             NodeName::Plant => NodeKind::Plant,
             NodeName::Trajectory => NodeKind::Trajectory,
             NodeName::Controller => NodeKind::Controller,
+            NodeName::Logger => NodeKind::Logger,
         }
     }
 }
@@ -101,6 +105,26 @@ struct RunArgs {
     runs_dir: PathBuf,
 }
 
+#[derive(Debug, Args)]
+struct ReplayArgs {
+    /// The run's MCAP log (runs/<id>/run.mcap).
+    #[arg(value_name = "FILE.mcap")]
+    log: PathBuf,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Write one row per control step to this CSV file.
+    #[arg(long, value_name = "FILE")]
+    csv: Option<PathBuf>,
+    /// Write the paper's figures (PNG and SVG) and a timing figure here.
+    #[arg(long, value_name = "DIR")]
+    plots: Option<PathBuf>,
+    /// Re-drive the controller from the logged states and references and
+    /// report the largest difference from the logged torques.
+    #[arg(long)]
+    verify: bool,
+}
+
 /// Exit status of a run stopped by Ctrl-C (128 + SIGINT).
 const EXIT_INTERRUPTED: u8 = 130;
 
@@ -110,6 +134,7 @@ pub fn run() -> Result<ExitCode> {
     match cli.command {
         Command::Sim(args) => sim(args),
         Command::Run(args) => run_stack(args),
+        Command::Replay(args) => replay(args),
         Command::Node { name, args } => {
             node::run(name.kind(), &args)
                 .with_context(|| format!("{} node", name.kind().name()))?;
@@ -126,7 +151,7 @@ fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario::Plan> {
     Ok(scenario::load(common.scenario.as_deref(), &overrides)?)
 }
 
-fn print_report(report: &SimReport, json: bool) -> Result<()> {
+fn print_report(report: &Report, json: bool) -> Result<()> {
     if json {
         println!("{}", serde_json::to_string_pretty(report)?);
     } else {
@@ -134,6 +159,9 @@ fn print_report(report: &SimReport, json: bool) -> Result<()> {
     }
     if !report.summary.finite {
         eprintln!("testbed: warning: the run produced non-finite values or controller faults");
+    }
+    if let Some(w) = &report.warning {
+        eprintln!("testbed: warning: {w}");
     }
     Ok(())
 }
@@ -172,7 +200,7 @@ fn sim(args: SimArgs) -> Result<ExitCode> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     result.with_context(|| format!("running {}", plan.source))?;
-    print_report(&SimReport::new(&plan, summary.finish(), wall), args.json)?;
+    print_report(&Report::from_sim(&plan, summary.finish(), wall), args.json)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -195,10 +223,41 @@ fn run_stack(args: RunArgs) -> Result<ExitCode> {
         }
         Err(e) => return Err(e).with_context(|| format!("running {source}")),
     };
-    let mut report = SimReport::new(&plan, outcome.summary, outcome.wall_time_s);
-    report.timing = Some(outcome.timing);
+    let mut report = Report::from_log(outcome.analysis);
     report.run_dir = Some(outcome.run_dir.display().to_string());
-    report.missing_rows = Some(outcome.missing_rows);
     print_report(&report, args.common.json)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn replay(args: ReplayArgs) -> Result<ExitCode> {
+    let mut csv = match &args.csv {
+        Some(path) => {
+            Some(BufWriter::new(File::create(path).with_context(|| {
+                format!("cannot create CSV file {}", path.display())
+            })?))
+        }
+        None => None,
+    };
+    let csv_name = args
+        .csv
+        .as_ref()
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    let analysis = launch::analysis::analyse(
+        &args.log,
+        launch::analysis::AnalyseOptions {
+            csv: csv
+                .as_mut()
+                .map(|w| (csv_name.as_str(), w as &mut dyn Write)),
+            verify: args.verify,
+            series: args.plots.is_some(),
+        },
+    )?;
+    if let (Some(dir), Some(series)) = (&args.plots, &analysis.series) {
+        let written = launch::plots::write_all(dir, series, &analysis.plan)
+            .with_context(|| format!("writing figures to {}", dir.display()))?;
+        eprintln!("testbed: wrote {} figures to {}", written, dir.display());
+    }
+    print_report(&Report::from_log(analysis), args.json)?;
     Ok(ExitCode::SUCCESS)
 }

@@ -82,6 +82,7 @@ pub fn run(
             qdd: &qdd,
             tau: &diag.tau,
             q_d: &reference.q_d,
+            qd_d: &reference.qd_d,
             kc: &reference.kc,
             z1: &diag.z1,
             z1g: &diag.z1g,

@@ -7,12 +7,16 @@
 //! (plant, trajectory, controller) that talk over iceoryx2 ([`wire`]), and
 //! [`run`] supervises them and assembles the same records from the topics.
 
+pub mod analysis;
 pub mod assemble;
 pub mod clock;
 pub mod closed_loop;
 pub mod csv_out;
+pub mod log;
 pub mod mode;
 pub mod node;
+pub mod plots;
 pub mod record;
 pub mod run;
 pub mod summary;
+pub mod verify;

@@ -16,6 +16,8 @@ pub struct StepRecord<'a> {
     pub tau: &'a [f64],
     /// Desired position q_d(t_k).
     pub q_d: &'a [f64],
+    /// Desired velocity q̇_d(t_k).
+    pub qd_d: &'a [f64],
     /// Envelope k_c(t_k) per joint, as the trajectory gives it.
     pub kc: &'a [f64],
     /// Tracking error Z1.

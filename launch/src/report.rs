@@ -1,15 +1,16 @@
-//! What `testbed sim` prints: a JSON object or a table.
+//! What `testbed sim`, `run` and `replay` print: a JSON object or a table.
 
 use std::fmt::Write;
 
+use launch::analysis::LogAnalysis;
 use launch::run::timing::{Percentiles, TimingSummary};
 use launch::summary::Summary;
 use scenario::Plan;
 use serde::Serialize;
 
-/// The JSON object of `testbed sim --json`.
+/// The JSON object of `testbed sim|run|replay --json`.
 #[derive(Debug, Serialize)]
-pub struct SimReport {
+pub struct Report {
     /// Scenario name.
     pub scenario: String,
     /// Where the scenario came from.
@@ -21,23 +22,40 @@ pub struct SimReport {
     /// The run's figures.
     #[serde(flatten)]
     pub summary: Summary,
-    /// Wall-clock time of the loop, s.
+    /// Wall-clock time of the loop, s (for a logged run: from the first to
+    /// the last joint state's publish time).
     pub wall_time_s: f64,
     /// Sim time per wall time.
     pub realtime_factor: f64,
     /// Timing of a multi-process run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub timing: Option<TimingSummary>,
-    /// The run's folder (multi-process runs).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub run_dir: Option<String>,
-    /// Rows that could not be rebuilt because samples were dropped (multi-process runs).
+    /// Rows that could not be rebuilt because samples were dropped.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub missing_rows: Option<u64>,
+    /// Samples the logger could not take (real time), from the log's stats.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub logger_dropped: Option<u64>,
+    /// The run's MCAP log.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub log: Option<String>,
+    /// The run's folder.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub run_dir: Option<String>,
+    /// `replay --verify`: largest |τ re-driven − τ logged|.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_abs_torque_diff: Option<f64>,
+    /// `replay --verify`: steps compared.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verified_steps: Option<u64>,
+    /// Set when the log was read only in part.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
 }
 
-impl SimReport {
-    pub fn new(plan: &Plan, summary: Summary, wall_time_s: f64) -> Self {
+impl Report {
+    /// For an in-process run.
+    pub fn from_sim(plan: &Plan, summary: Summary, wall_time_s: f64) -> Self {
         let sim_s = summary.steps as f64 * summary.dt_s;
         Self {
             scenario: plan.scenario.name.clone(),
@@ -48,22 +66,58 @@ impl SimReport {
             summary,
             wall_time_s,
             timing: None,
-            run_dir: None,
             missing_rows: None,
+            logger_dropped: None,
+            log: None,
+            run_dir: None,
+            max_abs_torque_diff: None,
+            verified_steps: None,
+            warning: None,
         }
     }
-}
 
-fn percentiles(p: &Percentiles) -> String {
-    format!("p50 {:8.1}  p99 {:8.1}  max {:8.1}", p.p50, p.p99, p.max)
+    /// For a logged run: everything from the log.
+    pub fn from_log(a: LogAnalysis) -> Self {
+        let meta = |k: &str| a.contents.run.get(k).cloned().unwrap_or_default();
+        let dropped = a.contents.stats.as_ref().map(|stats| {
+            stats
+                .iter()
+                .filter(|(k, _)| k.ends_with(".dropped"))
+                .filter_map(|(_, v)| v.parse::<u64>().ok())
+                .sum()
+        });
+        let warning = a.warning();
+        let sim_s = a.summary.steps as f64 * a.summary.dt_s;
+        Self {
+            scenario: a.plan.scenario.name.clone(),
+            scenario_source: meta("scenario_source"),
+            robot: meta("robot"),
+            duration_s: sim_s,
+            realtime_factor: sim_s / a.wall_span_s.max(1e-9),
+            wall_time_s: a.wall_span_s,
+            timing: Some(a.timing),
+            missing_rows: Some(a.missing_rows),
+            logger_dropped: dropped,
+            log: Some(a.contents.path.display().to_string()),
+            run_dir: None,
+            max_abs_torque_diff: a.verify.map(|v| v.0),
+            verified_steps: a.verify.map(|v| v.1),
+            warning,
+            summary: a.summary,
+        }
+    }
 }
 
 fn opt(v: Option<f64>, prec: usize) -> String {
     v.map_or_else(|| "n/a".into(), |x| format!("{x:.prec$}"))
 }
 
+fn percentiles(p: &Percentiles) -> String {
+    format!("p50 {:8.1}  p99 {:8.1}  max {:8.1}", p.p50, p.p99, p.max)
+}
+
 /// A readable summary.
-pub fn table(r: &SimReport) -> String {
+pub fn table(r: &Report) -> String {
     let s = &r.summary;
     let mut out = String::new();
     let _ = writeln!(
@@ -150,8 +204,17 @@ pub fn table(r: &SimReport) -> String {
     if let Some(m) = r.missing_rows.filter(|m| *m > 0) {
         let _ = writeln!(out, "rows lost to dropped samples: {m}");
     }
-    if let Some(d) = &r.run_dir {
-        let _ = writeln!(out, "run folder: {d}");
+    if let Some(d) = r.logger_dropped.filter(|d| *d > 0) {
+        let _ = writeln!(out, "samples the logger could not take: {d}");
+    }
+    if let (Some(d), Some(n)) = (r.max_abs_torque_diff, r.verified_steps) {
+        let _ = writeln!(
+            out,
+            "verify: {n} steps re-driven, max |tau - logged tau| = {d:e}"
+        );
+    }
+    if let Some(l) = &r.log {
+        let _ = writeln!(out, "log: {l}");
     }
     out
 }

@@ -196,6 +196,7 @@ mod tests {
             qdd: z1,
             tau,
             q_d: z1,
+            qd_d: z1,
             kc,
             z1,
             z1g,

@@ -183,6 +183,19 @@ impl RobotSource {
         })
     }
 
+    /// A URDF given as text (e.g. a log's attachment); `label` names it in messages.
+    pub fn from_text(urdf: &str, label: &str) -> Result<Self, ScenarioError> {
+        let model = ArmModel::from_urdf_str(urdf).map_err(|cause| ScenarioError::Plant {
+            file: label.to_string(),
+            cause,
+        })?;
+        Ok(Self {
+            path: Some(PathBuf::from(label)),
+            urdf: urdf.to_string(),
+            model,
+        })
+    }
+
     /// The paper's two-link arm.
     pub fn builtin() -> Self {
         let urdf = plant_rapier::TWO_LINK_URDF.to_string();

@@ -2,6 +2,7 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod log_replay;
 mod run_cli;
 mod sim_cli;
 mod util;

@@ -91,7 +91,7 @@ fn short_realtime_run_reports_timing() {
 #[test]
 fn killing_any_node_fails_the_run_cleanly() {
     let dir = tempfile::tempdir().unwrap();
-    for victim in ["plant", "trajectory", "controller"] {
+    for victim in ["plant", "trajectory", "controller", "logger"] {
         let mut launcher = testbed()
             .args(["run", "--duration", "60", "--runs-dir"])
             .arg(dir.path())
@@ -100,7 +100,9 @@ fn killing_any_node_fails_the_run_cleanly() {
             .spawn()
             .unwrap();
         let nodes = wait_for_nodes(launcher.id());
-        std::thread::sleep(Duration::from_millis(500));
+        // The logger closes a chunk every 0.5 s: give it time to write one.
+        let ms = if victim == "logger" { 1500 } else { 500 };
+        std::thread::sleep(Duration::from_millis(ms));
         let (_, pid, prefix) = nodes.iter().find(|n| n.0 == victim).unwrap().clone();
         kill(Pid::from_raw(pid as i32), Signal::SIGKILL).unwrap();
         let status = wait_bounded(&mut launcher, 20);
@@ -120,6 +122,14 @@ fn killing_any_node_fails_the_run_cleanly() {
             Vec::<String>::new(),
             "{victim}: shared memory left"
         );
+        if victim == "logger" {
+            // The unfinished log keeps what was flushed before the kill.
+            let log = newest_log(dir.path());
+            let out = ok(testbed().arg("replay").arg(&log).arg("--json"));
+            let s = crate::util::json(&out);
+            assert!(s["steps"].as_u64().unwrap() > 0, "{s}");
+            assert!(s["warning"].as_str().unwrap().contains("recovered"), "{s}");
+        }
         // A run right after the killed one starts normally.
         ok(testbed()
             .args([
@@ -232,4 +242,14 @@ fn bad_run_settings_fail_before_anything_starts() {
         0,
         "a run folder was made"
     );
+}
+
+fn newest_log(runs: &std::path::Path) -> std::path::PathBuf {
+    std::fs::read_dir(runs)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path().join("run.mcap"))
+        .filter(|p| p.exists())
+        .max_by_key(|p| std::fs::metadata(p).and_then(|m| m.modified()).ok())
+        .expect("a run log")
 }

@@ -92,11 +92,11 @@ pub fn nodes_of(launcher: u32) -> Vec<(String, u32, String)> {
     out
 }
 
-/// Polls until launcher `pid` has started all three nodes; returns them.
+/// Polls until launcher `pid` has started all four nodes; returns them.
 pub fn wait_for_nodes(launcher: u32) -> Vec<(String, u32, String)> {
     for _ in 0..1500 {
         let nodes = nodes_of(launcher);
-        if nodes.len() == 3 {
+        if nodes.len() == 4 {
             return nodes;
         }
         std::thread::sleep(std::time::Duration::from_millis(20));

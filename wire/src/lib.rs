@@ -23,6 +23,7 @@ mod messages;
 mod topics;
 
 pub use domain::DomainNodes;
+pub use iceoryx2::prelude::ZeroCopySend;
 pub use messages::*;
 pub use topics::{
     Bus, Delivery, RunPrefix, SUBSCRIBER_BUFFER, Topic, TopicPublisher, TopicSubscriber, WireError,

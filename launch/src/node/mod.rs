@@ -7,6 +7,7 @@
 //! exits by itself when its launcher disappears or a SIGINT/SIGTERM arrives.
 
 pub mod controller;
+pub mod logger;
 pub mod plant;
 pub mod trajectory;
 
@@ -38,6 +39,12 @@ pub struct NodeArgs {
     /// Exit when this process (the launcher) is gone.
     #[arg(long, value_name = "PID")]
     pub parent_pid: Option<u32>,
+    /// Logger only: the MCAP file to write.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Logger only: where the scenario originally came from (for the log's metadata).
+    #[arg(long, value_name = "TEXT")]
+    pub source: Option<String>,
 }
 
 /// Why a node stopped.
@@ -191,14 +198,41 @@ pub fn run(kind: NodeKind, args: &NodeArgs) -> Result<(), NodeError> {
         NodeKind::Plant => plant::run(&mut ctx),
         NodeKind::Controller => controller::run(&mut ctx),
         NodeKind::Trajectory => trajectory::run(&mut ctx),
-        NodeKind::Logger => Err(NodeError::Protocol(
-            "the logger node is not built yet".into(),
-        )),
+        NodeKind::Logger => match &args.out {
+            Some(out) => {
+                let mut meta = logger_metadata(&ctx, out);
+                if let Some(source) = &args.source {
+                    meta.scenario_source = source.clone();
+                }
+                logger::run(&mut ctx, out, meta)
+            }
+            None => Err(NodeError::Protocol("the logger needs --out FILE".into())),
+        },
     };
     match result {
         // STOP means the run is over (or was cut short by the launcher,
         // which then reports why): exit quietly.
         Err(NodeError::Stopped) => Ok(()),
         other => other,
+    }
+}
+
+/// The `testbed.run` record: what the logger knows about the run.
+fn logger_metadata(ctx: &NodeContext, out: &std::path::Path) -> crate::log::RunMetadata {
+    let plan = &ctx.plan;
+    crate::log::RunMetadata {
+        run_id: out
+            .parent()
+            .and_then(|p| p.file_name())
+            .map_or_else(String::new, |n| n.to_string_lossy().to_string()),
+        mode: ctx.mode.as_str().to_string(),
+        rate_hz: plan.scenario.rate_hz,
+        scenario_toml: plan.toml.clone(),
+        scenario_source: plan.source.clone(),
+        robot: plan.robot.label(),
+        joint_names: plan.robot.model.joint_names(),
+        start_time_unix_ns: std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos() as u64),
     }
 }

@@ -5,13 +5,16 @@ use std::time::Duration;
 
 use plant_rapier::Plant;
 use wire::{
-    Command, Delivery, Header, JointState, MAX_DOF, STATE_FINAL, Timing, Topic, TopicPublisher,
-    TopicSubscriber, joints, monotonic_ns,
+    Command, Delivery, Header, JointState, MAX_DOF, NODE_RUNNING, STATE_FINAL, Timing, Topic,
+    TopicPublisher, TopicSubscriber, joints, monotonic_ns,
 };
 
 use super::{NodeContext, NodeError};
 use crate::clock;
 use crate::mode::Mode;
+
+/// Steps between progress reports on the status topic.
+const PROGRESS_EVERY: u64 = 256;
 
 struct Ports {
     state: TopicPublisher<JointState>,
@@ -121,6 +124,9 @@ fn lockstep(ctx: &mut NodeContext, ports: &Ports, st: &mut Stepper) -> Result<()
         })?;
         state = st.state_msg(k + 1);
         ports.state.send(state)?;
+        if (k + 1) % PROGRESS_EVERY == 0 {
+            ctx.report(NODE_RUNNING, k + 1)?;
+        }
     }
     Ok(())
 }
@@ -202,6 +208,9 @@ fn realtime(
         last_wake = wake;
         if k % 32 == 0 {
             ctx.check()?;
+        }
+        if k % PROGRESS_EVERY == 0 {
+            ctx.report(NODE_RUNNING, k)?;
         }
     }
     Ok(())

@@ -1,7 +1,6 @@
 //! `testbed run`: the launcher. It turns a validated plan into running
 //! processes, starts them together, watches them, and stops them in order.
 
-pub mod collect;
 pub mod spawn;
 pub mod timing;
 
@@ -16,14 +15,21 @@ use wire::{
     NODE_READY, NodeKind, NodeStatus, RunPrefix, Topic, WireError, monotonic_ns,
 };
 
+use crate::analysis::{AnalyseOptions, AnalysisError, LogAnalysis, analyse};
 use crate::mode::Mode;
-use crate::summary::Summary;
-use collect::Collector;
 use spawn::{Children, describe};
-use timing::TimingSummary;
 
-/// The nodes `testbed run` starts, in start order.
-pub const NODES: [NodeKind; 3] = [NodeKind::Plant, NodeKind::Trajectory, NodeKind::Controller];
+/// The nodes `testbed run` starts, in start order (the logger first, so it
+/// is listening before anything is sent).
+pub const NODES: [NodeKind; 4] = [
+    NodeKind::Logger,
+    NodeKind::Plant,
+    NodeKind::Trajectory,
+    NodeKind::Controller,
+];
+
+/// The nodes whose DONE ends a run; the logger then finishes the file.
+const PRODUCERS: [NodeKind; 3] = [NodeKind::Plant, NodeKind::Trajectory, NodeKind::Controller];
 
 /// How long nodes may take to connect.
 const START_TIMEOUT: Duration = Duration::from_secs(30);
@@ -31,8 +37,6 @@ const START_TIMEOUT: Duration = Duration::from_secs(30);
 const EXTERNAL_START_TIMEOUT: Duration = Duration::from_secs(300);
 /// A run whose row count does not move for this long is declared stuck.
 const STALL_TIMEOUT: Duration = Duration::from_secs(20);
-/// How long nodes may take to report DONE once every row is in.
-const DONE_TIMEOUT: Duration = Duration::from_secs(5);
 /// Grace period between STOP, SIGTERM and SIGKILL.
 const STOP_GRACE: Duration = Duration::from_secs(2);
 /// How often the launcher wakes to drain topics and check its children.
@@ -58,16 +62,14 @@ pub struct RunOptions {
 /// What a finished run produced.
 #[derive(Debug)]
 pub struct RunOutcome {
-    /// The step figures.
-    pub summary: Summary,
-    /// The timing figures.
-    pub timing: TimingSummary,
-    /// The run's folder (holds the scenario it ran).
+    /// Everything computed from the run's log.
+    pub analysis: LogAnalysis,
+    /// The run's folder (holds the scenario it ran and the log).
     pub run_dir: PathBuf,
-    /// Wall time from START to the last row, s.
+    /// The MCAP log.
+    pub log: PathBuf,
+    /// Wall time from START to the plant's last step, s.
     pub wall_time_s: f64,
-    /// Rows that could not be rebuilt because samples were dropped.
-    pub missing_rows: u64,
 }
 
 /// Why a run failed.
@@ -118,6 +120,9 @@ pub enum RunError {
     /// Ctrl-C or SIGTERM.
     #[error("interrupted; all nodes stopped")]
     Interrupted,
+    /// The log could not be analysed.
+    #[error(transparent)]
+    Analysis(#[from] AnalysisError),
     /// The arm has more joints than the wire carries.
     #[error("the robot has {dof} actuated joints; the wire carries at most {MAX_DOF}")]
     TooManyJoints {
@@ -136,9 +141,11 @@ fn run_id() -> String {
 
 /// The arguments of `testbed node <kind>` for this run.
 pub fn node_args(
+    kind: NodeKind,
     prefix: &RunPrefix,
     scenario: &Path,
     mode: Mode,
+    (log, source): (&Path, &str),
     parent: Option<u32>,
 ) -> Vec<String> {
     let mut args = vec![
@@ -149,6 +156,12 @@ pub fn node_args(
         "--mode".to_string(),
         mode.as_str().to_string(),
     ];
+    if kind == NodeKind::Logger {
+        args.push("--out".into());
+        args.push(log.display().to_string());
+        args.push("--source".into());
+        args.push(source.to_string());
+    }
     if let Some(pid) = parent {
         args.push("--parent-pid".into());
         args.push(pid.to_string());
@@ -185,38 +198,41 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let bus = Bus::new(&prefix, "launcher")?;
     let status = bus.subscriber::<NodeStatus>(Topic::Status)?;
     let control = bus.publisher::<Control>(Topic::Control, Delivery::DropWhenFull)?;
-    let csv = match &opts.csv {
-        Some(path) => {
-            let file =
-                File::create(path).map_err(|e| RunError::Output(path.display().to_string(), e))?;
-            let mut w = BufWriter::new(file);
-            std::io::Write::write_all(
-                &mut w,
-                format!("{}\n", crate::csv_out::header(dof)).as_bytes(),
-            )
-            .map_err(|e| RunError::Output(path.display().to_string(), e))?;
-            Some((w, path.display().to_string()))
-        }
-        None => None,
-    };
-    let mut collector = Collector::new(&bus, plan, csv)?;
+    let log = std::path::absolute(run_dir.join("run.mcap"))
+        .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?;
 
     let exe = std::env::current_exe().map_err(|cause| RunError::Spawn {
         node: "plant",
         cause,
     })?;
     let mut children = Children::default();
-    let args = node_args(&prefix, &scenario_file, opts.mode, Some(std::process::id()));
+    let me = Some(std::process::id());
     for kind in NODES {
         if opts.external.contains(&kind) {
+            let args = node_args(
+                kind,
+                &prefix,
+                &scenario_file,
+                opts.mode,
+                (&log, &plan.source),
+                None,
+            );
             eprintln!(
                 "testbed: waiting for the {} node; start it with:\n  testbed node {} {}",
                 kind.name(),
                 kind.name(),
-                node_args(&prefix, &scenario_file, opts.mode, None).join(" ")
+                args.join(" ")
             );
             continue;
         }
+        let args = node_args(
+            kind,
+            &prefix,
+            &scenario_file,
+            opts.mode,
+            (&log, &plan.source),
+            me,
+        );
         let child = spawn::spawn(&exe, kind, &args).map_err(|cause| RunError::Spawn {
             node: kind.name(),
             cause,
@@ -224,31 +240,53 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         children.push(child);
     }
 
-    let result = supervise(
-        &opts,
-        &bus,
-        &status,
-        &control,
-        &mut collector,
-        &mut children,
-    );
-    // Whatever happened: STOP, grace, SIGTERM, SIGKILL, reap.
+    let result = supervise(&opts, &bus, &status, &control, &mut children);
+    // Whatever happened: STOP (the logger then finishes the file), grace,
+    // SIGTERM, SIGKILL, reap.
     let _ = control.send(control_msg(CONTROL_STOP, 0));
     children.stop(STOP_GRACE);
-    let finished = collector.finish(opts.mode, plan.scenario.rate_hz);
-    let missing_rows = collector.missing_rows();
+    let logger_exit = children.exit_of(NodeKind::Logger);
     // Close every port of this process, then remove what is left of the
     // run's domain (including what a killed node left behind).
-    drop((collector, status, control, bus));
+    drop((status, control, bus));
     let _ = prefix.remove_domain_if_unused();
     let wall_time_s = result?;
-    let (summary, timing) = finished?;
+    if let Some((status, stderr)) = logger_exit.filter(|(s, _)| !s.success()) {
+        return Err(RunError::NodeFailed {
+            node: NodeKind::Logger.name(),
+            how: describe(status),
+            stderr,
+        });
+    }
+
+    // One analysis path: the summary comes from the log just written.
+    let mut csv_file = match &opts.csv {
+        Some(path) => {
+            Some(BufWriter::new(File::create(path).map_err(|e| {
+                RunError::Output(path.display().to_string(), e)
+            })?))
+        }
+        None => None,
+    };
+    let csv_name = opts
+        .csv
+        .as_ref()
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    let analysis = analyse(
+        &log,
+        AnalyseOptions {
+            csv: csv_file
+                .as_mut()
+                .map(|w| (csv_name.as_str(), w as &mut dyn std::io::Write)),
+            ..AnalyseOptions::default()
+        },
+    )?;
     Ok(RunOutcome {
-        summary,
-        timing,
+        analysis,
         run_dir,
+        log,
         wall_time_s,
-        missing_rows,
     })
 }
 
@@ -265,34 +303,32 @@ fn control_msg(command: u32, epoch_wall_ns: u64) -> Control {
     }
 }
 
-/// Waits for READY, sends START, drains until every row is in. Returns the
-/// wall time of the run proper.
+/// Waits for READY, sends START, follows the plant's progress until every
+/// producer is DONE. Returns the wall time of the run proper.
 fn supervise(
     opts: &RunOptions,
     bus: &Bus,
     status: &wire::TopicSubscriber<NodeStatus>,
     control: &wire::TopicPublisher<Control>,
-    collector: &mut Collector,
     children: &mut Children,
 ) -> Result<f64, RunError> {
     let plan = &opts.plan;
-    let mut ready: Vec<NodeKind> = Vec::new();
-    let mut done: Vec<NodeKind> = Vec::new();
+    let mut nodes = NodeStates::default();
     let limit = if opts.external.is_empty() {
         START_TIMEOUT
     } else {
         EXTERNAL_START_TIMEOUT
     };
     let start_wait = Instant::now();
-    while ready.len() < NODES.len() {
+    while NODES.iter().any(|k| !nodes.ready.contains(k)) {
         tick(bus)?;
-        read_status(status, &mut ready, &mut done)?;
+        nodes.read(status)?;
         check_children(children)?;
         if start_wait.elapsed() > limit {
             return Err(RunError::StartTimeout {
                 missing: NODES
                     .iter()
-                    .filter(|k| !ready.contains(k))
+                    .filter(|k| !nodes.ready.contains(k))
                     .map(|k| k.name())
                     .collect(),
                 secs: limit.as_secs(),
@@ -305,26 +341,25 @@ fn supervise(
     control.send(control_msg(CONTROL_START, epoch))?;
     let started = Instant::now();
     let bar = progress_bar(opts);
-    let mut last_rows = 0;
+    let mut last_step = 0;
     let mut last_change = Instant::now();
-    loop {
+    let mut wall = None;
+    while PRODUCERS.iter().any(|k| !nodes.done.contains(k)) {
         tick(bus)?;
-        collector.drain()?;
-        read_status(status, &mut ready, &mut done)?;
-        if collector.complete() {
-            break;
+        nodes.read(status)?;
+        if nodes.done.contains(&NodeKind::Plant) && wall.is_none() {
+            wall = Some(started.elapsed().as_secs_f64());
         }
         check_children(children)?;
-        let rows = collector.rows();
         if let Some(b) = &bar {
-            b.set_position(rows);
+            b.set_position(nodes.plant_step);
         }
-        if rows != last_rows {
-            last_rows = rows;
+        if nodes.plant_step != last_step || nodes.done.contains(&NodeKind::Plant) {
+            last_step = nodes.plant_step;
             last_change = Instant::now();
         } else if last_change.elapsed() > STALL_TIMEOUT {
             return Err(RunError::Stalled {
-                step: rows,
+                step: last_step,
                 steps: plan.steps,
                 secs: STALL_TIMEOUT.as_secs(),
             });
@@ -333,21 +368,45 @@ fn supervise(
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let wall = started.elapsed().as_secs_f64();
-    // Let every node finish its part (the trajectory publishes a last
-    // sample after the plant's last state) before STOP.
-    let finishing = Instant::now();
-    while NODES
-        .iter()
-        .any(|k| !done.contains(k) && !opts.external.contains(k))
-        && finishing.elapsed() < DONE_TIMEOUT
-    {
-        tick(bus)?;
-        collector.drain()?;
-        read_status(status, &mut ready, &mut done)?;
-        check_children(children)?;
+    Ok(wall.unwrap_or_else(|| started.elapsed().as_secs_f64()))
+}
+
+/// What the status topic has said so far.
+#[derive(Default)]
+struct NodeStates {
+    ready: Vec<NodeKind>,
+    done: Vec<NodeKind>,
+    plant_step: u64,
+}
+
+impl NodeStates {
+    fn read(&mut self, status: &wire::TopicSubscriber<NodeStatus>) -> Result<(), RunError> {
+        while let Some(s) = status.receive()? {
+            let Some(kind) = NodeKind::from_u32(s.node) else {
+                continue;
+            };
+            if kind == NodeKind::Plant {
+                self.plant_step = self.plant_step.max(s.step);
+            }
+            let list = match s.state {
+                NODE_READY => &mut self.ready,
+                NODE_DONE => &mut self.done,
+                NODE_FAILED => {
+                    return Err(RunError::NodeFailed {
+                        node: kind.name(),
+                        how: "reported a failure".into(),
+                        stderr: String::new(),
+                    });
+                }
+                _ => continue,
+            };
+            if !list.contains(&kind) {
+                list.push(kind);
+            }
+        }
+        let _ = status.drain_events();
+        Ok(())
     }
-    Ok(wall)
 }
 
 /// Sleeps one tick; a SIGINT or SIGTERM turns into `Interrupted`.
@@ -356,35 +415,6 @@ fn tick(bus: &Bus) -> Result<(), RunError> {
         WireError::Terminated => RunError::Interrupted,
         other => RunError::Wire(other),
     })
-}
-
-fn read_status(
-    status: &wire::TopicSubscriber<NodeStatus>,
-    ready: &mut Vec<NodeKind>,
-    done: &mut Vec<NodeKind>,
-) -> Result<(), RunError> {
-    while let Some(s) = status.receive()? {
-        let Some(kind) = NodeKind::from_u32(s.node) else {
-            continue;
-        };
-        let list = match s.state {
-            NODE_READY => &mut *ready,
-            NODE_DONE => &mut *done,
-            NODE_FAILED => {
-                return Err(RunError::NodeFailed {
-                    node: kind.name(),
-                    how: "reported a failure".into(),
-                    stderr: String::new(),
-                });
-            }
-            _ => continue,
-        };
-        if !list.contains(&kind) {
-            list.push(kind);
-        }
-    }
-    let _ = status.drain_events();
-    Ok(())
 }
 
 /// Any child that exits before the run is over has failed.

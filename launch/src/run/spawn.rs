@@ -130,6 +130,14 @@ impl Children {
         None
     }
 
+    /// How `kind` ended (status and stderr tail), once it has.
+    pub fn exit_of(&mut self, kind: NodeKind) -> Option<(ExitStatus, String)> {
+        let c = self.0.iter_mut().find(|c| c.kind == kind)?;
+        let status = c.poll()?;
+        c.join_forwarder();
+        Some((status, c.stderr_tail()))
+    }
+
     /// Waits up to `grace` for every child to exit (after STOP was sent),
     /// then SIGTERM, another `grace`, then SIGKILL. Returns the children
     /// that needed a signal.

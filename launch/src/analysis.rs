@@ -1,0 +1,314 @@
+//! Everything a run's figures are computed from, read back from its log.
+//!
+//! `testbed run` and `testbed replay` both call [`analyse`], so a summary
+//! never depends on how it is produced: the log alone decides it.
+
+use std::io::Write;
+use std::path::Path;
+
+use scenario::{Plan, RobotSource, Scenario};
+use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
+
+use crate::assemble::RecordAssembler;
+use crate::csv_out;
+use crate::log::{LogContents, LogError, LogMessage, read_log};
+use crate::mode::Mode;
+use crate::run::timing::{TimingStats, TimingSummary};
+use crate::summary::{Summary, SummaryBuilder};
+use crate::verify::Verifier;
+
+/// Why a log could not be analysed.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalysisError {
+    /// Reading the file failed.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The run's metadata is unusable.
+    #[error("{path}: {reason}")]
+    Metadata {
+        /// The log.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The CSV could not be written.
+    #[error("{path}: {cause}")]
+    Output {
+        /// The file.
+        path: String,
+        /// The cause.
+        cause: std::io::Error,
+    },
+}
+
+/// Per-row values the figures need.
+#[derive(Debug, Clone, Default)]
+pub struct Series {
+    /// Sim time of each row, s.
+    pub t: Vec<f64>,
+    /// Per joint: q, q_d, k_c, q̇, q̇_d, Z1, ‖Ŵa‖, τ (each indexed [joint][row]).
+    pub q: Vec<Vec<f64>>,
+    /// q_d.
+    pub q_d: Vec<Vec<f64>>,
+    /// k_c.
+    pub kc: Vec<Vec<f64>>,
+    /// q̇.
+    pub qd: Vec<Vec<f64>>,
+    /// q̇_d.
+    pub qd_d: Vec<Vec<f64>>,
+    /// Z1.
+    pub z1: Vec<Vec<f64>>,
+    /// ‖Ŵa‖.
+    pub wa: Vec<Vec<f64>>,
+    /// τ.
+    pub tau: Vec<Vec<f64>>,
+    /// Period jitter samples, µs.
+    pub jitter_us: Vec<f64>,
+    /// Round-trip samples, µs.
+    pub round_trip_us: Vec<f64>,
+}
+
+impl Series {
+    fn new(n: usize) -> Self {
+        let v = || vec![Vec::new(); n];
+        Self {
+            q: v(),
+            q_d: v(),
+            kc: v(),
+            qd: v(),
+            qd_d: v(),
+            z1: v(),
+            wa: v(),
+            tau: v(),
+            ..Self::default()
+        }
+    }
+
+    fn add(&mut self, r: &crate::record::StepRecord<'_>) {
+        self.t.push(r.t);
+        for i in 0..self.q.len() {
+            self.q[i].push(r.q[i]);
+            self.q_d[i].push(r.q_d[i]);
+            self.kc[i].push(r.kc[i]);
+            self.qd[i].push(r.qd[i]);
+            self.qd_d[i].push(r.qd_d[i]);
+            self.z1[i].push(r.z1[i]);
+            self.wa[i].push(r.wa_norm[i]);
+            self.tau[i].push(r.tau[i]);
+        }
+    }
+}
+
+/// What to compute besides the summary.
+#[derive(Default)]
+pub struct AnalyseOptions<'a> {
+    /// Write one CSV row per step here (path for messages, writer).
+    pub csv: Option<(&'a str, &'a mut dyn Write)>,
+    /// Re-drive the controller and compare torques.
+    pub verify: bool,
+    /// Keep the per-row series for figures.
+    pub series: bool,
+}
+
+/// The result of reading a log.
+#[derive(Debug)]
+pub struct LogAnalysis {
+    /// The scenario and robot as the run used them.
+    pub plan: Plan,
+    /// Metadata, stats, completeness.
+    pub contents: LogContents,
+    /// Mode of the run.
+    pub mode: Mode,
+    /// The step figures.
+    pub summary: Summary,
+    /// The timing figures.
+    pub timing: TimingSummary,
+    /// Rows the run should have.
+    pub expected_rows: u64,
+    /// Rows whose samples were dropped.
+    pub missing_rows: u64,
+    /// Largest |τ_replayed − τ_logged| and steps compared, with `verify`.
+    pub verify: Option<(f64, u64)>,
+    /// Per-row values, with `series`.
+    pub series: Option<Series>,
+    /// Wall time between the first and the last logged joint state, s.
+    pub wall_span_s: f64,
+}
+
+impl LogAnalysis {
+    /// A warning for a log that was read only in part, or None.
+    pub fn warning(&self) -> Option<String> {
+        let rows = self.summary.steps;
+        let why = self.contents.cut_short.as_ref()?;
+        Some(format!(
+            "{}: {why}; recovered {rows} of {} steps ({:.3} s of {:.3} s)",
+            self.contents.path.display(),
+            self.expected_rows,
+            rows as f64 * self.plan.dt(),
+            self.expected_rows as f64 * self.plan.dt()
+        ))
+    }
+}
+
+fn meta_err(path: &Path, reason: impl Into<String>) -> AnalysisError {
+    AnalysisError::Metadata {
+        path: path.display().to_string(),
+        reason: reason.into(),
+    }
+}
+
+/// Rebuilds the run's plan from the log's metadata and URDF attachment.
+fn plan_from(contents: &LogContents) -> Result<(Plan, Mode), AnalysisError> {
+    let path = contents.path.as_path();
+    let get = |k: &str| {
+        contents
+            .run
+            .get(k)
+            .ok_or_else(|| meta_err(path, format!("testbed.run metadata has no '{k}'")))
+    };
+    let toml = get("scenario_toml")?;
+    let label = format!("{} (testbed.run scenario_toml)", path.display());
+    let mut scenario =
+        Scenario::from_toml_str(toml, &label).map_err(|e| meta_err(path, e.to_string()))?;
+    // The robot is the attached URDF, wherever the original file was.
+    scenario.robot = None;
+    let robot = match &contents.urdf {
+        Some(urdf) => RobotSource::from_text(urdf, &format!("{} (robot.urdf)", path.display()))
+            .map_err(|e| meta_err(path, e.to_string()))?,
+        None => return Err(meta_err(path, "the log has no robot.urdf attachment")),
+    };
+    let mode = match get("mode")?.as_str() {
+        "lockstep" => Mode::Lockstep,
+        "realtime" => Mode::Realtime,
+        other => return Err(meta_err(path, format!("unknown mode '{other}'"))),
+    };
+    let plan = scenario::plan(scenario, label, toml.clone(), robot)
+        .map_err(|e| meta_err(path, e.to_string()))?;
+    Ok((plan, mode))
+}
+
+/// Reads the log at `path` and computes everything from it.
+pub fn analyse(path: &Path, mut opts: AnalyseOptions<'_>) -> Result<LogAnalysis, AnalysisError> {
+    let head = read_log(path, None)?;
+    let (plan, mode) = plan_from(&head)?;
+    let n = plan.robot.model.dof();
+    let mut assembler = RecordAssembler::new(n, plan.dt(), plan.steps);
+    let mut summary = SummaryBuilder::new(
+        plan.robot.model.joint_names(),
+        plan.dt(),
+        plan.scenario.controller.tc,
+    );
+    let mut timing = TimingStats::new(plan.period_ns);
+    let mut series = opts.series.then(|| Series::new(n));
+    let mut verifier = if opts.verify {
+        Some(
+            Verifier::new(plan.scenario.controller.clone(), n, plan.dt())
+                .map_err(|e| meta_err(path, e.to_string()))?,
+        )
+    } else {
+        None
+    };
+    if let Some((p, w)) = opts.csv.as_mut() {
+        writeln!(w, "{}", csv_out::header(n)).map_err(|cause| AnalysisError::Output {
+            path: p.to_string(),
+            cause,
+        })?;
+    }
+    let mut csv_error: Option<std::io::Error> = None;
+    let mut wall = (u64::MAX, 0u64);
+    let mut on_message = |topic: &str, v: &serde_json::Value| -> Result<(), String> {
+        match topic {
+            t if t == JointState::TOPIC => {
+                let s = JointState::parse(v)?;
+                check_dof(s.dof, n)?;
+                wall = (wall.0.min(s.header.wall_ns), wall.1.max(s.header.wall_ns));
+                if let Some(ver) = verifier.as_mut() {
+                    ver.push_state(s);
+                }
+                assembler.push_state(s);
+            }
+            t if t == ControllerDiagnostics::TOPIC => {
+                let d = ControllerDiagnostics::parse(v)?;
+                check_dof(d.dof, n)?;
+                if let Some(ver) = verifier.as_mut() {
+                    ver.push_diag(d);
+                }
+                assembler.push_diag(d);
+            }
+            t if t == Command::TOPIC => {
+                let c = Command::parse(v)?;
+                if let Some(ver) = verifier.as_mut() {
+                    ver.push_command(c);
+                }
+            }
+            t if t == Timing::TOPIC => {
+                let t = Timing::parse(v)?;
+                timing.add(&t);
+                if let Some(s) = series.as_mut() {
+                    if t.period_ns > 0 {
+                        s.jitter_us.push(
+                            (t.period_ns - plan.period_ns as i64).unsigned_abs() as f64 / 1e3,
+                        );
+                    }
+                    if t.round_trip_ns >= 0 {
+                        s.round_trip_us.push(t.round_trip_ns as f64 / 1e3);
+                    }
+                }
+            }
+            t if t == ReferenceSample::TOPIC => {
+                ReferenceSample::parse(v)?;
+            }
+            _ => {}
+        }
+        let emitted = assembler.emit(|r| {
+            summary.add(r);
+            if let Some(s) = series.as_mut() {
+                s.add(r);
+            }
+            match opts.csv.as_mut() {
+                Some((_, w)) => csv_out::write_row(w, r),
+                None => Ok(()),
+            }
+        });
+        if let Err(e) = emitted {
+            csv_error = Some(e);
+            return Err("cannot write the CSV".into());
+        }
+        Ok(())
+    };
+    let contents = read_log(path, Some(&mut on_message))?;
+    if let (Some(cause), Some((p, _))) = (csv_error, opts.csv.as_ref()) {
+        return Err(AnalysisError::Output {
+            path: p.to_string(),
+            cause,
+        });
+    }
+    if let Some((p, w)) = opts.csv.as_mut() {
+        w.flush().map_err(|cause| AnalysisError::Output {
+            path: p.to_string(),
+            cause,
+        })?;
+    }
+    let rate_hz = plan.scenario.rate_hz;
+    let wall_span_s = wall.1.saturating_sub(wall.0) as f64 / 1e9;
+    Ok(LogAnalysis {
+        wall_span_s,
+        expected_rows: plan.steps,
+        missing_rows: assembler.missing(),
+        summary: summary.finish(),
+        timing: timing.finish(mode, rate_hz),
+        verify: verifier.map(|v| (v.max_abs_torque_diff, v.steps)),
+        series,
+        contents,
+        plan,
+        mode,
+    })
+}
+
+fn check_dof(dof: u32, n: usize) -> Result<(), String> {
+    if dof as usize == n {
+        Ok(())
+    } else {
+        Err(format!("dof {dof} but the logged robot has {n} joints"))
+    }
+}

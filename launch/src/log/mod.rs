@@ -1,0 +1,53 @@
+//! The run log: one MCAP file per run that explains itself.
+//!
+//! Channels carry JSON messages with `jsonschema` schemas (so Foxglove can
+//! plot every field), in zstd-compressed chunks; each message's log time is
+//! its sim time and its publish time the sample's wall timestamp. A metadata
+//! record `testbed.run` holds the scenario (full TOML), run id, mode, rate,
+//! software version and start time; the robot's URDF is an attachment; a
+//! last metadata record `testbed.log_stats` counts what the logger received
+//! and what it could not take.
+
+mod json;
+mod reader;
+mod writer;
+
+pub use json::{Field, Fields, LogMessage};
+pub use reader::{LogContents, OnMessage, read_log};
+pub use writer::{LogWriter, RunMetadata};
+
+/// Name of the metadata record that describes the run.
+pub const RUN_METADATA: &str = "testbed.run";
+/// Name of the metadata record with the logger's counts.
+pub const STATS_METADATA: &str = "testbed.log_stats";
+/// Name of the URDF attachment.
+pub const URDF_ATTACHMENT: &str = "robot.urdf";
+
+/// Why a log could not be written or read.
+#[derive(Debug, thiserror::Error)]
+pub enum LogError {
+    /// File system.
+    #[error("{path}: {cause}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        cause: std::io::Error,
+    },
+    /// The MCAP library.
+    #[error("{path}: {cause}")]
+    Mcap {
+        /// The file.
+        path: String,
+        /// The cause.
+        cause: mcap::McapError,
+    },
+    /// The file is readable MCAP but not a testbed log.
+    #[error("{path}: {reason}")]
+    NotATestbedLog {
+        /// The file.
+        path: String,
+        /// What is missing or wrong.
+        reason: String,
+    },
+}

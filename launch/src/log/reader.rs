@@ -1,0 +1,113 @@
+//! Reading a run log, as far as it goes.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+use mcap::read::{ChunkFlattener, Options};
+use mcap::records::Record;
+
+use super::{LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
+
+/// What a log holds besides its messages.
+#[derive(Debug, Clone, Default)]
+pub struct LogContents {
+    /// The file.
+    pub path: PathBuf,
+    /// The `testbed.run` metadata.
+    pub run: BTreeMap<String, String>,
+    /// The logger's counts (`testbed.log_stats`), absent if it never finished.
+    pub stats: Option<BTreeMap<String, String>>,
+    /// The robot's URDF.
+    pub urdf: Option<String>,
+    /// Messages read.
+    pub messages: u64,
+    /// The file ended with its footer (the logger finished it).
+    pub complete: bool,
+    /// Why reading stopped early, if it did.
+    pub cut_short: Option<String>,
+}
+
+/// Called for every message of a log, in file order.
+pub type OnMessage<'a> = &'a mut dyn FnMut(&str, &serde_json::Value) -> Result<(), String>;
+
+/// Reads `path` record by record, calling `on_message(topic, json)` (if
+/// given) for every message in file order. A truncated or unfinished file is
+/// read up to its last whole record; `cut_short` then says why it ended.
+pub fn read_log(
+    path: &Path,
+    mut on_message: Option<OnMessage<'_>>,
+) -> Result<LogContents, LogError> {
+    let p = path.display().to_string();
+    let buf = std::fs::read(path).map_err(|cause| LogError::Io {
+        path: p.clone(),
+        cause,
+    })?;
+    if !buf.starts_with(mcap::MAGIC) {
+        return Err(LogError::NotATestbedLog {
+            path: p,
+            reason: "not an MCAP file (no MCAP magic at the start)".into(),
+        });
+    }
+    let mut out = LogContents {
+        path: path.to_path_buf(),
+        ..LogContents::default()
+    };
+    let mut topics: HashMap<u16, String> = HashMap::new();
+    let records = ChunkFlattener::new_with_options(&buf, Options::IgnoreEndMagic.into()).map_err(
+        |cause| LogError::Mcap {
+            path: p.clone(),
+            cause,
+        },
+    )?;
+    for record in records {
+        let record = match record {
+            Ok(r) => r,
+            Err(e) => {
+                out.cut_short = Some(format!("the file ends inside a record ({e})"));
+                break;
+            }
+        };
+        match record {
+            Record::Channel(c) => {
+                topics.insert(c.id, c.topic);
+            }
+            Record::Message { header, data } => {
+                let (Some(topic), Some(on_message)) =
+                    (topics.get(&header.channel_id), on_message.as_mut())
+                else {
+                    out.messages += 1;
+                    continue;
+                };
+                let value: serde_json::Value = match serde_json::from_slice(&data) {
+                    Ok(v) => v,
+                    Err(e) => {
+                        out.cut_short = Some(format!("a {topic} message is not JSON ({e})"));
+                        break;
+                    }
+                };
+                if let Err(e) = on_message(topic, &value) {
+                    out.cut_short = Some(format!("a {topic} message is malformed: {e}"));
+                    break;
+                }
+                out.messages += 1;
+            }
+            Record::Metadata(m) if m.name == RUN_METADATA => out.run = m.metadata,
+            Record::Metadata(m) if m.name == STATS_METADATA => out.stats = Some(m.metadata),
+            Record::Attachment { header, data, .. } if header.name == URDF_ATTACHMENT => {
+                out.urdf = Some(String::from_utf8_lossy(&data).to_string());
+            }
+            Record::Footer(_) => out.complete = true,
+            _ => {}
+        }
+    }
+    if out.run.is_empty() {
+        return Err(LogError::NotATestbedLog {
+            path: p,
+            reason: "no testbed.run metadata: not a log written by testbed".into(),
+        });
+    }
+    if !out.complete && out.cut_short.is_none() {
+        out.cut_short = Some("the logger never finished the file (no footer)".into());
+    }
+    Ok(out)
+}

@@ -1,0 +1,191 @@
+//! Writing a run log.
+
+use std::collections::{BTreeMap, HashMap};
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use mcap::records::MessageHeader;
+use mcap::{Attachment, Compression, WriteOptions, Writer};
+
+use super::json::LogMessage;
+use super::{LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
+
+/// A chunk is closed at least this often, so a crash loses at most this
+/// much wall time of data (an unfinished MCAP file loses only its open chunk).
+const FLUSH_EVERY: Duration = Duration::from_millis(500);
+/// Chunks are also closed when they reach this size (compressed input).
+const CHUNK_BYTES: u64 = 1 << 20;
+
+/// What the `testbed.run` metadata record says.
+#[derive(Debug, Clone)]
+pub struct RunMetadata {
+    /// Run id (the run folder's name).
+    pub run_id: String,
+    /// "realtime" or "lockstep".
+    pub mode: String,
+    /// Control rate, Hz.
+    pub rate_hz: f64,
+    /// The scenario as it ran (TOML).
+    pub scenario_toml: String,
+    /// Where the scenario came from.
+    pub scenario_source: String,
+    /// The robot's label.
+    pub robot: String,
+    /// Joint names, in order.
+    pub joint_names: Vec<String>,
+    /// Wall-clock start, ns since the Unix epoch.
+    pub start_time_unix_ns: u64,
+}
+
+impl RunMetadata {
+    fn to_map(&self) -> BTreeMap<String, String> {
+        BTreeMap::from([
+            ("run_id".into(), self.run_id.clone()),
+            ("mode".into(), self.mode.clone()),
+            ("rate_hz".into(), format!("{:?}", self.rate_hz)),
+            ("scenario_toml".into(), self.scenario_toml.clone()),
+            ("scenario_source".into(), self.scenario_source.clone()),
+            ("robot".into(), self.robot.clone()),
+            ("joint_names".into(), self.joint_names.join(",")),
+            (
+                "start_time_unix_ns".into(),
+                self.start_time_unix_ns.to_string(),
+            ),
+            (
+                "software".into(),
+                format!("testbed {}", env!("CARGO_PKG_VERSION")),
+            ),
+        ])
+    }
+}
+
+/// An open log.
+pub struct LogWriter {
+    writer: Writer<BufWriter<File>>,
+    path: PathBuf,
+    channels: HashMap<&'static str, (u16, u32)>,
+    last_flush: Instant,
+}
+
+impl LogWriter {
+    /// Creates the file and writes the run's metadata and the URDF.
+    pub fn create(path: &Path, meta: &RunMetadata, urdf: &str) -> Result<Self, LogError> {
+        let p = path.display().to_string();
+        let file = File::create(path).map_err(|cause| LogError::Io {
+            path: p.clone(),
+            cause,
+        })?;
+        let mcap_err = |cause| LogError::Mcap {
+            path: p.clone(),
+            cause,
+        };
+        let mut writer = WriteOptions::new()
+            .compression(Some(Compression::Zstd))
+            .chunk_size(Some(CHUNK_BYTES))
+            .profile("")
+            .library(format!("testbed {}", env!("CARGO_PKG_VERSION")))
+            .create(BufWriter::new(file))
+            .map_err(mcap_err)?;
+        writer
+            .write_metadata(&mcap::records::Metadata {
+                name: RUN_METADATA.into(),
+                metadata: meta.to_map(),
+            })
+            .map_err(mcap_err)?;
+        writer
+            .attach(&Attachment {
+                log_time: 0,
+                create_time: meta.start_time_unix_ns,
+                name: URDF_ATTACHMENT.into(),
+                media_type: "application/xml".into(),
+                data: std::borrow::Cow::Borrowed(urdf.as_bytes()),
+            })
+            .map_err(mcap_err)?;
+        Ok(Self {
+            writer,
+            path: path.to_path_buf(),
+            channels: HashMap::new(),
+            last_flush: Instant::now(),
+        })
+    }
+
+    fn err(&self) -> impl Fn(mcap::McapError) -> LogError + '_ {
+        |cause| LogError::Mcap {
+            path: self.path.display().to_string(),
+            cause,
+        }
+    }
+
+    /// Registers the channel of `M` (done on first write otherwise).
+    pub fn add_channel<M: LogMessage>(&mut self) -> Result<u16, LogError> {
+        if let Some((id, _)) = self.channels.get(M::TOPIC) {
+            return Ok(*id);
+        }
+        let schema = serde_json::to_vec(&M::schema()).unwrap_or_default();
+        let schema_id = self
+            .writer
+            .add_schema(M::SCHEMA, "jsonschema", &schema)
+            .map_err(|cause| LogError::Mcap {
+                path: self.path.display().to_string(),
+                cause,
+            })?;
+        let id = self
+            .writer
+            .add_channel(schema_id, M::TOPIC, "json", &BTreeMap::new())
+            .map_err(|cause| LogError::Mcap {
+                path: self.path.display().to_string(),
+                cause,
+            })?;
+        self.channels.insert(M::TOPIC, (id, 0));
+        Ok(id)
+    }
+
+    /// Appends one message.
+    pub fn write<M: LogMessage>(&mut self, msg: &M) -> Result<(), LogError> {
+        let id = self.add_channel::<M>()?;
+        let seq = self.channels.get_mut(M::TOPIC).map_or(0, |(_, s)| {
+            *s = s.wrapping_add(1);
+            *s
+        });
+        let h = msg.header();
+        let data = serde_json::to_vec(&msg.to_json()).unwrap_or_default();
+        let header = MessageHeader {
+            channel_id: id,
+            sequence: seq,
+            log_time: h.t_ns,
+            publish_time: h.wall_ns,
+        };
+        let res = self.writer.write_to_known_channel(&header, &data);
+        res.map_err(self.err())
+    }
+
+    /// Closes the open chunk if it is older than the flush period.
+    pub fn flush_if_due(&mut self) -> Result<(), LogError> {
+        if self.last_flush.elapsed() >= FLUSH_EVERY {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Closes the open chunk and pushes it to the file.
+    pub fn flush(&mut self) -> Result<(), LogError> {
+        self.last_flush = Instant::now();
+        let res = self.writer.flush();
+        res.map_err(self.err())
+    }
+
+    /// Writes the `testbed.log_stats` record, the summary and the footer.
+    /// Checked: mcap's own `Drop` would throw a failure away.
+    pub fn finish(mut self, stats: BTreeMap<String, String>) -> Result<(), LogError> {
+        let res = self.writer.write_metadata(&mcap::records::Metadata {
+            name: STATS_METADATA.into(),
+            metadata: stats,
+        });
+        res.map_err(self.err())?;
+        let res = self.writer.finish();
+        res.map_err(self.err())?;
+        Ok(())
+    }
+}

@@ -1,0 +1,385 @@
+//! The paper's five figures and a timing figure, as PNG and SVG.
+//!
+//! Text is drawn with an embedded DejaVu Sans (see `assets/`), so figures do
+//! not depend on the fonts of the machine.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+use scenario::Plan;
+
+use crate::analysis::Series;
+
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+const FAMILY: &str = "sans-serif";
+/// More points than a figure can show only make SVGs large.
+const MAX_POINTS: usize = 4000;
+const COLORS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(23, 190, 207),
+];
+
+/// One curve.
+struct Line<'a> {
+    label: String,
+    y: &'a [f64],
+    color: RGBColor,
+    dashed: bool,
+}
+
+/// One panel of a figure (one joint).
+struct Panel<'a> {
+    title: String,
+    y_label: &'static str,
+    lines: Vec<Line<'a>>,
+}
+
+fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+fn decimate(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
+    let stride = t.len().div_ceil(MAX_POINTS).max(1);
+    t.iter()
+        .zip(y)
+        .step_by(stride)
+        .filter(|(_, y)| y.is_finite())
+        .map(|(t, y)| (*t, *y))
+        .collect()
+}
+
+fn draw_panels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    t: &[f64],
+    panels: &[Panel<'_>],
+    vline: Option<f64>,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(err)?;
+    let root = root.titled(title, (FAMILY, 22)).map_err(err)?;
+    let areas = root.split_evenly((panels.len(), 1));
+    let t_end = t.last().copied().unwrap_or(1.0).max(1e-9);
+    for (area, panel) in areas.iter().zip(panels) {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for l in &panel.lines {
+            for y in l.y.iter().filter(|y| y.is_finite()) {
+                lo = lo.min(*y);
+                hi = hi.max(*y);
+            }
+        }
+        if !lo.is_finite() {
+            (lo, hi) = (-1.0, 1.0);
+        }
+        let pad = ((hi - lo) * 0.05).max(1e-6);
+        let mut chart = ChartBuilder::on(area)
+            .caption(&panel.title, (FAMILY, 16))
+            .margin(8)
+            .x_label_area_size(32)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("t [s]")
+            .y_desc(panel.y_label)
+            .label_style((FAMILY, 12))
+            .draw()
+            .map_err(err)?;
+        for l in &panel.lines {
+            let pts = decimate(t, l.y);
+            let style = ShapeStyle::from(&l.color).stroke_width(2);
+            let series = if l.dashed {
+                chart
+                    .draw_series(DashedLineSeries::new(pts, 6, 4, style))
+                    .map_err(err)?
+            } else {
+                chart
+                    .draw_series(LineSeries::new(pts, style))
+                    .map_err(err)?
+            };
+            let c = l.color;
+            if !l.label.is_empty() {
+                series
+                    .label(l.label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c));
+            }
+        }
+        if let Some(x) = vline {
+            chart
+                .draw_series(LineSeries::new(
+                    vec![(x, lo - pad), (x, hi + pad)],
+                    ShapeStyle::from(&BLACK.mix(0.5)).stroke_width(1),
+                ))
+                .map_err(err)?
+                .label(format!("T_c = {x} s"))
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.mix(0.5)));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK.mix(0.3))
+            .label_font((FAMILY, 12))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(err)?;
+    }
+    root.present().map_err(err)
+}
+
+/// Writes `name.png` and `name.svg`.
+fn save(
+    dir: &Path,
+    name: &str,
+    title: &str,
+    t: &[f64],
+    panels: &[Panel<'_>],
+    vline: Option<f64>,
+) -> Result<(), String> {
+    let h = 260 * panels.len() as u32 + 60;
+    let png = dir.join(format!("{name}.png"));
+    draw_panels(
+        &BitMapBackend::new(&png, (1000, h)).into_drawing_area(),
+        title,
+        t,
+        panels,
+        vline,
+    )
+    .map_err(|e| format!("{}: {e}", png.display()))?;
+    let svg = dir.join(format!("{name}.svg"));
+    draw_panels(
+        &SVGBackend::new(&svg, (1000, h)).into_drawing_area(),
+        title,
+        t,
+        panels,
+        vline,
+    )
+    .map_err(|e| format!("{}: {e}", svg.display()))
+}
+
+fn bounds(a: &[f64], b: &[f64], sign: f64) -> Vec<f64> {
+    a.iter().zip(b).map(|(a, b)| a + sign * b).collect()
+}
+
+/// A figure could not be drawn or written.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct PlotError(String);
+
+/// Writes every figure into `dir` (created if needed); returns how many.
+pub fn write_all(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, PlotError> {
+    write_figures(dir, s, plan).map_err(PlotError)
+}
+
+fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    // Registering twice is harmless; the bytes are a valid font by construction.
+    let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
+    let names = plan.robot.model.joint_names();
+    let tc = plan.scenario.controller.tc;
+    let n = names.len();
+    let line = |label: String, y, i: usize, dashed| Line {
+        label,
+        y,
+        color: COLORS[i % COLORS.len()],
+        dashed,
+    };
+    let red = RGBColor(214, 39, 40);
+
+    let mut upper = Vec::new();
+    let mut lower = Vec::new();
+    for i in 0..n {
+        upper.push(bounds(&s.q_d[i], &s.kc[i], 1.0));
+        lower.push(bounds(&s.q_d[i], &s.kc[i], -1.0));
+    }
+    let positions: Vec<Panel<'_>> = (0..n)
+        .map(|i| Panel {
+            title: format!("{}: position", names[i]),
+            y_label: "q [rad]",
+            lines: vec![
+                line("q".into(), &s.q[i], 0, false),
+                line("q_d".into(), &s.q_d[i], 1, true),
+                Line {
+                    label: "q_d ± k_c".into(),
+                    y: &upper[i],
+                    color: red,
+                    dashed: true,
+                },
+                Line {
+                    label: String::new(),
+                    y: &lower[i],
+                    color: red,
+                    dashed: true,
+                },
+            ],
+        })
+        .collect();
+    save(
+        dir,
+        "fig1_positions",
+        "Joint positions with q_d ± k_c",
+        &s.t,
+        &positions,
+        Some(tc),
+    )?;
+
+    let velocities: Vec<Panel<'_>> = (0..n)
+        .map(|i| Panel {
+            title: format!("{}: velocity", names[i]),
+            y_label: "q̇ [rad/s]",
+            lines: vec![
+                line("q̇".into(), &s.qd[i], 0, false),
+                line("q̇_d".into(), &s.qd_d[i], 1, true),
+            ],
+        })
+        .collect();
+    save(
+        dir,
+        "fig2_velocities",
+        "Joint velocities",
+        &s.t,
+        &velocities,
+        None,
+    )?;
+
+    let neg_kc: Vec<Vec<f64>> =
+        s.kc.iter()
+            .map(|k| k.iter().map(|x| -x).collect())
+            .collect();
+    let errors: Vec<Panel<'_>> = (0..n)
+        .map(|i| Panel {
+            title: format!("{}: tracking error", names[i]),
+            y_label: "Z1 [rad]",
+            lines: vec![
+                line("Z1 = q − q_d".into(), &s.z1[i], 0, false),
+                Line {
+                    label: "± k_c".into(),
+                    y: &s.kc[i],
+                    color: red,
+                    dashed: true,
+                },
+                Line {
+                    label: String::new(),
+                    y: &neg_kc[i],
+                    color: red,
+                    dashed: true,
+                },
+            ],
+        })
+        .collect();
+    save(
+        dir,
+        "fig3_errors",
+        "Tracking errors with ± k_c",
+        &s.t,
+        &errors,
+        Some(tc),
+    )?;
+
+    let weights = vec![Panel {
+        title: "actor weight norms".into(),
+        y_label: "‖Ŵa‖",
+        lines: (0..n)
+            .map(|i| line(names[i].clone(), &s.wa[i], i, false))
+            .collect(),
+    }];
+    save(
+        dir,
+        "fig4_actor_weights",
+        "Norms of the actor weights per joint",
+        &s.t,
+        &weights,
+        None,
+    )?;
+
+    let torques = vec![Panel {
+        title: "torques".into(),
+        y_label: "τ [N m]",
+        lines: (0..n)
+            .map(|i| line(names[i].clone(), &s.tau[i], i, false))
+            .collect(),
+    }];
+    save(dir, "fig5_torques", "Input torques", &s.t, &torques, None)?;
+
+    timing_figure(dir, s)?;
+    Ok(6)
+}
+
+/// Histograms of period jitter and round trip.
+fn timing_figure(dir: &Path, s: &Series) -> Result<(), String> {
+    let png = dir.join("fig6_timing.png");
+    draw_timing(
+        &BitMapBackend::new(&png, (1000, 640)).into_drawing_area(),
+        s,
+    )
+    .map_err(|e| format!("{}: {e}", png.display()))?;
+    let svg = dir.join("fig6_timing.svg");
+    draw_timing(&SVGBackend::new(&svg, (1000, 640)).into_drawing_area(), s)
+        .map_err(|e| format!("{}: {e}", svg.display()))
+}
+
+fn draw_timing<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    s: &Series,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(err)?;
+    let root = root.titled("Timing", (FAMILY, 22)).map_err(err)?;
+    let areas = root.split_evenly((2, 1));
+    for (area, (title, data)) in areas.iter().zip([
+        ("period jitter |actual − nominal period| [µs]", &s.jitter_us),
+        ("round trip state → command [µs]", &s.round_trip_us),
+    ]) {
+        histogram(area, title, data)?;
+    }
+    root.present().map_err(err)
+}
+
+fn histogram<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    data: &[f64],
+) -> Result<(), String> {
+    const BINS: usize = 60;
+    let mut sorted: Vec<f64> = data.iter().copied().filter(|x| x.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    // Up to the 99th percentile (the last bin holds the rest): the far
+    // tail would squash everything else into one bar.
+    let hi = sorted
+        .get(((sorted.len() as f64) * 0.99) as usize)
+        .or(sorted.last())
+        .copied()
+        .unwrap_or(1.0)
+        .max(1e-3);
+    let width = hi / BINS as f64;
+    let mut counts = [0u64; BINS];
+    for x in &sorted {
+        counts[((x / width) as usize).min(BINS - 1)] += 1;
+    }
+    let top = counts.iter().copied().max().unwrap_or(1).max(1);
+    let mut chart = ChartBuilder::on(area)
+        .caption(format!("{title} ({} samples)", sorted.len()), (FAMILY, 16))
+        .margin(8)
+        .x_label_area_size(32)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..hi, 0u64..top + top / 10 + 1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("µs")
+        .y_desc("cycles")
+        .label_style((FAMILY, 12))
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(counts.iter().enumerate().map(|(i, c)| {
+            let x0 = i as f64 * width;
+            Rectangle::new([(x0, 0), (x0 + width, *c)], COLORS[0].filled())
+        }))
+        .map_err(err)?;
+    Ok(())
+}

@@ -1,0 +1,243 @@
+//! The run log (MCAP) and `testbed replay`.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use crate::util::{fails, json, ok, testbed};
+
+/// Runs a lockstep run of `duration` seconds; returns its JSON and log path.
+fn lockstep_run(dir: &Path, duration: &str) -> (serde_json::Value, PathBuf) {
+    let out = ok(testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--duration",
+            duration,
+            "--json",
+            "--runs-dir",
+        ])
+        .arg(dir));
+    let s = json(&out);
+    let log = PathBuf::from(s["log"].as_str().expect("run JSON has log"));
+    (s, log)
+}
+
+/// The log, read with the official MCAP library: header, footer, summary
+/// with statistics; every message valid against its channel's JSON schema;
+/// one message per step on each step topic.
+#[test]
+fn log_is_complete_mcap_with_valid_json_messages() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run, log) = lockstep_run(dir.path(), "0.5");
+    let buf = std::fs::read(&log).unwrap();
+    assert!(buf.starts_with(mcap::MAGIC) && buf.ends_with(mcap::MAGIC));
+    mcap::read::footer(&buf).unwrap();
+    let summary = mcap::Summary::read(&buf).unwrap().expect("summary section");
+    let stats = summary.stats.as_ref().expect("statistics");
+    let mut counts: BTreeMap<String, u64> = BTreeMap::new();
+    for (id, ch) in &summary.channels {
+        let n = stats.channel_message_counts.get(id).copied().unwrap_or(0);
+        counts.insert(ch.topic.clone(), n);
+        let schema = ch.schema.as_ref().expect("every channel has a schema");
+        assert_eq!(schema.encoding, "jsonschema");
+        assert_eq!(ch.message_encoding, "json");
+    }
+    let steps = run["steps"].as_u64().unwrap();
+    assert_eq!(steps, 500);
+    assert_eq!(counts["/joint_state"], steps + 1, "{counts:?}"); // states 0..=steps
+    assert_eq!(counts["/command"], steps, "{counts:?}");
+    assert_eq!(counts["/controller/diagnostics"], steps, "{counts:?}");
+    assert_eq!(counts["/timing"], steps, "{counts:?}");
+    assert_eq!(counts["/reference"], steps + 1, "{counts:?}");
+
+    let mut validators = BTreeMap::new();
+    for ch in summary.channels.values() {
+        let schema: serde_json::Value =
+            serde_json::from_slice(&ch.schema.as_ref().unwrap().data).unwrap();
+        validators.insert(
+            ch.topic.clone(),
+            jsonschema::validator_for(&schema).unwrap(),
+        );
+    }
+    let mut seen = 0;
+    for msg in mcap::MessageStream::new(&buf).unwrap() {
+        let msg = msg.unwrap();
+        let value: serde_json::Value = serde_json::from_slice(&msg.data).unwrap();
+        let v = &validators[&msg.channel.topic];
+        if let Err(e) = v.validate(&value) {
+            panic!(
+                "{} message {} does not match its schema: {e}",
+                msg.channel.topic, msg.sequence
+            );
+        }
+        // log_time is sim time, publish_time the sample's wall timestamp.
+        assert_eq!(msg.log_time, value["t_ns"].as_u64().unwrap());
+        assert_eq!(msg.publish_time, value["wall_ns"].as_u64().unwrap());
+        seen += 1;
+    }
+    assert_eq!(seen, counts.values().sum::<u64>());
+    // Metadata and attachment.
+    let meta: Vec<_> = summary
+        .metadata_indexes
+        .iter()
+        .map(|m| m.name.clone())
+        .collect();
+    assert!(
+        meta.contains(&"testbed.run".to_string())
+            && meta.contains(&"testbed.log_stats".to_string())
+    );
+    let run_meta = summary
+        .metadata_indexes
+        .iter()
+        .find(|m| m.name == "testbed.run")
+        .map(|idx| mcap::read::metadata(&buf, idx).unwrap())
+        .unwrap();
+    for k in [
+        "scenario_toml",
+        "run_id",
+        "mode",
+        "rate_hz",
+        "software",
+        "start_time_unix_ns",
+    ] {
+        assert!(run_meta.metadata.contains_key(k), "testbed.run lacks {k}");
+    }
+    assert_eq!(run_meta.metadata["mode"], "lockstep");
+    assert!(run_meta.metadata["scenario_toml"].contains("[controller]"));
+    let urdf = summary
+        .attachment_indexes
+        .iter()
+        .find(|a| a.name == "robot.urdf")
+        .expect("URDF attached");
+    let att = mcap::read::attachment(&buf, urdf).unwrap();
+    assert!(String::from_utf8_lossy(&att.data).contains("<robot name=\"two_link\">"));
+}
+
+/// One analysis path: replaying the log prints what the run printed.
+#[test]
+fn replay_summary_equals_the_run_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut run, log) = lockstep_run(dir.path(), "2.5");
+    let mut replay = json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
+    run.as_object_mut().unwrap().remove("run_dir");
+    assert_eq!(replay.as_object_mut().unwrap().remove("warning"), None);
+    assert_eq!(run, replay);
+    assert_eq!(run["timing"]["cycles"], 2500);
+}
+
+/// Re-driving the controller from a lockstep log gives the logged torques exactly.
+#[test]
+fn verify_is_exact_on_a_lockstep_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, log) = lockstep_run(dir.path(), "2.5");
+    let s = json(&ok(testbed()
+        .arg("replay")
+        .arg(&log)
+        .args(["--verify", "--json"])));
+    assert_eq!(s["max_abs_torque_diff"], 0.0);
+    assert_eq!(s["verified_steps"], 2500);
+}
+
+/// The replay CSV is the sim CSV, and the figures are written.
+#[test]
+fn replay_writes_csv_and_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, log) = lockstep_run(dir.path(), "1");
+    let (csv, sim_csv, plots) = (
+        dir.path().join("r.csv"),
+        dir.path().join("s.csv"),
+        dir.path().join("plots"),
+    );
+    ok(testbed()
+        .arg("replay")
+        .arg(&log)
+        .arg("--csv")
+        .arg(&csv)
+        .arg("--plots")
+        .arg(&plots));
+    ok(testbed()
+        .args(["sim", "--duration", "1", "--csv"])
+        .arg(&sim_csv));
+    assert!(std::fs::read(&csv).unwrap() == std::fs::read(&sim_csv).unwrap());
+    for fig in [
+        "fig1_positions",
+        "fig2_velocities",
+        "fig3_errors",
+        "fig4_actor_weights",
+        "fig5_torques",
+        "fig6_timing",
+    ] {
+        for ext in ["png", "svg"] {
+            let f = plots.join(format!("{fig}.{ext}"));
+            let len = std::fs::metadata(&f).map(|m| m.len()).unwrap_or(0);
+            assert!(len > 5_000, "{} missing or empty", f.display());
+        }
+        assert!(
+            std::fs::read(plots.join(format!("{fig}.png")))
+                .unwrap()
+                .starts_with(b"\x89PNG")
+        );
+    }
+}
+
+/// A log cut anywhere is read as far as it goes, with a warning saying how much.
+#[test]
+fn truncated_logs_are_analysed_as_far_as_they_go() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, log) = lockstep_run(dir.path(), "3");
+    let full = std::fs::read(&log).unwrap();
+    let mut last_steps = 0;
+    for frac in [0.2, 0.45, 0.7, 0.9] {
+        let cut = dir.path().join(format!("cut-{frac}.mcap"));
+        std::fs::write(&cut, &full[..(full.len() as f64 * frac) as usize]).unwrap();
+        let out = ok(testbed().arg("replay").arg(&cut).arg("--json"));
+        let s = json(&out);
+        let steps = s["steps"].as_u64().unwrap();
+        assert!(steps > last_steps && steps < 3000, "{frac}: {steps} steps");
+        last_steps = steps;
+        let warning = s["warning"].as_str().unwrap();
+        assert!(
+            warning.contains(&format!("recovered {steps} of 3000 steps")),
+            "{warning}"
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("warning"), "{err}");
+    }
+    // Cut in the summary section: every step is there, but the file is
+    // still reported as unfinished.
+    let cut = dir.path().join("cut-summary.mcap");
+    std::fs::write(&cut, &full[..full.len() - 40]).unwrap();
+    let s = json(&ok(testbed().arg("replay").arg(&cut).arg("--json")));
+    assert_eq!(s["steps"], 3000);
+    assert!(
+        s["warning"]
+            .as_str()
+            .unwrap()
+            .contains("recovered 3000 of 3000 steps"),
+        "{s}"
+    );
+}
+
+#[test]
+fn replay_of_a_non_log_fails_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let junk = dir.path().join("junk.mcap");
+    std::fs::write(&junk, "hello").unwrap();
+    let err = fails(testbed().arg("replay").arg(&junk));
+    assert!(
+        err.contains("junk.mcap") && err.contains("not an MCAP file"),
+        "{err}"
+    );
+    let err = fails(testbed().args(["replay", "nope.mcap"]));
+    assert!(err.contains("nope.mcap"), "{err}");
+    // Cut inside the first bytes: not even the metadata is there.
+    let (_, log) = lockstep_run(dir.path(), "0.2");
+    let head = dir.path().join("head.mcap");
+    std::fs::write(&head, &std::fs::read(&log).unwrap()[..20]).unwrap();
+    let err = fails(testbed().arg("replay").arg(&head));
+    assert!(
+        err.contains("head.mcap") && err.contains("testbed.run"),
+        "{err}"
+    );
+}
