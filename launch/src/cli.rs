@@ -33,6 +33,13 @@ enum Command {
     Sim(SimArgs),
     /// Run the stack as separate processes over iceoryx2 shared memory.
     Run(RunArgs),
+    /// Describe an arm: joints in order, limits, masses, and the default
+    /// scenario `--robot` would run on it; or why it cannot be used.
+    Robot {
+        /// The URDF file.
+        #[arg(value_name = "URDF")]
+        path: PathBuf,
+    },
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
     Replay(ReplayArgs),
     /// Run one node of a stack (the launcher starts these; start one by hand
@@ -70,6 +77,10 @@ struct ScenarioArgs {
     /// Scenario file (TOML) [default: the built-in paper scenario, scenarios/paper.toml].
     #[arg(long, value_name = "FILE")]
     scenario: Option<PathBuf>,
+    /// Run this arm (URDF) instead of the scenario's; with no --scenario,
+    /// the default scenario for the arm (see `testbed robot`).
+    #[arg(long, value_name = "URDF")]
+    robot: Option<PathBuf>,
     /// Run for this many seconds instead of the scenario's duration_s.
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
@@ -135,6 +146,10 @@ pub fn run() -> Result<ExitCode> {
         Command::Sim(args) => sim(args),
         Command::Run(args) => run_stack(args),
         Command::Replay(args) => replay(args),
+        Command::Robot { path } => {
+            print!("{}", crate::robot_info::describe(&path)?);
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Node { name, args } => {
             node::run(name.kind(), &args)
                 .with_context(|| format!("{} node", name.kind().name()))?;
@@ -147,6 +162,7 @@ fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario::Plan> {
     let overrides = Overrides {
         duration_s: common.duration,
         rate_hz: rate,
+        robot: common.robot.clone(),
     };
     Ok(scenario::load(common.scenario.as_deref(), &overrides)?)
 }

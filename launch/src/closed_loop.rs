@@ -80,7 +80,7 @@ pub fn run(
             q: &q,
             qd: &qd,
             qdd: &qdd,
-            tau: &diag.tau,
+            tau: plant.applied_torque(),
             q_d: &reference.q_d,
             qd_d: &reference.qd_d,
             kc: &reference.kc,

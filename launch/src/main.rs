@@ -2,6 +2,7 @@
 
 mod cli;
 mod report;
+mod robot_info;
 
 use std::process::ExitCode;
 

@@ -14,6 +14,8 @@ pub struct PlantConfig {
     pub substeps: u32,
     /// Gravity vector in the URDF's world frame (default: [0, 0, -9.81], m/s²).
     pub gravity: [f64; 3],
+    /// Clip each joint's torque to the URDF's effort limit (default: true).
+    pub saturate: bool,
 }
 
 impl Default for PlantConfig {
@@ -21,6 +23,7 @@ impl Default for PlantConfig {
         Self {
             substeps: 8,
             gravity: [0.0, 0.0, -9.81],
+            saturate: true,
         }
     }
 }

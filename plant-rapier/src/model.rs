@@ -98,6 +98,8 @@ pub struct ArmModel {
     /// Indices of the actuated joints, in file order: the joint order used
     /// everywhere in the testbed.
     pub actuated: Vec<usize>,
+    /// Fixed joints folded into their parent link, described for users.
+    pub merged: Vec<String>,
 }
 
 impl ArmModel {
@@ -146,6 +148,21 @@ impl ArmModel {
             joints.push(info);
         }
 
+        let model = Self::assemble(robot.name.clone(), links, joints, Vec::new())?;
+        model.merge_fixed_joints()
+    }
+
+    /// Finds the root, orders the joints from it, and lists the actuated ones.
+    fn assemble(
+        name: String,
+        links: Vec<LinkInfo>,
+        joints: Vec<JointInfo>,
+        merged: Vec<String>,
+    ) -> Result<Self, PlantError> {
+        let mut parent_of: Vec<Option<usize>> = vec![None; links.len()];
+        for (ji, j) in joints.iter().enumerate() {
+            parent_of[j.child] = Some(ji);
+        }
         let roots: Vec<usize> = (0..links.len())
             .filter(|&i| parent_of[i].is_none())
             .collect();
@@ -191,13 +208,72 @@ impl ArmModel {
             return Err(PlantError::NoActuatedJoints);
         }
         Ok(Self {
-            name: robot.name.clone(),
+            name,
             links,
             joints,
             root,
             topological,
             actuated,
+            merged,
         })
+    }
+
+    /// Folds every fixed joint into its parent: the child's mass joins the
+    /// parent link's, and the child's own joints hang from the parent. The
+    /// plant then simulates only bodies that move independently.
+    fn merge_fixed_joints(mut self) -> Result<Self, PlantError> {
+        while let Some(ji) = self.joints.iter().position(|j| j.kind == JointKind::Fixed) {
+            let j = self.joints.remove(ji);
+            let (parent, child) = (j.parent, j.child);
+            let t = iso(&j.origin);
+            let child_link = self.links[child].clone();
+            merge_mass(&mut self.links[parent], &child_link, &t);
+            for k in &mut self.joints {
+                if k.parent == child {
+                    k.parent = parent;
+                    k.origin = origin_of(&(t * iso(&k.origin)));
+                }
+            }
+            self.merged.push(format!(
+                "{} ({} into {})",
+                j.name, child_link.name, self.links[parent].name
+            ));
+            // Drop the child link and renumber.
+            self.links.remove(child);
+            for k in &mut self.joints {
+                if k.parent > child {
+                    k.parent -= 1;
+                }
+                if k.child > child {
+                    k.child -= 1;
+                }
+            }
+        }
+        let model = Self::assemble(self.name, self.links, self.joints, self.merged)?;
+        // A joint must move some mass, or its acceleration is undefined.
+        for &ji in &model.actuated {
+            let j = &model.joints[ji];
+            if model.subtree_mass(j.child) <= 0.0 {
+                return Err(PlantError::BadInertia {
+                    link: model.links[j.child].name.clone(),
+                    reason: format!(
+                        "joint '{}' moves this link, but it and everything it carries have no mass",
+                        j.name
+                    ),
+                });
+            }
+        }
+        Ok(model)
+    }
+
+    fn subtree_mass(&self, link: usize) -> f64 {
+        self.links[link].mass
+            + self
+                .joints
+                .iter()
+                .filter(|j| j.parent == link)
+                .map(|j| self.subtree_mass(j.child))
+                .sum::<f64>()
     }
 
     /// Number of actuated joints.
@@ -222,6 +298,66 @@ impl ArmModel {
             .map(|(_, l)| l.mass)
             .sum()
     }
+}
+
+fn iso(o: &Origin) -> nalgebra::Isometry3<f64> {
+    nalgebra::Isometry3::from_parts(
+        nalgebra::Translation3::new(o.xyz[0], o.xyz[1], o.xyz[2]),
+        nalgebra::UnitQuaternion::from_euler_angles(o.rpy[0], o.rpy[1], o.rpy[2]),
+    )
+}
+
+fn origin_of(t: &nalgebra::Isometry3<f64>) -> Origin {
+    let (r, p, y) = t.rotation.euler_angles();
+    let v = t.translation.vector;
+    Origin {
+        xyz: [v.x, v.y, v.z],
+        rpy: [r, p, y],
+    }
+}
+
+/// The tensor about the COM in link axes, and the COM, of a link.
+fn link_inertia(l: &LinkInfo) -> (nalgebra::Matrix3<f64>, nalgebra::Vector3<f64>) {
+    let [ixx, ixy, ixz, iyy, iyz, izz] = l.inertia;
+    let i = nalgebra::Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
+    let t = iso(&l.inertial_origin);
+    let r = t.rotation.to_rotation_matrix();
+    (
+        r.matrix() * i * r.matrix().transpose(),
+        t.translation.vector,
+    )
+}
+
+/// Adds `child`, placed at `t` in `parent`'s frame, to `parent`'s mass properties.
+fn merge_mass(parent: &mut LinkInfo, child: &LinkInfo, t: &nalgebra::Isometry3<f64>) {
+    let m = parent.mass + child.mass;
+    if child.mass == 0.0 || m == 0.0 {
+        return;
+    }
+    let (ip, cp) = link_inertia(parent);
+    let (ic, cc) = link_inertia(child);
+    let r = t.rotation.to_rotation_matrix();
+    let ic = r.matrix() * ic * r.matrix().transpose();
+    let cc = t * nalgebra::Point3::from(cc);
+    let c = (parent.mass * cp + child.mass * cc.coords) / m;
+    // Parallel-axis theorem for each part about the combined COM.
+    let shift = |mass: f64, d: nalgebra::Vector3<f64>| {
+        mass * (d.dot(&d) * nalgebra::Matrix3::identity() - d * d.transpose())
+    };
+    let i = ip + shift(parent.mass, cp - c) + ic + shift(child.mass, cc.coords - c);
+    parent.mass = m;
+    parent.inertial_origin = Origin {
+        xyz: [c.x, c.y, c.z],
+        rpy: [0.0; 3],
+    };
+    parent.inertia = [
+        i[(0, 0)],
+        i[(0, 1)],
+        i[(0, 2)],
+        i[(1, 1)],
+        i[(1, 2)],
+        i[(2, 2)],
+    ];
 }
 
 fn finite(field: String, v: f64) -> Result<f64, PlantError> {
@@ -410,6 +546,41 @@ mod tests {
         assert!((m.moving_mass() - 2.85).abs() < 1e-12);
         assert_eq!(m.joints[0].axis, [0.0, -1.0, 0.0]);
         assert_eq!(m.joints[1].origin.xyz, [0.35, 0.0, 0.0]);
+    }
+
+    /// The 0.2 kg tool on a fixed joint 0.2 m along link3 (0.5 kg, COM at
+    /// 0.1 m, I = 0.5·0.2²/12 about it) folds into link3 by the parallel-axis theorem.
+    #[test]
+    fn fixed_joint_mass_merges_into_the_parent() {
+        let m =
+            ArmModel::from_urdf_str(include_str!("../../robots/three_link_planar.urdf")).unwrap();
+        assert_eq!(m.dof(), 3);
+        assert!(m.links.iter().all(|l| l.name != "tool"));
+        let l3 = m.links.iter().find(|l| l.name == "link3").unwrap();
+        let c = (0.5 * 0.1 + 0.2 * 0.2) / 0.7;
+        assert!((l3.mass - 0.7).abs() < 1e-12);
+        assert!((l3.inertial_origin.xyz[0] - c).abs() < 1e-12);
+        let i_rod = 0.00166667; // 0.5·0.2²/12 as the URDF writes it
+        let iyy = i_rod + 0.5 * (0.1 - c) * (0.1 - c) + 0.0001 + 0.2 * (0.2 - c) * (0.2 - c);
+        assert!(
+            (l3.inertia[3] - iyy).abs() < 1e-9,
+            "{} vs {iyy}",
+            l3.inertia[3]
+        );
+        assert_eq!(m.merged, ["tool_mount (tool into link3)"]);
+    }
+
+    #[test]
+    fn a_joint_that_moves_no_mass_is_refused() {
+        let j2 = J1
+            .replace("j1", "j2")
+            .replace("base", "a")
+            .replace("<child link=\"a\"/>", "<child link=\"b\"/>");
+        let e = err(&arm(&format!("{J1}{j2}"), "<link name=\"b\"/>"));
+        assert!(
+            e.contains("joint 'j2' moves this link") && e.contains("no mass"),
+            "{e}"
+        );
     }
 
     #[test]

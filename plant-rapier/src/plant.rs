@@ -28,6 +28,10 @@ pub struct Plant {
     names: Vec<String>,
     substeps: u32,
     bodies: Vec<RigidBodyHandle>,
+    /// Effort limit per joint (infinite when none or saturation is off).
+    effort: Vec<f64>,
+    /// The torque applied over the last step, after saturation.
+    applied: Vec<f64>,
 }
 
 impl std::fmt::Debug for Plant {
@@ -177,13 +181,23 @@ impl Plant {
                 dofs.len()
             )));
         }
+        let effort = model
+            .actuated
+            .iter()
+            .map(|&ji| match model.joints[ji].effort {
+                Some(e) if config.saturate => e,
+                _ => f64::INFINITY,
+            })
+            .collect();
         Ok(Self {
             world,
             multibody,
             names: model.joint_names(),
+            applied: vec![0.0; dofs.len()],
             dofs,
             substeps: config.substeps,
             bodies: handles,
+            effort,
         })
     }
 
@@ -266,12 +280,28 @@ impl Plant {
                 value: dt,
             });
         }
+        for ((a, t), e) in self.applied.iter_mut().zip(tau).zip(&self.effort) {
+            *a = t.clamp(-e, *e);
+        }
         self.world.integration_parameters.dt = dt / f64::from(self.substeps);
         for _ in 0..self.substeps {
-            self.apply_torques(tau);
+            let applied = std::mem::take(&mut self.applied);
+            self.apply_torques(&applied);
+            self.applied = applied;
             self.world.step();
         }
         Ok(())
+    }
+
+    /// The torque applied over the last step: the command clipped to the
+    /// effort limits.
+    pub fn applied_torque(&self) -> &[f64] {
+        &self.applied
+    }
+
+    /// Effort limit per joint (infinite where there is none or saturation is off).
+    pub fn effort_limits(&self) -> &[f64] {
+        &self.effort
     }
 
     /// Rapier has no generalized-force input for multibody joints: a joint

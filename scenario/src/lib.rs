@@ -13,12 +13,16 @@
 //! assert_eq!(s.duration_s, 20.0); // the paper's default
 //! ```
 
+mod default_for_arm;
+
 use std::path::{Path, PathBuf};
 
 use controller::{ControllerError, ControllerParams};
 use plant_rapier::{ArmModel, PlantConfig, PlantError};
 use serde::{Deserialize, Serialize};
 use trajectory::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError};
+
+pub use default_for_arm::max_inverse_inertia;
 
 /// The paper's scenario as shipped in `scenarios/paper.toml`.
 pub const PAPER_TOML: &str = include_str!("../../scenarios/paper.toml");
@@ -334,6 +338,9 @@ pub struct Overrides {
     pub duration_s: Option<f64>,
     /// Replaces `rate_hz`.
     pub rate_hz: Option<f64>,
+    /// Replaces the robot; with no scenario file, the default scenario for
+    /// that arm is used.
+    pub robot: Option<PathBuf>,
 }
 
 /// Loads a scenario file (or the built-in paper scenario when `path` is
@@ -354,7 +361,25 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
             None,
         ),
     };
-    let mut scenario = Scenario::from_toml_str(&toml_text, &source)?;
+    let arm = match &overrides.robot {
+        Some(path) => Some(RobotSource::from_file(path)?),
+        None => None,
+    };
+    let (mut scenario, toml_text, source) = match (&arm, path) {
+        (Some(arm), None) => {
+            let s = Scenario::for_arm(&arm.model).map_err(|cause| ScenarioError::Plant {
+                file: arm.label(),
+                cause,
+            })?;
+            let text = toml::to_string(&s).unwrap_or_default();
+            (s, text, format!("default scenario for {}", arm.label()))
+        }
+        _ => (
+            Scenario::from_toml_str(&toml_text, &source)?,
+            toml_text,
+            source,
+        ),
+    };
     if let Some(d) = overrides.duration_s {
         scenario.duration_s = d;
         scenario.validate(&format!("{source} with --duration {d}"))?;
@@ -363,10 +388,13 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
         scenario.rate_hz = r;
         scenario.validate(&format!("{source} with --rate {r}"))?;
     }
-    let robot = match (&scenario.robot, &base) {
-        (Some(rel), Some(base)) => RobotSource::from_file(&base.join(rel)),
-        (Some(rel), None) => RobotSource::from_file(Path::new(rel)),
-        (None, _) => Ok(RobotSource::builtin()),
+    let robot = match (arm, &scenario.robot, &base) {
+        (Some(arm), _, _) => Ok(arm),
+        (None, rel, base) => match (rel, base) {
+            (Some(rel), Some(base)) => RobotSource::from_file(&base.join(rel)),
+            (Some(rel), None) => RobotSource::from_file(Path::new(rel)),
+            (None, _) => Ok(RobotSource::builtin()),
+        },
     }
     .map_err(|cause| ScenarioError::Robot {
         file: source.clone(),

@@ -48,10 +48,11 @@ impl Stepper {
             flags: if k == self.steps { STATE_FINAL } else { 0 },
             q: joints(&self.q),
             qd: joints(&self.qd),
+            // What the plant really applied: the command after saturation.
             tau_applied: if k == 0 {
                 [0.0; MAX_DOF]
             } else {
-                joints(&self.tau)
+                joints(self.plant.applied_torque())
             },
             deadline_misses: self.misses,
         }
@@ -66,6 +67,12 @@ impl Stepper {
             )));
         }
         self.tau.copy_from_slice(&cmd.tau[..self.n]);
+        Ok(())
+    }
+
+    /// Steps the arm over one period with the held command.
+    fn step(&mut self) -> Result<(), NodeError> {
+        self.plant.step(&self.tau, self.dt)?;
         Ok(())
     }
 }
@@ -111,7 +118,7 @@ fn lockstep(ctx: &mut NodeContext, ports: &Ports, st: &mut Stepper) -> Result<()
     for k in 0..st.steps {
         let cmd = wait_for_command(ctx, &ports.command, k)?;
         st.take(&cmd)?;
-        st.plant.step(&st.tau, st.dt)?;
+        st.step()?;
         ports.timing.send(Timing {
             header: Header {
                 seq: k,
@@ -186,7 +193,7 @@ fn realtime(
         if let Some(c) = latest {
             st.take(&c)?;
         }
-        st.plant.step(&st.tau, st.dt)?;
+        st.step()?;
         ports.timing.send(Timing {
             header: Header {
                 seq: k - 1,

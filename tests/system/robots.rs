@@ -1,0 +1,226 @@
+//! Any URDF arm: the shipped arms end to end, and URDFs that cannot be used.
+
+use crate::util::{fails, json, ok, testbed};
+
+const ARMS: [&str; 3] = [
+    "robots/two_link.urdf",
+    "robots/three_link_planar.urdf",
+    "robots/ur5.urdf",
+];
+
+/// Each shipped arm runs its default scenario to the end, in process and in
+/// lockstep, with the same bits, finite signals and the envelope respected
+/// after T_c.
+#[test]
+fn every_shipped_arm_runs_its_default_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    for arm in ARMS {
+        let (a, b) = (dir.path().join("sim.csv"), dir.path().join("lockstep.csv"));
+        let sim = json(&ok(testbed()
+            .args(["sim", "--json", "--robot", arm, "--csv"])
+            .arg(&a)));
+        let run = json(&ok(testbed()
+            .args([
+                "run",
+                "--mode",
+                "lockstep",
+                "--json",
+                "--robot",
+                arm,
+                "--runs-dir",
+            ])
+            .arg(dir.path())
+            .arg("--csv")
+            .arg(&b)));
+        for s in [&sim, &run] {
+            assert_eq!(s["finite"], true, "{arm}: {s}");
+            assert_eq!(s["constraint_satisfied_after_tc"], true, "{arm}: {s}");
+            assert!(
+                (s["duration_s"].as_f64().unwrap() - 10.0).abs() < 1e-3,
+                "{arm}: {s}"
+            );
+        }
+        assert!(
+            std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+            "{arm}: lockstep differs from sim"
+        );
+    }
+}
+
+#[test]
+fn robot_command_reports_joint_order_and_masses() {
+    let out = ok(testbed().args(["robot", "robots/ur5.urdf"]));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("6 actuated joints"), "{text}");
+    let order: Vec<usize> = [
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_1_joint",
+        "wrist_2_joint",
+        "wrist_3_joint",
+    ]
+    .iter()
+    .map(|j| text.find(j).unwrap())
+    .collect();
+    assert!(
+        order.windows(2).all(|w| w[0] < w[1]),
+        "joints not in file order: {text}"
+    );
+    assert!(text.contains("merged fixed joint ee_fixed_joint"), "{text}");
+    assert!(text.contains("moving mass 16.9939 kg"), "{text}");
+}
+
+/// URDFs a user may bring that the plant cannot simulate: each is a clear
+/// error naming the file and what is wrong, with a non-zero exit, never a panic.
+#[test]
+fn malformed_and_unsupported_urdfs_are_clear_errors() {
+    let link = |name: &str, mass: &str, inertia: &str| {
+        format!(
+            r#"<link name="{name}"><inertial><mass value="{mass}"/><inertia {inertia}/></inertial></link>"#
+        )
+    };
+    let good_i = r#"ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1""#;
+    let joint = |name: &str, kind: &str, parent: &str, child: &str, extra: &str| {
+        format!(
+            r#"<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/>{extra}</joint>"#
+        )
+    };
+    let robot = |body: String| format!(r#"<robot name="r"><link name="base"/>{body}</robot>"#);
+    let a = link("a", "1", good_i);
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("not_xml", "this is not xml".into(), "not a valid URDF"),
+        ("empty", String::new(), "not a valid URDF"),
+        (
+            "missing_parent",
+            robot(format!("{a}{}", joint("j", "revolute", "ghost", "a", ""))),
+            "parent link 'ghost' does not exist",
+        ),
+        (
+            "cycle",
+            robot(format!(
+                "{a}{}{}",
+                joint("j1", "revolute", "base", "a", ""),
+                joint("j2", "revolute", "a", "base", "")
+            )),
+            "loop",
+        ),
+        (
+            "not_positive_definite",
+            robot(format!(
+                "{}{}",
+                link(
+                    "a",
+                    "1",
+                    r#"ixx="0.1" ixy="0.2" ixz="0" iyy="0.1" iyz="0" izz="0.1""#
+                ),
+                joint("j", "revolute", "base", "a", "")
+            )),
+            "link 'a': the inertia tensor is not positive definite",
+        ),
+        (
+            "triangle",
+            robot(format!(
+                "{}{}",
+                link(
+                    "a",
+                    "1",
+                    r#"ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.5""#
+                ),
+                joint("j", "revolute", "base", "a", "")
+            )),
+            "triangle inequality",
+        ),
+        (
+            "negative_mass",
+            robot(format!(
+                "{}{}",
+                link("a", "-2", good_i),
+                joint("j", "revolute", "base", "a", "")
+            )),
+            "link 'a': mass -2 is negative",
+        ),
+        (
+            "floating",
+            robot(format!("{a}{}", joint("j", "floating", "base", "a", ""))),
+            "joint 'j' is floating",
+        ),
+        (
+            "planar",
+            robot(format!("{a}{}", joint("j", "planar", "base", "a", ""))),
+            "joint 'j' is planar",
+        ),
+        (
+            "mimic",
+            robot(format!(
+                "{a}{}",
+                joint("j", "revolute", "base", "a", r#"<mimic joint="k"/>"#)
+            )),
+            "<mimic>",
+        ),
+        (
+            "bad_number",
+            robot(format!(
+                "{}{}",
+                link("a", "abc", good_i),
+                joint("j", "revolute", "base", "a", "")
+            )),
+            "not a valid URDF",
+        ),
+        (
+            "nan_axis",
+            robot(format!(
+                "{a}{}",
+                joint("j", "revolute", "base", "a", "").replace("0 0 1", "0 nan 1")
+            )),
+            "joint 'j' axis",
+        ),
+        (
+            "limits_reversed",
+            robot(format!(
+                "{a}{}",
+                joint("j", "revolute", "base", "a", "")
+                    .replace(r#"lower="-1" upper="1""#, r#"lower="1" upper="-1""#)
+            )),
+            "limit lower 1 is above upper -1",
+        ),
+        (
+            "duplicate_link",
+            robot(format!("{a}{a}{}", joint("j", "revolute", "base", "a", ""))),
+            "two links are named 'a'",
+        ),
+        (
+            "no_actuated_joint",
+            robot(format!("{a}{}", joint("j", "fixed", "base", "a", ""))),
+            "no actuated",
+        ),
+        (
+            "massless_moving_link",
+            robot(format!(
+                "<link name=\"a\"/>{}",
+                joint("j", "revolute", "base", "a", "")
+            )),
+            "no mass",
+        ),
+        ("two_roots", robot(a.clone()), "several root links"),
+    ];
+    assert!(cases.len() >= 10);
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text, needle) in &cases {
+        let path = dir.path().join(format!("{name}.urdf"));
+        std::fs::write(&path, text).unwrap();
+        for cmd in [vec!["robot"], vec!["sim", "--duration", "0.1", "--robot"]] {
+            let err = fails(testbed().args(&cmd).arg(&path));
+            assert!(
+                err.contains(needle),
+                "{name} ({cmd:?}): expected '{needle}' in: {err}"
+            );
+            assert!(
+                err.contains(&format!("{name}.urdf")),
+                "{name}: error does not name the file: {err}"
+            );
+        }
+    }
+    let err = fails(testbed().args(["robot", "no/such.urdf"]));
+    assert!(err.contains("no/such.urdf"), "{err}");
+}
