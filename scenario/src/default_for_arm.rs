@@ -98,7 +98,10 @@ impl Scenario {
             name: format!("default for {}", model.name),
             duration_s: 10.0,
             reference: ReferenceConfig { joints: reference },
-            envelope: EnvelopeConfig { joints: envelope },
+            envelope: EnvelopeConfig {
+                joints: envelope,
+                from_limits: false,
+            },
             ..Scenario::default()
         };
         // Start 1.5 envelopes away from the reference: outside the bound,

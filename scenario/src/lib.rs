@@ -321,11 +321,15 @@ impl Scenario {
                 file: file.to_string(),
                 cause,
             })?;
-        Reference::new(&self.reference, &self.envelope).map_err(|cause| {
-            ScenarioError::Trajectory {
-                file: file.to_string(),
-                cause,
-            }
+        // With the envelope from the limits, the robot is needed to check it (see `plan`).
+        let checked = if self.envelope.from_limits {
+            self.reference.validate()
+        } else {
+            Reference::new(&self.reference, &self.envelope).map(|_| ())
+        };
+        checked.map_err(|cause| ScenarioError::Trajectory {
+            file: file.to_string(),
+            cause,
         })?;
         Ok(())
     }
@@ -427,15 +431,25 @@ pub fn plan(
         ("reference.joints", scenario.reference.joints.len()),
         ("envelope.joints", scenario.envelope.joints.len()),
     ] {
-        if len != dof {
+        if len != dof && !(key == "envelope.joints" && scenario.envelope.from_limits) {
             return Err(mismatch(key, len));
         }
     }
-    let reference = Reference::new(&scenario.reference, &scenario.envelope).map_err(|cause| {
-        ScenarioError::Trajectory {
-            file: source.clone(),
-            cause,
-        }
+    let model = &robot.model;
+    let limits: Vec<Option<(f64, f64)>> = model
+        .actuated
+        .iter()
+        .map(|&j| model.joints[j].limits)
+        .collect();
+    let reference = Reference::with_limits(
+        &scenario.reference,
+        &scenario.envelope,
+        &limits,
+        &model.joint_names(),
+    )
+    .map_err(|cause| ScenarioError::Trajectory {
+        file: source.clone(),
+        cause,
     })?;
     let period_ns = (1e9 / scenario.rate_hz).round() as u64;
     let steps = (scenario.duration_s * 1e9 / period_ns as f64).round() as u64;

@@ -224,3 +224,46 @@ fn malformed_and_unsupported_urdfs_are_clear_errors() {
     let err = fails(testbed().args(["robot", "no/such.urdf"]));
     assert!(err.contains("no/such.urdf"), "{err}");
 }
+
+/// The envelope taken from the URDF's joint limits (paper Section III),
+/// in both barrier modes.
+#[test]
+fn envelope_from_joint_limits_is_respected() {
+    let dir = tempfile::tempdir().unwrap();
+    let shipped =
+        std::fs::read_to_string(crate::util::repo_root().join("scenarios/three_link_limits.toml"))
+            .unwrap();
+    let abs_robots = crate::util::repo_root().join("robots");
+    for barrier in ["per-joint", "norm"] {
+        let text = shipped
+            .replace("k2 = 5.0", &format!("k2 = 5.0\nbarrier = \"{barrier}\""))
+            .replace("../robots", abs_robots.to_str().unwrap());
+        let path = dir.path().join(format!("{barrier}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let s = json(&ok(testbed()
+            .args(["sim", "--json", "--scenario"])
+            .arg(&path)));
+        assert_eq!(s["constraint_satisfied_after_tc"], true, "{barrier}: {s}");
+        assert_eq!(s["finite"], true, "{barrier}: {s}");
+    }
+    // A continuous joint has no limits to take an envelope from.
+    let cont = dir.path().join("cont.urdf");
+    std::fs::write(
+        &cont,
+        std::fs::read_to_string(crate::util::repo_root().join("robots/three_link_planar.urdf"))
+            .unwrap()
+            .replacen("type=\"revolute\"", "type=\"continuous\"", 1),
+    )
+    .unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        shipped.replace("../robots/three_link_planar.urdf", cont.to_str().unwrap()),
+    )
+    .unwrap();
+    let err = fails(testbed().args(["sim", "--scenario"]).arg(&bad));
+    assert!(
+        err.contains("bad.toml") && err.contains("joint 'joint1' has no position limits"),
+        "{err}"
+    );
+}

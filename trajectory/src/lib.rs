@@ -48,6 +48,32 @@ pub enum TrajectoryError {
         /// The smallest value it reaches.
         min: f64,
     },
+    /// The envelope is to come from joint limits, but a joint has none.
+    #[error(
+        "envelope.from_limits: joint '{joint}' has no position limits (continuous or unlimited)"
+    )]
+    NoLimits {
+        /// The joint.
+        joint: String,
+    },
+    /// With the envelope from the limits, the reference must stay inside them.
+    #[error(
+        "{field}: with envelope.from_limits the reference must stay inside joint '{joint}' limits [{lo}, {hi}], but it spans [{min}, {max}]"
+    )]
+    OutsideLimits {
+        /// The reference's key.
+        field: String,
+        /// The joint.
+        joint: String,
+        /// Its lower limit.
+        lo: f64,
+        /// Its upper limit.
+        hi: f64,
+        /// The reference's smallest value.
+        min: f64,
+        /// The reference's largest value.
+        max: f64,
+    },
     /// Reference and envelope disagree on the number of joints.
     #[error(
         "reference.joints has {reference} entries but envelope.joints has {envelope}; both need one per joint"
@@ -97,14 +123,21 @@ impl ReferenceConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvelopeConfig {
-    /// k_c,i(t) per joint (rad or m); must stay positive.
+    /// k_c,i(t) per joint (rad or m); must stay positive. Ignored with `from_limits`.
+    #[serde(default)]
     pub joints: Vec<Sinusoid>,
+    /// Take the envelope from the robot's joint limits, as in the paper's
+    /// Section III: k_c,i(t) = min(upper_i − q_d,i(t), q_d,i(t) − lower_i)
+    /// (default: false).
+    #[serde(default)]
+    pub from_limits: bool,
 }
 
 impl EnvelopeConfig {
     /// The paper's envelope: k_c1 = 0.5 + 0.1 sin(0.5t), k_c2 = 0.45 + 0.1 cos(0.5t).
     pub fn paper() -> Self {
         Self {
+            from_limits: false,
             joints: vec![
                 Sinusoid {
                     offset: 0.5,
@@ -154,30 +187,48 @@ impl ReferenceSample {
     }
 }
 
+/// Where k_c comes from.
+#[derive(Debug, Clone)]
+enum Envelope {
+    /// One sinusoid per joint.
+    Sinusoids(Vec<Sinusoid>),
+    /// The distance from q_d to the nearer joint limit.
+    Limits(Vec<(f64, f64)>),
+}
+
 /// A validated reference and envelope.
 #[derive(Debug, Clone)]
 pub struct Reference {
     q_d: Vec<Sinusoid>,
-    kc: Vec<Sinusoid>,
+    kc: Envelope,
+}
+
+impl ReferenceConfig {
+    /// Checks that every number is finite.
+    pub fn validate(&self) -> Result<(), TrajectoryError> {
+        if self.joints.is_empty() {
+            return Err(TrajectoryError::Empty);
+        }
+        for (i, s) in self.joints.iter().enumerate() {
+            s.validate(&format!("reference.joints[{i}]"))?;
+        }
+        Ok(())
+    }
 }
 
 impl Reference {
     /// Validates both configs (finite, same length, envelope > 0 everywhere).
+    /// Without `from_limits` only; see [`Reference::with_limits`].
     pub fn new(
         reference: &ReferenceConfig,
         envelope: &EnvelopeConfig,
     ) -> Result<Self, TrajectoryError> {
-        if reference.joints.is_empty() {
-            return Err(TrajectoryError::Empty);
-        }
+        reference.validate()?;
         if reference.joints.len() != envelope.joints.len() {
             return Err(TrajectoryError::DofMismatch {
                 reference: reference.joints.len(),
                 envelope: envelope.joints.len(),
             });
-        }
-        for (i, s) in reference.joints.iter().enumerate() {
-            s.validate(&format!("reference.joints[{i}]"))?;
         }
         for (i, s) in envelope.joints.iter().enumerate() {
             let field = format!("envelope.joints[{i}]");
@@ -194,7 +245,53 @@ impl Reference {
         }
         Ok(Self {
             q_d: reference.joints.clone(),
-            kc: envelope.joints.clone(),
+            kc: Envelope::Sinusoids(envelope.joints.clone()),
+        })
+    }
+
+    /// Like [`Reference::new`], but with `envelope.from_limits` the envelope
+    /// is taken from `limits` (per joint, named by `names`).
+    pub fn with_limits(
+        reference: &ReferenceConfig,
+        envelope: &EnvelopeConfig,
+        limits: &[Option<(f64, f64)>],
+        names: &[String],
+    ) -> Result<Self, TrajectoryError> {
+        if !envelope.from_limits {
+            return Self::new(reference, envelope);
+        }
+        reference.validate()?;
+        let mut bounds = Vec::with_capacity(limits.len());
+        for (i, (lim, name)) in limits.iter().zip(names).enumerate() {
+            let Some((lo, hi)) = *lim else {
+                return Err(TrajectoryError::NoLimits {
+                    joint: name.clone(),
+                });
+            };
+            if let Some(s) = reference.joints.get(i) {
+                let (min, max) = (s.min_value(), s.max_value());
+                if !(min > lo && max < hi) {
+                    return Err(TrajectoryError::OutsideLimits {
+                        field: format!("reference.joints[{i}]"),
+                        joint: name.clone(),
+                        lo,
+                        hi,
+                        min,
+                        max,
+                    });
+                }
+            }
+            bounds.push((lo, hi));
+        }
+        if reference.joints.len() != bounds.len() {
+            return Err(TrajectoryError::DofMismatch {
+                reference: reference.joints.len(),
+                envelope: bounds.len(),
+            });
+        }
+        Ok(Self {
+            q_d: reference.joints.clone(),
+            kc: Envelope::Limits(bounds),
         })
     }
 
@@ -213,10 +310,27 @@ impl Reference {
             out.qd_d[i] = d1;
             out.qdd_d[i] = d2;
         }
-        for (i, s) in self.kc.iter().enumerate() {
-            let [v, d1, _] = s.eval(t);
-            out.kc[i] = v;
-            out.kc_dot[i] = d1;
+        match &self.kc {
+            Envelope::Sinusoids(kc) => {
+                for (i, s) in kc.iter().enumerate() {
+                    let [v, d1, _] = s.eval(t);
+                    out.kc[i] = v;
+                    out.kc_dot[i] = d1;
+                }
+            }
+            Envelope::Limits(bounds) => {
+                for (i, (lo, hi)) in bounds.iter().enumerate() {
+                    let (up, down) = (hi - out.q_d[i], out.q_d[i] - lo);
+                    // The nearer limit binds; k̇_c follows it.
+                    if up <= down {
+                        out.kc[i] = up;
+                        out.kc_dot[i] = -out.qd_d[i];
+                    } else {
+                        out.kc[i] = down;
+                        out.kc_dot[i] = out.qd_d[i];
+                    }
+                }
+            }
         }
     }
 
@@ -271,6 +385,55 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "reference.joints[0].omega: NaN is not a finite number"
+        );
+    }
+
+    #[test]
+    fn envelope_from_limits_is_the_distance_to_the_nearer_limit() {
+        let env = EnvelopeConfig {
+            joints: vec![],
+            from_limits: true,
+        };
+        let names = ["a".to_string(), "b".to_string()];
+        let r = Reference::with_limits(
+            &ReferenceConfig::paper(),
+            &env,
+            &[Some((-1.5, 1.5)), Some((-2.0, 1.2))],
+            &names,
+        )
+        .unwrap();
+        for &t in &[0.0, 0.4, 1.0, 3.3] {
+            let s = r.sample(t);
+            assert!((s.kc[0] - (1.5 - (2.0 * t).sin().abs())).abs() < 1e-12);
+            let expect = (1.2 - t.cos()).min(t.cos() + 2.0);
+            assert!((s.kc[1] - expect).abs() < 1e-12);
+            // k̇_c is the derivative of the active branch.
+            let h = 1e-6;
+            let fd = (r.sample(t + h).kc[1] - r.sample(t - h).kc[1]) / (2.0 * h);
+            assert!((s.kc_dot[1] - fd).abs() < 1e-6, "t = {t}");
+        }
+        let err = Reference::with_limits(
+            &ReferenceConfig::paper(),
+            &env,
+            &[Some((-0.5, 0.5)), None],
+            &names,
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("must stay inside joint 'a' limits"),
+            "{err}"
+        );
+        let err = Reference::with_limits(
+            &ReferenceConfig::paper(),
+            &env,
+            &[Some((-2.0, 2.0)), None],
+            &names,
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string().contains("joint 'b' has no position limits"),
+            "{err}"
         );
     }
 

@@ -56,6 +56,15 @@ impl Sinusoid {
         }
     }
 
+    /// The largest value the signal reaches.
+    pub fn max_value(&self) -> f64 {
+        if self.omega == 0.0 {
+            self.offset + self.cos
+        } else {
+            self.offset + self.amplitude()
+        }
+    }
+
     pub(crate) fn validate(&self, field: &str) -> Result<(), TrajectoryError> {
         for (name, value) in [
             ("offset", self.offset),
