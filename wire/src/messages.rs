@@ -36,7 +36,7 @@ pub const STATE_FINAL: u32 = 1;
 
 /// The plant's state at step `header.seq` (t_k = k Δt).
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
 #[type_name("testbed.JointState.v1")]
 pub struct JointState {
     /// seq = k, t_ns = t_k.
@@ -57,7 +57,7 @@ pub struct JointState {
 
 /// The reference and envelope at `header.t_ns`.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
 #[type_name("testbed.Reference.v1")]
 pub struct ReferenceSample {
     /// seq counts samples, t_ns is the time they describe.
@@ -80,7 +80,7 @@ pub struct ReferenceSample {
 
 /// The controller's torque for the state with the same `header.seq`.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
 #[type_name("testbed.Command.v1")]
 pub struct Command {
     /// seq and t_ns of the state this answers; wall_ns when it was sent.
@@ -99,7 +99,7 @@ pub struct Command {
 
 /// Everything the controller computed at one step (SPEC §12).
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
 #[type_name("testbed.ControllerDiagnostics.v1")]
 pub struct ControllerDiagnostics {
     /// seq and t_ns of the state acted on.

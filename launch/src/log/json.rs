@@ -26,7 +26,7 @@ pub enum Field<'a> {
 }
 
 /// A message type as it appears in the log.
-pub trait LogMessage: Sized + Copy {
+pub trait LogMessage: Sized + Copy + Default {
     /// MCAP topic.
     const TOPIC: &'static str;
     /// Schema name.
@@ -39,8 +39,6 @@ pub trait LogMessage: Sized + Copy {
     fn fields(&self) -> Vec<(&'static str, Field<'_>)>;
     /// Rebuilds the message from a JSON object.
     fn from_fields(header: Header, m: &Fields<'_>) -> Result<Self, String>;
-    /// A value with every field present, for the schema.
-    fn example() -> Self;
 
     /// The JSON object.
     fn to_json(&self) -> Value {
@@ -87,7 +85,7 @@ pub trait LogMessage: Sized + Copy {
             "t".into(),
             json!({"type": ["number", "null"], "description": "sim time, s"}),
         );
-        let example = Self::example();
+        let example = Self::default();
         for (name, f) in example.fields() {
             let s = match f {
                 Field::U(_) | Field::I(_) => json!({"type": "integer"}),
@@ -176,12 +174,6 @@ fn trim(j: &Joints, dof: u32) -> &[f64] {
     &j[..(dof as usize).min(MAX_DOF)]
 }
 
-const ZERO_HEADER: Header = Header {
-    seq: 0,
-    t_ns: 0,
-    wall_ns: 0,
-};
-
 impl LogMessage for JointState {
     const TOPIC: &'static str = "/joint_state";
     const SCHEMA: &'static str = "testbed.JointState";
@@ -210,17 +202,6 @@ impl LogMessage for JointState {
             tau_applied: m.j("tau_applied")?,
             deadline_misses: m.u("deadline_misses")?,
         })
-    }
-    fn example() -> Self {
-        Self {
-            header: ZERO_HEADER,
-            dof: 0,
-            flags: 0,
-            q: [0.0; MAX_DOF],
-            qd: [0.0; MAX_DOF],
-            tau_applied: [0.0; MAX_DOF],
-            deadline_misses: 0,
-        }
     }
 }
 
@@ -254,18 +235,6 @@ impl LogMessage for ReferenceSample {
             kc_dot: m.j("kc_dot")?,
         })
     }
-    fn example() -> Self {
-        Self {
-            header: ZERO_HEADER,
-            dof: 0,
-            reserved: 0,
-            q_d: [0.0; MAX_DOF],
-            qd_d: [0.0; MAX_DOF],
-            qdd_d: [0.0; MAX_DOF],
-            kc: [0.0; MAX_DOF],
-            kc_dot: [0.0; MAX_DOF],
-        }
-    }
 }
 
 impl LogMessage for Command {
@@ -294,16 +263,6 @@ impl LogMessage for Command {
             state_wall_ns: m.u("state_wall_ns")?,
             compute_ns: m.u("compute_ns")?,
         })
-    }
-    fn example() -> Self {
-        Self {
-            header: ZERO_HEADER,
-            dof: 0,
-            fault: 0,
-            tau: [0.0; MAX_DOF],
-            state_wall_ns: 0,
-            compute_ns: 0,
-        }
     }
 }
 
@@ -375,38 +334,6 @@ impl LogMessage for ControllerDiagnostics {
             wa_norm: m.j("wa_norm")?,
         })
     }
-    fn example() -> Self {
-        let z = [0.0; MAX_DOF];
-        Self {
-            header: ZERO_HEADER,
-            dof: 0,
-            fault: 0,
-            barrier_breached: 0,
-            reserved: 0,
-            compute_ns: 0,
-            gamma: 0.0,
-            gamma_dot: 0.0,
-            j_hat: 0.0,
-            delta: 0.0,
-            r: 0.0,
-            wc_norm: 0.0,
-            q_d: z,
-            qd_d: z,
-            kc_in: z,
-            kc_dot: z,
-            z1: z,
-            z1g: z,
-            z2: z,
-            alpha: z,
-            kc: z,
-            d: z,
-            tau: z,
-            tau_actor: z,
-            tau_feedback: z,
-            tau_barrier: z,
-            wa_norm: z,
-        }
-    }
 }
 
 impl LogMessage for Timing {
@@ -441,9 +368,6 @@ impl LogMessage for Timing {
             deadline_misses: m.u("deadline_misses")?,
         })
     }
-    fn example() -> Self {
-        Timing::default()
-    }
 }
 
 #[cfg(test)]
@@ -452,13 +376,15 @@ mod tests {
 
     #[test]
     fn round_trip_keeps_every_bit_and_nan() {
-        let mut s = JointState::example();
-        s.header = Header {
-            seq: 7,
-            t_ns: 7_000_000,
-            wall_ns: u64::MAX - 3,
+        let mut s = JointState {
+            header: Header {
+                seq: 7,
+                t_ns: 7_000_000,
+                wall_ns: u64::MAX - 3,
+            },
+            dof: 2,
+            ..JointState::default()
         };
-        s.dof = 2;
         s.q[0] = 0.1 + 0.2;
         s.q[1] = -1e-300;
         s.qd[0] = f64::NAN;
@@ -474,14 +400,14 @@ mod tests {
     fn schema_lists_every_field_as_required() {
         let schema = ControllerDiagnostics::schema();
         let req = schema["required"].as_array().unwrap();
-        let obj = ControllerDiagnostics::example().to_json();
+        let obj = ControllerDiagnostics::default().to_json();
         assert_eq!(req.len(), obj.as_object().unwrap().len());
         assert_eq!(schema["type"], "object");
     }
 
     #[test]
     fn malformed_json_is_an_error_naming_the_field() {
-        let mut v = Command::example().to_json();
+        let mut v = Command::default().to_json();
         v["tau"] = json!("x");
         assert_eq!(
             Command::parse(&v).unwrap_err(),

@@ -208,15 +208,17 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let mut children = Children::default();
     let me = Some(std::process::id());
     for kind in NODES {
-        if opts.external.contains(&kind) {
-            let args = node_args(
-                kind,
-                &prefix,
-                &scenario_file,
-                opts.mode,
-                (&log, &plan.source),
-                None,
-            );
+        let external = opts.external.contains(&kind);
+        let parent = if external { None } else { me };
+        let args = node_args(
+            kind,
+            &prefix,
+            &scenario_file,
+            opts.mode,
+            (&log, &plan.source),
+            parent,
+        );
+        if external {
             eprintln!(
                 "testbed: waiting for the {} node; start it with:\n  testbed node {} {}",
                 kind.name(),
@@ -225,14 +227,6 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
             );
             continue;
         }
-        let args = node_args(
-            kind,
-            &prefix,
-            &scenario_file,
-            opts.mode,
-            (&log, &plan.source),
-            me,
-        );
         let child = spawn::spawn(&exe, kind, &args).map_err(|cause| RunError::Spawn {
             node: kind.name(),
             cause,
