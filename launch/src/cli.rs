@@ -40,6 +40,9 @@ enum Command {
         #[arg(value_name = "URDF")]
         path: PathBuf,
     },
+    /// Measure speed and timing on this machine: in process, lockstep, real
+    /// time, and the machine's own timer floor.
+    Bench(BenchArgs),
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
     Replay(ReplayArgs),
     /// Run one node of a stack (the launcher starts these; start one by hand
@@ -117,6 +120,28 @@ struct RunArgs {
 }
 
 #[derive(Debug, Args)]
+struct BenchArgs {
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Length of each real-time part and of the timer floor, s.
+    #[arg(long, value_name = "S", default_value_t = 60.0)]
+    realtime_s: f64,
+    /// Repeats of the in-process and lockstep parts (medians are reported).
+    #[arg(long, value_name = "N", default_value_t = 3)]
+    repeats: usize,
+    /// Shorten every scenario to this many seconds (quick check).
+    #[arg(long, value_name = "S")]
+    duration: Option<f64>,
+    /// The largest arm to measure besides the paper's.
+    #[arg(long, value_name = "URDF", default_value = "robots/ur5.urdf")]
+    large_arm: PathBuf,
+    /// Folder for run folders.
+    #[arg(long, value_name = "DIR", default_value = "runs")]
+    runs_dir: PathBuf,
+}
+
+#[derive(Debug, Args)]
 struct ReplayArgs {
     /// The run's MCAP log (runs/<id>/run.mcap).
     #[arg(value_name = "FILE.mcap")]
@@ -146,6 +171,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Sim(args) => sim(args),
         Command::Run(args) => run_stack(args),
         Command::Replay(args) => replay(args),
+        Command::Bench(args) => bench(args),
         Command::Robot { path } => {
             print!("{}", crate::robot_info::describe(&path)?);
             Ok(ExitCode::SUCCESS)
@@ -275,5 +301,31 @@ fn replay(args: ReplayArgs) -> Result<ExitCode> {
         eprintln!("testbed: wrote {} figures to {}", written, dir.display());
     }
     print_report(&Report::from_log(analysis), args.json)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn bench(args: BenchArgs) -> Result<ExitCode> {
+    if !(args.realtime_s.is_finite() && args.realtime_s > 0.0) {
+        anyhow::bail!(
+            "--realtime-s {} is invalid: it must be a number of seconds > 0",
+            args.realtime_s
+        );
+    }
+    if args.repeats == 0 {
+        anyhow::bail!("--repeats 0 is invalid: it must be at least 1");
+    }
+    let opts = launch::bench::BenchOptions {
+        realtime_s: args.realtime_s,
+        repeats: args.repeats,
+        runs_dir: args.runs_dir,
+        duration_s: args.duration,
+        large_arm: args.large_arm,
+    };
+    let report = launch::bench::run(&opts, |what| eprintln!("testbed bench: {what}"))?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report::bench_table(&report));
+    }
     Ok(ExitCode::SUCCESS)
 }

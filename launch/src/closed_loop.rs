@@ -33,9 +33,27 @@ pub enum LoopError {
     },
 }
 
+/// Wall time of each plant and controller step, ns (for benchmarks).
+#[derive(Debug, Default, Clone)]
+pub struct StepCosts {
+    /// One entry per plant step.
+    pub plant_ns: Vec<u64>,
+    /// One entry per controller step.
+    pub controller_ns: Vec<u64>,
+}
+
 /// Runs `plan` to the end, handing every step to `on_step`.
 pub fn run(
     plan: &Plan,
+    on_step: impl FnMut(&StepRecord<'_>) -> std::io::Result<()>,
+) -> Result<(), LoopError> {
+    run_measured(plan, None, on_step)
+}
+
+/// [`run`], also timing every plant and controller step into `costs`.
+pub fn run_measured(
+    plan: &Plan,
+    mut costs: Option<&mut StepCosts>,
     mut on_step: impl FnMut(&StepRecord<'_>) -> std::io::Result<()>,
 ) -> Result<(), LoopError> {
     let robot = plan.robot.label();
@@ -69,8 +87,14 @@ pub fn run(
             kc: &reference.kc,
             kc_dot: &reference.kc_dot,
         };
+        let t0 = std::time::Instant::now();
         controller.step(dt, &input, &mut diag);
+        let t1 = std::time::Instant::now();
         plant.step(&diag.tau, dt).map_err(plant_err)?;
+        if let Some(c) = costs.as_mut() {
+            c.controller_ns.push((t1 - t0).as_nanos() as u64);
+            c.plant_ns.push(t1.elapsed().as_nanos() as u64);
+        }
         plant.state_into(&mut q_next, &mut qd_next);
         for i in 0..n {
             qdd[i] = (qd_next[i] - qd[i]) / dt;

@@ -9,6 +9,7 @@
 
 pub mod analysis;
 pub mod assemble;
+pub mod bench;
 pub mod clock;
 pub mod closed_loop;
 pub mod csv_out;

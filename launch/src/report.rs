@@ -218,3 +218,70 @@ pub fn table(r: &Report) -> String {
     }
     out
 }
+
+/// A readable bench report.
+pub fn bench_table(b: &launch::bench::BenchReport) -> String {
+    let mut out = String::new();
+    let m = &b.machine;
+    let _ = writeln!(
+        out,
+        "machine: {} ({} CPUs), kernel {}; medians of {} runs",
+        m.cpu, m.cores, m.kernel, b.repeats
+    );
+    for a in &b.arms {
+        let _ = writeln!(
+            out,
+            "\n{} ({} joints, {} s sim):",
+            a.scenario, a.dof, a.sim_s
+        );
+        let _ = writeln!(out, "  in process      {:8.3} s wall", a.inprocess_wall_s);
+        let _ = writeln!(
+            out,
+            "  lockstep + log  {:8.3} s wall = {:.1}x real time, {:.2}x the in-process wall",
+            a.lockstep_wall_s, a.lockstep_realtime_factor, a.lockstep_to_inprocess_ratio
+        );
+        let _ = writeln!(
+            out,
+            "  per step        controller {:.2} us, plant {:.2} us",
+            a.controller_step_us, a.plant_step_us
+        );
+        let r = &a.realtime;
+        let _ = writeln!(
+            out,
+            "  real time       {} cycles, {} deadline misses, {} samples dropped by the logger",
+            r.cycles, r.deadline_misses, r.logger_dropped
+        );
+        let _ = writeln!(
+            out,
+            "    period jitter us  {}",
+            percentiles(&r.period_jitter_us)
+        );
+        let _ = writeln!(
+            out,
+            "    round trip us     {}",
+            percentiles(&r.round_trip_us)
+        );
+        let rss: Vec<String> = a
+            .peak_rss_kb
+            .iter()
+            .map(|(n, kb)| format!("{n} {:.1} MB", *kb as f64 / 1024.0))
+            .collect();
+        let _ = writeln!(out, "  peak memory     {}", rss.join(", "));
+    }
+    let f = &b.timer_floor;
+    let _ = writeln!(
+        out,
+        "\ntimer floor (bare absolute-deadline sleep loop, no IPC, no work):"
+    );
+    let _ = writeln!(
+        out,
+        "  {} cycles, {} late by a whole period or more",
+        f.cycles, f.deadline_misses
+    );
+    let _ = writeln!(
+        out,
+        "  period jitter us  {}",
+        percentiles(&f.period_jitter_us)
+    );
+    out
+}

@@ -253,3 +253,56 @@ fn newest_log(runs: &std::path::Path) -> std::path::PathBuf {
         .max_by_key(|p| std::fs::metadata(p).and_then(|m| m.modified()).ok())
         .expect("a run log")
 }
+
+/// `testbed bench` measures every part and reports the keys users script on.
+#[test]
+fn bench_reports_every_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = ok(testbed()
+        .args([
+            "bench",
+            "--json",
+            "--realtime-s",
+            "0.3",
+            "--repeats",
+            "1",
+            "--duration",
+            "0.5",
+            "--runs-dir",
+        ])
+        .arg(dir.path()));
+    let b = crate::util::json(&out);
+    for k in [
+        "inprocess_wall_s",
+        "lockstep_wall_s",
+        "lockstep_realtime_factor",
+        "lockstep_to_inprocess_ratio",
+        "controller_step_us",
+        "plant_step_us",
+    ] {
+        assert!(b[k].as_f64().unwrap() > 0.0, "{k} in {b}");
+    }
+    for k in ["cycles", "deadline_misses"] {
+        assert!(
+            b["realtime"][k].is_u64() && b["timer_floor"][k].is_u64(),
+            "{k} in {b}"
+        );
+    }
+    assert_eq!(b["realtime"]["cycles"], 300);
+    assert_eq!(b["timer_floor"]["cycles"], 300);
+    for k in ["period_jitter_us", "round_trip_us"] {
+        assert!(b["realtime"][k]["p99"].as_f64().is_some(), "{k} in {b}");
+    }
+    assert!(
+        b["timer_floor"]["period_jitter_us"]["p50"]
+            .as_f64()
+            .is_some()
+    );
+    let arms = b["arms"].as_array().unwrap();
+    assert_eq!(arms.len(), 2);
+    assert_eq!(arms[1]["dof"], 6);
+    assert!(arms[0]["peak_rss_kb"].as_array().unwrap().len() >= 5, "{b}");
+    assert!(b["machine"]["cores"].as_u64().unwrap() >= 1);
+    let err = crate::util::fails(testbed().args(["bench", "--realtime-s", "0"]));
+    assert!(err.contains("--realtime-s"), "{err}");
+}

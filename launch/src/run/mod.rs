@@ -70,6 +70,8 @@ pub struct RunOutcome {
     pub log: PathBuf,
     /// Wall time from START to the plant's last step, s.
     pub wall_time_s: f64,
+    /// Peak resident memory of each node (kB), read just before STOP.
+    pub peak_rss_kb: Vec<(NodeKind, u64)>,
 }
 
 /// Why a run failed.
@@ -235,6 +237,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     }
 
     let result = supervise(&opts, &bus, &status, &control, &mut children);
+    let peak_rss_kb = children.peak_rss_kb();
     // Whatever happened: STOP (the logger then finishes the file), grace,
     // SIGTERM, SIGKILL, reap.
     let _ = control.send(control_msg(CONTROL_STOP, 0));
@@ -281,6 +284,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         run_dir,
         log,
         wall_time_s,
+        peak_rss_kb,
     })
 }
 

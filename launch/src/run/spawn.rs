@@ -130,6 +130,14 @@ impl Children {
         None
     }
 
+    /// Peak resident memory (VmHWM, kB) of each child still running.
+    pub fn peak_rss_kb(&self) -> Vec<(NodeKind, u64)> {
+        self.0
+            .iter()
+            .filter_map(|c| peak_rss_kb(c.pid()).map(|kb| (c.kind, kb)))
+            .collect()
+    }
+
     /// How `kind` ended (status and stderr tail), once it has.
     pub fn exit_of(&mut self, kind: NodeKind) -> Option<(ExitStatus, String)> {
         let c = self.0.iter_mut().find(|c| c.kind == kind)?;
@@ -191,4 +199,11 @@ impl Drop for Children {
             c.join_forwarder();
         }
     }
+}
+
+/// VmHWM of process `pid` in kB, from /proc.
+pub fn peak_rss_kb(pid: u32) -> Option<u64> {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
 }
