@@ -206,7 +206,20 @@ fn euler_integrator_shows_the_instability_of_spec_9() {
     .unwrap();
     let out = ok(testbed().args(["sim", "--json", "--scenario"]).arg(&p));
     let s = json(&out);
-    // The run completes and reports the divergence instead of hiding it.
+    // The run completes and reports the divergence instead of hiding it:
+    // the weights explode and the torque sits at the effort limit (500 N m)
+    // that saturation holds it to.
+    for j in s["joints"].as_array().unwrap() {
+        assert!(j["max_actor_weight_norm"].as_f64().unwrap() > 1e6, "{s}");
+        assert_eq!(j["max_abs_torque"], 500.0, "{s}");
+    }
+    // Without saturation the torque itself goes non-finite.
+    std::fs::write(
+        &p,
+        "duration_s = 0.5\n[controller]\nintegrator = \"euler\"\n[plant]\nsaturate = false\n",
+    )
+    .unwrap();
+    let s = json(&ok(testbed().args(["sim", "--json", "--scenario"]).arg(&p)));
     assert_eq!(s["finite"], false, "{s}");
     assert!(s["fault_steps"].as_u64().unwrap() > 0, "{s}");
 }
