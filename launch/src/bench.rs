@@ -119,20 +119,9 @@ pub struct BenchReport {
     pub machine: Machine,
     /// Repeats per part.
     pub repeats: usize,
-    /// Paper scenario: in-process wall, s.
-    pub inprocess_wall_s: f64,
-    /// Paper scenario: lockstep wall, s.
-    pub lockstep_wall_s: f64,
-    /// Paper scenario: sim / lockstep wall.
-    pub lockstep_realtime_factor: f64,
-    /// Paper scenario: lockstep / in-process wall.
-    pub lockstep_to_inprocess_ratio: f64,
-    /// Paper scenario: controller step, µs.
-    pub controller_step_us: f64,
-    /// Paper scenario: plant step, µs.
-    pub plant_step_us: f64,
-    /// Paper scenario in real time.
-    pub realtime: RealtimeFigures,
+    /// The paper scenario's figures, at the top level of the JSON.
+    #[serde(flatten)]
+    pub paper: ArmBench,
     /// The bare sleep loop, same length, same bench run.
     pub timer_floor: TimerFloor,
     /// Every arm's figures.
@@ -268,13 +257,7 @@ fn bench_arm(
     rt_plan.scenario.duration_s = opts.realtime_s;
     let rt = stack(&rt_plan, Mode::Realtime, opts)?;
     let t = &rt.analysis.timing;
-    let dropped = rt.analysis.contents.stats.as_ref().map_or(0, |stats| {
-        stats
-            .iter()
-            .filter(|(k, _)| k.ends_with(".dropped"))
-            .filter_map(|(_, v)| v.parse::<u64>().ok())
-            .sum()
-    });
+    let dropped = rt.analysis.contents.logger_dropped().unwrap_or(0);
     Ok(ArmBench {
         scenario: plan.scenario.name.clone(),
         dof: plan.robot.model.dof(),
@@ -307,17 +290,10 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
         opts.realtime_s
     ));
     let floor = timer_floor(paper.scenario.rate_hz, opts.realtime_s);
-    let p = arms[0].clone();
     Ok(BenchReport {
         machine: machine(),
         repeats: opts.repeats,
-        inprocess_wall_s: p.inprocess_wall_s,
-        lockstep_wall_s: p.lockstep_wall_s,
-        lockstep_realtime_factor: p.lockstep_realtime_factor,
-        lockstep_to_inprocess_ratio: p.lockstep_to_inprocess_ratio,
-        controller_step_us: p.controller_step_us,
-        plant_step_us: p.plant_step_us,
-        realtime: p.realtime,
+        paper: arms[0].clone(),
         timer_floor: floor,
         arms,
     })

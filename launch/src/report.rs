@@ -79,13 +79,7 @@ impl Report {
     /// For a logged run: everything from the log.
     pub fn from_log(a: LogAnalysis) -> Self {
         let meta = |k: &str| a.contents.run.get(k).cloned().unwrap_or_default();
-        let dropped = a.contents.stats.as_ref().map(|stats| {
-            stats
-                .iter()
-                .filter(|(k, _)| k.ends_with(".dropped"))
-                .filter_map(|(_, v)| v.parse::<u64>().ok())
-                .sum()
-        });
+        let dropped = a.contents.logger_dropped();
         let warning = a.warning();
         let sim_s = a.summary.steps as f64 * a.summary.dt_s;
         Self {

@@ -27,6 +27,20 @@ pub struct LogContents {
     pub cut_short: Option<String>,
 }
 
+impl LogContents {
+    /// Samples the logger could not take, summed over topics (None if the
+    /// logger never finished the file).
+    pub fn logger_dropped(&self) -> Option<u64> {
+        self.stats.as_ref().map(|stats| {
+            stats
+                .iter()
+                .filter(|(k, _)| k.ends_with(".dropped"))
+                .filter_map(|(_, v)| v.parse::<u64>().ok())
+                .sum()
+        })
+    }
+}
+
 /// Called for every message of a log, in file order.
 pub type OnMessage<'a> = &'a mut dyn FnMut(&str, &serde_json::Value) -> Result<(), String>;
 
