@@ -194,7 +194,9 @@ fn truncated_logs_are_analysed_as_far_as_they_go() {
         let out = ok(testbed().arg("replay").arg(&cut).arg("--json"));
         let s = json(&out);
         let steps = s["steps"].as_u64().unwrap();
-        assert!(steps > last_steps && steps < 3000, "{frac}: {steps} steps");
+        // A cut loses its whole (compressed) chunk, and two cuts can fall in
+        // the same chunk: more of the file never recovers fewer steps.
+        assert!(steps >= last_steps && steps < 3000, "{frac}: {steps} steps");
         last_steps = steps;
         let warning = s["warning"].as_str().unwrap();
         assert!(
@@ -204,6 +206,7 @@ fn truncated_logs_are_analysed_as_far_as_they_go() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains("warning"), "{err}");
     }
+    assert!(last_steps > 0, "no cut recovered any step");
     // Cut in the summary section: every step is there, but the file is
     // still reported as unfinished.
     let cut = dir.path().join("cut-summary.mcap");
