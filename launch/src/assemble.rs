@@ -13,9 +13,12 @@ use wire::{ControllerDiagnostics, JointState};
 
 use crate::record::StepRecord;
 
-/// A diagnostics sample missing this many steps behind the newest state is
-/// given up on (real time only: a lossless run never drops one).
-const GIVE_UP_AFTER: u64 = 1000;
+/// Each topic arrives in sequence order (one publisher, delivered in order),
+/// but topics are interleaved in batches: a log may hold a thousand states
+/// before their diagnostics. So a row is given up only when the topic it
+/// lacks has moved past it (a sample dropped in real time), with a little
+/// slack for reordering.
+const GIVE_UP_AFTER: u64 = 8;
 
 /// Collects states and diagnostics and emits complete rows in step order.
 #[derive(Debug)]
@@ -25,6 +28,7 @@ pub struct RecordAssembler {
     steps: u64,
     next: u64,
     newest_state: Option<u64>,
+    newest_diag: Option<u64>,
     states: BTreeMap<u64, JointState>,
     diags: BTreeMap<u64, ControllerDiagnostics>,
     missing: u64,
@@ -40,6 +44,7 @@ impl RecordAssembler {
             steps,
             next: 0,
             newest_state: None,
+            newest_diag: None,
             states: BTreeMap::new(),
             diags: BTreeMap::new(),
             missing: 0,
@@ -58,8 +63,10 @@ impl RecordAssembler {
 
     /// Adds a diagnostics sample.
     pub fn push_diag(&mut self, d: ControllerDiagnostics) {
-        if d.header.seq >= self.next {
-            self.diags.insert(d.header.seq, d);
+        let seq = d.header.seq;
+        if seq >= self.next {
+            self.newest_diag = Some(self.newest_diag.map_or(seq, |n| n.max(seq)));
+            self.diags.insert(seq, d);
         }
     }
 
@@ -86,14 +93,14 @@ impl RecordAssembler {
         while self.next < self.steps {
             let k = self.next;
             let (Some(s), Some(s1)) = (self.states.get(&k), self.states.get(&(k + 1))) else {
-                if self.stale(k) {
+                if past(self.newest_state, k + 1) {
                     self.skip(k);
                     continue;
                 }
                 break;
             };
             let Some(d) = self.diags.get(&k) else {
-                if self.stale(k) {
+                if past(self.newest_diag, k) {
                     self.skip(k);
                     continue;
                 }
@@ -127,14 +134,85 @@ impl RecordAssembler {
         Ok(())
     }
 
-    fn stale(&self, k: u64) -> bool {
-        self.newest_state.is_some_and(|n| n > k + GIVE_UP_AFTER)
-    }
-
     fn skip(&mut self, k: u64) {
         self.states.remove(&k);
         self.diags.remove(&k);
         self.missing += 1;
         self.next += 1;
+    }
+}
+
+/// The stream whose newest sample is `newest` has moved well past `seq`.
+fn past(newest: Option<u64>, seq: u64) -> bool {
+    newest.is_some_and(|n| n > seq + GIVE_UP_AFTER)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(k: u64) -> JointState {
+        JointState {
+            header: wire::Header {
+                seq: k,
+                t_ns: k * 1_000_000,
+                wall_ns: 0,
+            },
+            dof: 1,
+            ..JointState::default()
+        }
+    }
+
+    fn diag(k: u64) -> ControllerDiagnostics {
+        ControllerDiagnostics {
+            header: wire::Header {
+                seq: k,
+                t_ns: k * 1_000_000,
+                wall_ns: 0,
+            },
+            dof: 1,
+            ..ControllerDiagnostics::default()
+        }
+    }
+
+    fn rows(a: &mut RecordAssembler) -> u64 {
+        let mut n = 0;
+        a.emit(|_| {
+            n += 1;
+            Ok(())
+        })
+        .unwrap();
+        n
+    }
+
+    /// Regression: a fast lockstep log holds batches of over a thousand
+    /// states before their diagnostics; rows were once given up then.
+    #[test]
+    fn rows_survive_a_batch_of_states_before_their_diagnostics() {
+        let mut a = RecordAssembler::new(1, 1e-3, 3000);
+        for k in 0..=3000 {
+            a.push_state(state(k));
+        }
+        assert_eq!(rows(&mut a), 0);
+        for k in 0..3000 {
+            a.push_diag(diag(k));
+        }
+        assert_eq!(rows(&mut a), 3000);
+        assert_eq!(a.missing(), 0);
+        assert!(a.complete());
+    }
+
+    #[test]
+    fn a_dropped_sample_costs_only_its_row() {
+        let mut a = RecordAssembler::new(1, 1e-3, 100);
+        for k in 0..=100 {
+            a.push_state(state(k));
+        }
+        for k in (0..100).filter(|k| *k != 40) {
+            a.push_diag(diag(k));
+        }
+        assert_eq!(rows(&mut a), 99);
+        assert_eq!(a.missing(), 1);
+        assert!(a.complete());
     }
 }
