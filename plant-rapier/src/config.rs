@@ -1,10 +1,13 @@
-//! Plant settings, as read from a scenario's `[plant]` table.
+//! Plant settings, as read from a scenario's `[plant]` table and its
+//! sub-tables: what the arm does that the controller does not know.
+//! Every effect is off unless the scenario turns it on.
 
 use serde::{Deserialize, Serialize};
 
 use crate::PlantError;
 
-/// How the plant integrates.
+/// How the plant integrates, and the effects it adds on top of the rigid
+/// body dynamics.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PlantConfig {
@@ -14,8 +17,21 @@ pub struct PlantConfig {
     pub substeps: u32,
     /// Gravity vector in the URDF's world frame (default: [0, 0, -9.81], m/s²).
     pub gravity: [f64; 3],
-    /// Clip each joint's torque to the URDF's effort limit (default: true).
+    /// Clip each joint's torque to its effort limit (default: true).
     pub saturate: bool,
+    /// Effort limit per joint, N m (N for prismatic joints); replaces the
+    /// URDF's `<limit effort>` (default: unset, the URDF's).
+    pub effort_limit: Option<PerJoint>,
+    /// Joint friction.
+    pub friction: FrictionConfig,
+    /// A payload mass fixed to a link.
+    pub payload: Option<PayloadConfig>,
+    /// The disturbance d(t) of the paper's eq. 1, added to the joint torques.
+    pub disturbance: DisturbanceConfig,
+    /// What the joint sensors report.
+    pub sensor: SensorConfig,
+    /// What happens to a command between the controller and the motors.
+    pub actuation: ActuationConfig,
 }
 
 impl Default for PlantConfig {
@@ -24,26 +40,346 @@ impl Default for PlantConfig {
             substeps: 8,
             gravity: [0.0, 0.0, -9.81],
             saturate: true,
+            effort_limit: None,
+            friction: FrictionConfig::default(),
+            payload: None,
+            disturbance: DisturbanceConfig::default(),
+            sensor: SensorConfig::default(),
+            actuation: ActuationConfig::default(),
         }
     }
 }
 
+/// One number for every joint, or one per joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum PerJoint {
+    /// The same value for every joint.
+    All(f64),
+    /// One value per actuated joint, in joint order.
+    Each(Vec<f64>),
+}
+
+impl Default for PerJoint {
+    fn default() -> Self {
+        Self::All(0.0)
+    }
+}
+
+impl PerJoint {
+    /// True when every entry is zero (the effect is off).
+    pub fn is_zero(&self) -> bool {
+        match self {
+            Self::All(x) => *x == 0.0,
+            Self::Each(v) => v.iter().all(|x| *x == 0.0),
+        }
+    }
+
+    /// The value per joint for an arm of `n` joints; `key` names it in errors.
+    /// Every entry must be finite and not negative.
+    pub fn resolve(&self, key: &str, n: usize) -> Result<Vec<f64>, PlantError> {
+        self.check(key)?;
+        self.resolve_signed(key, n)
+    }
+
+    /// As [`PerJoint::resolve`], for a signed quantity (any finite number).
+    pub fn resolve_signed(&self, key: &str, n: usize) -> Result<Vec<f64>, PlantError> {
+        let v = match self {
+            Self::All(x) => vec![*x; n],
+            Self::Each(v) if v.len() == n => v.clone(),
+            Self::Each(v) => {
+                return Err(invalid(
+                    key,
+                    format!("{} entries", v.len()),
+                    format!("one number, or one per actuated joint ({n})"),
+                ));
+            }
+        };
+        self.check_signed(key)?;
+        Ok(v)
+    }
+
+    /// Checks that every entry is finite and not negative, without the arm.
+    fn check(&self, key: &str) -> Result<(), PlantError> {
+        self.check_with(key, |x| x.is_finite() && x >= 0.0, "a finite number ≥ 0")
+    }
+
+    /// Checks that every entry is finite, without the arm.
+    fn check_signed(&self, key: &str) -> Result<(), PlantError> {
+        self.check_with(key, f64::is_finite, "a finite number")
+    }
+
+    fn check_with(&self, key: &str, ok: fn(f64) -> bool, need: &str) -> Result<(), PlantError> {
+        match self {
+            Self::All(x) if !ok(*x) => Err(invalid(key, x, need)),
+            Self::Each(v) => match v.iter().position(|x| !ok(*x)) {
+                Some(i) => Err(invalid(&format!("{key}[{i}]"), v[i], need)),
+                None => Ok(()),
+            },
+            Self::All(_) => Ok(()),
+        }
+    }
+}
+
+/// Viscous plus Coulomb friction at each joint:
+/// τ_f = −(b q̇ + F_c tanh(q̇ / v_s)), smoothed near zero velocity so that
+/// the dynamics stay continuous.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FrictionConfig {
+    /// Viscous coefficient b, N m s/rad (default: 0).
+    pub viscous: PerJoint,
+    /// Coulomb level F_c, N m (default: 0).
+    pub coulomb: PerJoint,
+    /// Velocity v_s at which the Coulomb term reaches tanh(1) ≈ 76 % of F_c
+    /// (default: 0.01, rad/s).
+    pub smoothing_velocity: f64,
+}
+
+impl Default for FrictionConfig {
+    fn default() -> Self {
+        Self {
+            viscous: PerJoint::default(),
+            coulomb: PerJoint::default(),
+            smoothing_velocity: 0.01,
+        }
+    }
+}
+
+/// A point mass fixed to a link, from a given time on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PayloadConfig {
+    /// The URDF link that carries it (a link merged by a fixed joint is fine).
+    pub link: String,
+    /// Its mass, kg.
+    pub mass: f64,
+    /// Where it sits in the link's frame, m (default: the link origin).
+    pub offset: [f64; 3],
+    /// When it is picked up, s (default: 0, carried from the start).
+    pub attach_at_s: f64,
+}
+
+impl Default for PayloadConfig {
+    fn default() -> Self {
+        Self {
+            link: String::new(),
+            mass: 0.0,
+            offset: [0.0; 3],
+            attach_at_s: 0.0,
+        }
+    }
+}
+
+/// The bounded disturbance d(t), per joint, as the sum of four parts:
+/// a constant, a step, a sinusoid, and band-limited noise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DisturbanceConfig {
+    /// Constant part, N m (signed: one number or one per joint).
+    pub constant: PerJoint,
+    /// Step part: added from `step_at_s` on, N m (signed).
+    pub step: PerJoint,
+    /// Time of the step, s (default: 0).
+    pub step_at_s: f64,
+    /// Amplitude of the sinusoid, N m (signed).
+    pub sin_amplitude: PerJoint,
+    /// Its angular frequency, rad/s (default: 1).
+    pub sin_omega: f64,
+    /// Standard deviation of the noise, N m (default: 0, off).
+    pub noise_std: PerJoint,
+    /// Noise bandwidth: first-order low-pass corner, Hz (default: 10). The
+    /// noise is clipped at 3 standard deviations so that d stays bounded,
+    /// as the paper assumes.
+    pub noise_bandwidth_hz: f64,
+}
+
+impl Default for DisturbanceConfig {
+    fn default() -> Self {
+        Self {
+            constant: PerJoint::default(),
+            step: PerJoint::default(),
+            step_at_s: 0.0,
+            sin_amplitude: PerJoint::default(),
+            sin_omega: 1.0,
+            noise_std: PerJoint::default(),
+            noise_bandwidth_hz: 10.0,
+        }
+    }
+}
+
+/// What the joint sensors report: q and q̇ plus Gaussian noise, and q
+/// quantised to an encoder's resolution.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SensorConfig {
+    /// Standard deviation of the noise on q, rad (default: 0).
+    pub q_noise_std: PerJoint,
+    /// Standard deviation of the noise on q̇, rad/s (default: 0).
+    pub qd_noise_std: PerJoint,
+    /// Encoder resolution: q is reported as a whole number of these, rad
+    /// (default: 0, no quantisation; a 4096-count encoder is 2π/4096 ≈ 0.00153).
+    pub q_resolution: PerJoint,
+}
+
+impl Default for SensorConfig {
+    fn default() -> Self {
+        Self {
+            q_noise_std: PerJoint::default(),
+            qd_noise_std: PerJoint::default(),
+            q_resolution: PerJoint::default(),
+        }
+    }
+}
+
+/// What happens to a command on its way to the motors.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ActuationConfig {
+    /// The command computed from state k is applied over period k + N
+    /// (default: 0).
+    pub delay_periods: u32,
+    /// Probability that a command is lost; the motors then hold the last
+    /// one received (default: 0).
+    pub drop_probability: f64,
+}
+
+fn invalid(key: &str, value: impl ToString, need: impl ToString) -> PlantError {
+    PlantError::InvalidConfig {
+        key: key.to_string(),
+        value: value.to_string(),
+        need: need.to_string(),
+    }
+}
+
+fn check_finite(key: &str, v: &[f64]) -> Result<(), PlantError> {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(invalid(
+            &format!("{key}[{i}]"),
+            v[i].to_string(),
+            "a finite number",
+        )),
+        None => Ok(()),
+    }
+}
+
 impl PlantConfig {
-    /// Checks every field; the error names the key (`plant.<key>`).
+    /// Checks every field that does not depend on the arm; the error names
+    /// the key (`plant.<key>`). [`PlantConfig::check_for`] checks the rest.
     pub fn validate(&self) -> Result<(), PlantError> {
         if !(1..=1000).contains(&self.substeps) {
-            return Err(PlantError::InvalidConfig {
-                key: "plant.substeps".into(),
-                value: self.substeps.to_string(),
-                need: "an integer from 1 to 1000".into(),
-            });
+            return Err(invalid(
+                "plant.substeps",
+                self.substeps,
+                "an integer from 1 to 1000",
+            ));
         }
         if let Some(g) = self.gravity.iter().find(|g| !g.is_finite()) {
-            return Err(PlantError::InvalidConfig {
-                key: "plant.gravity".into(),
-                value: g.to_string(),
-                need: "three finite numbers".into(),
-            });
+            return Err(invalid("plant.gravity", g, "three finite numbers"));
+        }
+        if let Some(e) = &self.effort_limit {
+            e.check("plant.effort_limit")?;
+        }
+        let f = &self.friction;
+        f.viscous.check("plant.friction.viscous")?;
+        f.coulomb.check("plant.friction.coulomb")?;
+        if !(f.smoothing_velocity.is_finite() && f.smoothing_velocity > 0.0) {
+            return Err(invalid(
+                "plant.friction.smoothing_velocity",
+                f.smoothing_velocity,
+                "a finite velocity > 0",
+            ));
+        }
+        if let Some(p) = &self.payload {
+            if p.link.is_empty() {
+                return Err(invalid(
+                    "plant.payload.link",
+                    "\"\"",
+                    "the name of a link of the robot",
+                ));
+            }
+            if !(p.mass.is_finite() && p.mass > 0.0) {
+                return Err(invalid("plant.payload.mass", p.mass, "a finite mass > 0"));
+            }
+            check_finite("plant.payload.offset", &p.offset)?;
+            if !(p.attach_at_s.is_finite() && p.attach_at_s >= 0.0) {
+                return Err(invalid(
+                    "plant.payload.attach_at_s",
+                    p.attach_at_s,
+                    "a finite time ≥ 0",
+                ));
+            }
+        }
+        let d = &self.disturbance;
+        d.constant.check_signed("plant.disturbance.constant")?;
+        d.step.check_signed("plant.disturbance.step")?;
+        d.sin_amplitude
+            .check_signed("plant.disturbance.sin_amplitude")?;
+        for (key, v) in [
+            ("plant.disturbance.step_at_s", d.step_at_s),
+            ("plant.disturbance.sin_omega", d.sin_omega),
+        ] {
+            if !v.is_finite() {
+                return Err(invalid(key, v, "a finite number"));
+            }
+        }
+        d.noise_std.check("plant.disturbance.noise_std")?;
+        if !(d.noise_bandwidth_hz.is_finite() && d.noise_bandwidth_hz > 0.0) {
+            return Err(invalid(
+                "plant.disturbance.noise_bandwidth_hz",
+                d.noise_bandwidth_hz,
+                "a finite frequency > 0",
+            ));
+        }
+        let s = &self.sensor;
+        s.q_noise_std.check("plant.sensor.q_noise_std")?;
+        s.qd_noise_std.check("plant.sensor.qd_noise_std")?;
+        s.q_resolution.check("plant.sensor.q_resolution")?;
+        let a = &self.actuation;
+        if a.delay_periods > 10_000 {
+            return Err(invalid(
+                "plant.actuation.delay_periods",
+                a.delay_periods,
+                "an integer from 0 to 10000",
+            ));
+        }
+        if !(0.0..=1.0).contains(&a.drop_probability) {
+            return Err(invalid(
+                "plant.actuation.drop_probability",
+                a.drop_probability,
+                "a probability from 0 to 1",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks the per-joint lengths against an arm of `n` joints and the
+    /// payload's link against `link_names`.
+    pub fn check_for(&self, n: usize, link_names: &[String]) -> Result<(), PlantError> {
+        self.validate()?;
+        if let Some(e) = &self.effort_limit {
+            e.resolve("plant.effort_limit", n)?;
+        }
+        self.friction.viscous.resolve("plant.friction.viscous", n)?;
+        self.friction.coulomb.resolve("plant.friction.coulomb", n)?;
+        let d = &self.disturbance;
+        d.constant.resolve_signed("plant.disturbance.constant", n)?;
+        d.step.resolve_signed("plant.disturbance.step", n)?;
+        d.sin_amplitude
+            .resolve_signed("plant.disturbance.sin_amplitude", n)?;
+        d.noise_std.resolve("plant.disturbance.noise_std", n)?;
+        let s = &self.sensor;
+        s.q_noise_std.resolve("plant.sensor.q_noise_std", n)?;
+        s.qd_noise_std.resolve("plant.sensor.qd_noise_std", n)?;
+        s.q_resolution.resolve("plant.sensor.q_resolution", n)?;
+        if let Some(p) = &self.payload
+            && !link_names.contains(&p.link)
+        {
+            return Err(invalid(
+                "plant.payload.link",
+                format!("\"{}\"", p.link),
+                format!("one of the robot's links ({})", link_names.join(", ")),
+            ));
         }
         Ok(())
     }

@@ -24,12 +24,19 @@
 //! floating, planar and spherical joints and `<mimic>` are refused.
 
 mod config;
+pub mod effects;
 mod model;
 mod plant;
+mod rig;
 
-pub use config::PlantConfig;
-pub use model::{ArmModel, JointInfo, JointKind, LinkInfo, Origin};
+pub use config::{
+    ActuationConfig, DisturbanceConfig, FrictionConfig, PayloadConfig, PerJoint, PlantConfig,
+    SensorConfig,
+};
+pub use effects::Effects;
+pub use model::{ArmModel, JointInfo, JointKind, LinkInfo, MergedLink, Origin};
 pub use plant::Plant;
+pub use rig::Rig;
 
 /// The paper's two-link arm (SPEC §1), embedded so the default scenario
 /// needs no files.

@@ -9,7 +9,7 @@ use std::collections::{HashMap, VecDeque};
 use crate::PlantError;
 
 /// A rigid transform from a URDF `<origin xyz rpy>`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Origin {
     /// Translation, m.
     pub xyz: [f64; 3],
@@ -100,6 +100,20 @@ pub struct ArmModel {
     pub actuated: Vec<usize>,
     /// Fixed joints folded into their parent link, described for users.
     pub merged: Vec<String>,
+    /// Links folded away by a merge: where each one now sits, so that a
+    /// scenario can still name it (a payload at a tool link, say).
+    pub merged_links: Vec<MergedLink>,
+}
+
+/// A link that a fixed joint folded into another one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MergedLink {
+    /// The URDF name of the folded link.
+    pub name: String,
+    /// Index of the link it is now part of.
+    pub into: usize,
+    /// Its frame in that link's frame.
+    pub origin: Origin,
 }
 
 impl ArmModel {
@@ -148,7 +162,7 @@ impl ArmModel {
             joints.push(info);
         }
 
-        let model = Self::assemble(robot.name.clone(), links, joints, Vec::new())?;
+        let model = Self::assemble(robot.name.clone(), links, joints, Vec::new(), Vec::new())?;
         model.merge_fixed_joints()
     }
 
@@ -158,6 +172,7 @@ impl ArmModel {
         links: Vec<LinkInfo>,
         joints: Vec<JointInfo>,
         merged: Vec<String>,
+        merged_links: Vec<MergedLink>,
     ) -> Result<Self, PlantError> {
         let mut parent_of: Vec<Option<usize>> = vec![None; links.len()];
         for (ji, j) in joints.iter().enumerate() {
@@ -215,6 +230,7 @@ impl ArmModel {
             topological,
             actuated,
             merged,
+            merged_links,
         })
     }
 
@@ -238,6 +254,17 @@ impl ArmModel {
                 "{} ({} into {})",
                 j.name, child_link.name, self.links[parent].name
             ));
+            for m in &mut self.merged_links {
+                if m.into == child {
+                    m.into = parent;
+                    m.origin = origin_of(&(t * iso(&m.origin)));
+                }
+            }
+            self.merged_links.push(MergedLink {
+                name: child_link.name.clone(),
+                into: parent,
+                origin: j.origin,
+            });
             // Drop the child link and renumber.
             self.links.remove(child);
             for k in &mut self.joints {
@@ -248,8 +275,19 @@ impl ArmModel {
                     k.child -= 1;
                 }
             }
+            for m in &mut self.merged_links {
+                if m.into > child {
+                    m.into -= 1;
+                }
+            }
         }
-        let model = Self::assemble(self.name, self.links, self.joints, self.merged)?;
+        let model = Self::assemble(
+            self.name,
+            self.links,
+            self.joints,
+            self.merged,
+            self.merged_links,
+        )?;
         // A joint must move some mass, or its acceleration is undefined.
         for &ji in &model.actuated {
             let j = &model.joints[ji];
@@ -276,6 +314,25 @@ impl ArmModel {
                 .sum::<f64>()
     }
 
+    /// The link called `name` (a merged one too): the index of the body it
+    /// is part of and its frame in that body's link frame.
+    pub fn locate_link(&self, name: &str) -> Option<(usize, Origin)> {
+        if let Some(i) = self.links.iter().position(|l| l.name == name) {
+            return Some((i, Origin::default()));
+        }
+        self.merged_links
+            .iter()
+            .find(|m| m.name == name)
+            .map(|m| (m.into, m.origin))
+    }
+
+    /// Names of every link a scenario may name: the URDF's, merged ones included.
+    pub fn link_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = self.links.iter().map(|l| l.name.clone()).collect();
+        names.extend(self.merged_links.iter().map(|m| m.name.clone()));
+        names
+    }
+
     /// Number of actuated joints.
     pub fn dof(&self) -> usize {
         self.actuated.len()
@@ -300,7 +357,7 @@ impl ArmModel {
     }
 }
 
-fn iso(o: &Origin) -> nalgebra::Isometry3<f64> {
+pub(crate) fn iso(o: &Origin) -> nalgebra::Isometry3<f64> {
     nalgebra::Isometry3::from_parts(
         nalgebra::Translation3::new(o.xyz[0], o.xyz[1], o.xyz[2]),
         nalgebra::UnitQuaternion::from_euler_angles(o.rpy[0], o.rpy[1], o.rpy[2]),

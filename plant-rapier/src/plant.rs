@@ -32,6 +32,18 @@ pub struct Plant {
     effort: Vec<f64>,
     /// The torque applied over the last step, after saturation.
     applied: Vec<f64>,
+    /// Whether the last step clipped any joint's torque.
+    saturated: bool,
+    /// Torque from outside the motors (the disturbance), held until changed.
+    external: Vec<f64>,
+    /// Viscous coefficient, Coulomb level, smoothing velocity.
+    viscous: Vec<f64>,
+    coulomb: Vec<f64>,
+    smoothing_velocity: f64,
+    /// Each link's own mass properties, before any payload.
+    link_mprops: Vec<MassProperties>,
+    /// What Rapier is given per substep: applied + external − friction.
+    total: Vec<f64>,
 }
 
 impl std::fmt::Debug for Plant {
@@ -53,7 +65,8 @@ fn pose(o: &Origin) -> Pose {
 impl Plant {
     /// Builds the multibody for `model` at q = 0, q̇ = 0.
     pub fn new(model: &ArmModel, config: &PlantConfig) -> Result<Self, PlantError> {
-        config.validate()?;
+        let n = model.dof();
+        config.check_for(n, &model.link_names())?;
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::new(config.gravity[0], config.gravity[1], config.gravity[2]);
         // One solver pass per call; accuracy comes from stepping `substeps`
@@ -67,6 +80,7 @@ impl Plant {
             link_pose[j.child] = link_pose[j.parent] * pose(&j.origin);
         }
         let mut handles = Vec::with_capacity(model.links.len());
+        let mut link_mprops = Vec::with_capacity(model.links.len());
         for (i, link) in model.links.iter().enumerate() {
             let builder = if i == model.root {
                 RigidBodyBuilder::fixed()
@@ -85,6 +99,7 @@ impl Plant {
             let in_link = r * tensor * r.transpose();
             let mprops =
                 MassProperties::with_inertia_matrix(inertial.translation, link.mass, in_link);
+            link_mprops.push(mprops);
             let body = builder
                 .pose(link_pose[i])
                 .additional_mass_properties(mprops)
@@ -181,19 +196,38 @@ impl Plant {
                 dofs.len()
             )));
         }
+        let scenario_effort = match &config.effort_limit {
+            Some(e) => Some(e.resolve("plant.effort_limit", n)?),
+            None => None,
+        };
         let effort = model
             .actuated
             .iter()
-            .map(|&ji| match model.joints[ji].effort {
-                Some(e) if config.saturate => e,
-                _ => f64::INFINITY,
+            .enumerate()
+            .map(|(i, &ji)| {
+                let limit = match &scenario_effort {
+                    Some(e) => Some(e[i]),
+                    None => model.joints[ji].effort,
+                };
+                match limit {
+                    Some(e) if config.saturate => e,
+                    _ => f64::INFINITY,
+                }
             })
             .collect();
+        let f = &config.friction;
         Ok(Self {
             world,
             multibody,
             names: model.joint_names(),
-            applied: vec![0.0; dofs.len()],
+            applied: vec![0.0; n],
+            saturated: false,
+            external: vec![0.0; n],
+            viscous: f.viscous.resolve("plant.friction.viscous", n)?,
+            coulomb: f.coulomb.resolve("plant.friction.coulomb", n)?,
+            smoothing_velocity: f.smoothing_velocity,
+            link_mprops,
+            total: vec![0.0; n],
             dofs,
             substeps: config.substeps,
             bodies: handles,
@@ -280,16 +314,101 @@ impl Plant {
                 value: dt,
             });
         }
+        self.saturated = false;
         for ((a, t), e) in self.applied.iter_mut().zip(tau).zip(&self.effort) {
             *a = t.clamp(-e, *e);
+            self.saturated |= *a != *t;
         }
         self.world.integration_parameters.dt = dt / f64::from(self.substeps);
+        let has_friction = self.has_friction();
         for _ in 0..self.substeps {
-            let applied = std::mem::take(&mut self.applied);
-            self.apply_torques(&applied);
-            self.applied = applied;
+            let mut total = std::mem::take(&mut self.total);
+            for ((x, a), d) in total.iter_mut().zip(&self.applied).zip(&self.external) {
+                *x = a + d;
+            }
+            if has_friction {
+                // Friction follows the velocity within the period.
+                let v = self.mb().generalized_velocity();
+                for (i, dof) in self.dofs.iter().enumerate() {
+                    total[i] -= friction(
+                        v[dof.assembly_id],
+                        self.viscous[i],
+                        self.coulomb[i],
+                        self.smoothing_velocity,
+                    );
+                }
+            }
+            self.apply_torques(&total);
+            self.total = total;
             self.world.step();
         }
+        Ok(())
+    }
+
+    /// Whether any joint has friction.
+    pub fn has_friction(&self) -> bool {
+        self.viscous.iter().chain(&self.coulomb).any(|x| *x != 0.0)
+    }
+
+    /// The friction torque each joint feels at its current velocity
+    /// (the torque the friction model adds, so opposite to q̇).
+    pub fn friction_torque(&self) -> Vec<f64> {
+        let (_, qd) = self.state();
+        (0..self.dof())
+            .map(|i| {
+                -friction(
+                    qd[i],
+                    self.viscous[i],
+                    self.coulomb[i],
+                    self.smoothing_velocity,
+                )
+            })
+            .collect()
+    }
+
+    /// Sets the torque from outside the motors (the disturbance d of eq. 1),
+    /// held over the following steps until set again. Saturation does not
+    /// touch it: it does not come from the motors.
+    pub fn set_external_torque(&mut self, d: &[f64]) -> Result<(), PlantError> {
+        self.check("external torque", d)?;
+        self.external.copy_from_slice(d);
+        Ok(())
+    }
+
+    /// The torque from outside the motors, as last set.
+    pub fn external_torque(&self) -> &[f64] {
+        &self.external
+    }
+
+    /// Whether the last step clipped any joint's torque at its effort limit.
+    pub fn saturated(&self) -> bool {
+        self.saturated
+    }
+
+    /// Fixes a point mass `mass` to the body of link index `link` at `point`
+    /// in that link's frame (a payload picked up). Replaces any earlier one
+    /// on that link.
+    pub fn attach_point_mass(
+        &mut self,
+        link: usize,
+        point: [f64; 3],
+        mass: f64,
+    ) -> Result<(), PlantError> {
+        let (Some(handle), Some(base)) = (self.bodies.get(link), self.link_mprops.get(link)) else {
+            return Err(PlantError::Engine(format!("no link with index {link}")));
+        };
+        let payload = MassProperties::new(
+            Vector::new(point[0], point[1], point[2]),
+            mass,
+            Vector::ZERO,
+        );
+        let total = *base + payload;
+        let body = self
+            .world
+            .bodies
+            .get_mut(*handle)
+            .ok_or_else(|| PlantError::Engine(format!("link {link} has no body")))?;
+        body.set_additional_mass_properties(total, true);
         Ok(())
     }
 
@@ -357,4 +476,10 @@ impl Plant {
             None => Ok(()),
         }
     }
+}
+
+/// The friction torque magnitude model: b q̇ + F_c tanh(q̇ / v_s). The plant
+/// subtracts it, so it always opposes the motion.
+fn friction(qd: f64, viscous: f64, coulomb: f64, smoothing_velocity: f64) -> f64 {
+    viscous * qd + coulomb * (qd / smoothing_velocity).tanh()
 }
