@@ -210,7 +210,7 @@ impl Default for DisturbanceConfig {
 
 /// What the joint sensors report: q and q̇ plus Gaussian noise, and q
 /// quantised to an encoder's resolution.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SensorConfig {
     /// Standard deviation of the noise on q, rad (default: 0).
@@ -222,15 +222,6 @@ pub struct SensorConfig {
     pub q_resolution: PerJoint,
 }
 
-impl Default for SensorConfig {
-    fn default() -> Self {
-        Self {
-            q_noise_std: PerJoint::default(),
-            qd_noise_std: PerJoint::default(),
-            q_resolution: PerJoint::default(),
-        }
-    }
-}
 
 /// What happens to a command on its way to the motors.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
