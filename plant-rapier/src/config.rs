@@ -222,7 +222,6 @@ pub struct SensorConfig {
     pub q_resolution: PerJoint,
 }
 
-
 /// What happens to a command on its way to the motors.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]

@@ -178,12 +178,8 @@ fn a_delay_of_n_periods_shifts_the_response_by_n_steps() {
             .collect::<Vec<_>>()
     };
     let (a, b) = (run(&base), run(&delayed));
-    for k in 0..n {
-        assert_eq!(
-            b[k],
-            ([0.5, -0.5], [0.0; 2]),
-            "step {k}: nothing applied yet"
-        );
+    for (k, s) in b.iter().take(n).enumerate() {
+        assert_eq!(*s, ([0.5, -0.5], [0.0; 2]), "step {k}: nothing applied yet");
     }
     for k in 0..40 - n {
         assert_eq!(b[k + n], a[k], "step {k}");
@@ -303,4 +299,3 @@ fn seeded_rigs_reproduce_exactly_and_seeds_differ() {
     assert_ne!(a, run(43));
     assert!(a.iter().any(|x| x.3.has(Effects::COMMAND_DROPPED)));
 }
-
