@@ -3,7 +3,7 @@
 //! multi-process lockstep mode must reproduce it bit for bit.
 
 use controller::{Controller, ControllerError, ControllerInput};
-use plant_rapier::{Plant, PlantError};
+use plant_rapier::{PlantError, Rig};
 use scenario::{Plan, ns_to_s};
 use trajectory::ReferenceSample;
 
@@ -62,26 +62,32 @@ pub fn run_measured(
         cause,
     };
     let s = &plan.scenario;
-    let mut plant = Plant::new(&plan.robot.model, &s.plant).map_err(plant_err)?;
-    plant
-        .set_state(&s.initial.q, &s.initial.qd)
+    let mut rig =
+        Rig::new(&plan.robot.model, &s.plant, s.seed, plan.period_ns).map_err(plant_err)?;
+    rig.set_state(&s.initial.q, &s.initial.qd)
         .map_err(plant_err)?;
-    let n = plant.dof();
+    let n = rig.dof();
     let mut controller = Controller::new(s.controller.clone(), n)?;
     let mut diag = controller.diagnostics();
     let mut reference = ReferenceSample::new(n);
     let dt = plan.dt();
 
-    let (mut q, mut qd) = plant.state();
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    let (mut qm, mut qdm) = (vec![0.0; n], vec![0.0; n]);
+    rig.true_state_into(&mut q, &mut qd);
     let (mut q_next, mut qd_next) = (vec![0.0; n], vec![0.0; n]);
     let mut qdd = vec![0.0; n];
     for k in 0..plan.steps {
-        let t = ns_to_s(plan.t_ns(k));
-        plan.reference.sample_into(t, &mut reference);
+        let t_ns = plan.t_ns(k);
+        let t = ns_to_s(t_ns);
+        // The sensors are read once per state, as the plant process does.
+        rig.measure_into(&mut qm, &mut qdm);
+        plan.reference
+            .sample_into(ns_to_s(plan.reference_t_ns(t_ns)), &mut reference);
         let input = ControllerInput {
             t,
-            q: &q,
-            qd: &qd,
+            q: &qm,
+            qd: &qdm,
             q_d: &reference.q_d,
             qd_d: &reference.qd_d,
             kc: &reference.kc,
@@ -90,12 +96,12 @@ pub fn run_measured(
         let t0 = std::time::Instant::now();
         controller.step(dt, &input, &mut diag);
         let t1 = std::time::Instant::now();
-        plant.step(&diag.tau, dt).map_err(plant_err)?;
+        rig.step(Some(&diag.tau)).map_err(plant_err)?;
         if let Some(c) = costs.as_mut() {
             c.controller_ns.push((t1 - t0).as_nanos() as u64);
             c.plant_ns.push(t1.elapsed().as_nanos() as u64);
         }
-        plant.state_into(&mut q_next, &mut qd_next);
+        rig.true_state_into(&mut q_next, &mut qd_next);
         for i in 0..n {
             qdd[i] = (qd_next[i] - qd[i]) / dt;
         }
@@ -103,8 +109,12 @@ pub fn run_measured(
             t,
             q: &q,
             qd: &qd,
+            q_measured: &qm,
+            qd_measured: &qdm,
             qdd: &qdd,
-            tau: plant.applied_torque(),
+            tau: rig.applied_torque(),
+            disturbance: rig.disturbance(),
+            effects: rig.effects().0,
             q_d: &reference.q_d,
             qd_d: &reference.qd_d,
             kc: &reference.kc,

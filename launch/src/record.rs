@@ -6,21 +6,29 @@
 pub struct StepRecord<'a> {
     /// Sim time t_k, s.
     pub t: f64,
-    /// Joint positions q(t_k).
+    /// True joint positions q(t_k).
     pub q: &'a [f64],
-    /// Joint velocities q̇(t_k).
+    /// True joint velocities q̇(t_k).
     pub qd: &'a [f64],
+    /// Positions as the sensors reported them (what the controller used).
+    pub q_measured: &'a [f64],
+    /// Velocities as the sensors reported them.
+    pub qd_measured: &'a [f64],
     /// The plant's mean acceleration over the step, (q̇(t_k+1) − q̇(t_k)) / Δt.
     pub qdd: &'a [f64],
-    /// Torque applied over the step.
+    /// Motor torque applied over the step (after delay, loss, saturation).
     pub tau: &'a [f64],
+    /// Disturbance d applied over the step.
+    pub disturbance: &'a [f64],
+    /// Plant effects over the step (bits of `plant_rapier::Effects`).
+    pub effects: u32,
     /// Desired position q_d(t_k).
     pub q_d: &'a [f64],
     /// Desired velocity q̇_d(t_k).
     pub qd_d: &'a [f64],
     /// Envelope k_c(t_k) per joint, as the trajectory gives it.
     pub kc: &'a [f64],
-    /// Tracking error Z1.
+    /// Tracking error Z1 as the controller saw it (from measured q).
     pub z1: &'a [f64],
     /// Shifted error Z1γ.
     pub z1g: &'a [f64],

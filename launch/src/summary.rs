@@ -5,6 +5,8 @@
 
 use serde::Serialize;
 
+use plant_rapier::Effects;
+
 use crate::record::StepRecord;
 
 /// Per-joint results.
@@ -43,6 +45,8 @@ pub struct Summary {
     pub tc_s: f64,
     /// Per joint, in joint order.
     pub joints: Vec<JointSummary>,
+    /// What the plant added that the controller does not know.
+    pub effects: EffectsSummary,
     /// |Z1_i| < k_c,i for every joint at every step with t ≥ T_c (false if
     /// the run has no such step).
     pub constraint_satisfied_after_tc: bool,
@@ -52,6 +56,19 @@ pub struct Summary {
     pub fault_steps: u64,
     /// Every state, torque and error was finite and no step faulted.
     pub finite: bool,
+}
+
+/// The plant effects of a run, as its logged states flag them.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EffectsSummary {
+    /// Every effect that acted at some step (names of `plant_rapier::Effects`).
+    pub active: Vec<&'static str>,
+    /// Steps whose torque was clipped at an effort limit.
+    pub saturated_steps: u64,
+    /// Commands lost on the way to the motors.
+    pub dropped_commands: u64,
+    /// Steps where no new command reached the motors (lost or late).
+    pub held_commands: u64,
 }
 
 /// Accumulates a [`Summary`] one step at a time.
@@ -73,6 +90,10 @@ pub struct SummaryBuilder {
     breached: u64,
     faults: u64,
     finite: bool,
+    effects_seen: u32,
+    saturated: u64,
+    dropped: u64,
+    held: u64,
 }
 
 impl SummaryBuilder {
@@ -96,13 +117,24 @@ impl SummaryBuilder {
             breached: 0,
             faults: 0,
             finite: true,
+            effects_seen: 0,
+            saturated: 0,
+            dropped: 0,
+            held: 0,
         }
     }
 
     /// Adds one step. NaN anywhere makes `finite` false and, through
     /// `max`/`min` that propagate NaN, shows in the affected figures.
+    /// Errors are judged on the true state: with sensor noise the
+    /// controller's Z1 is not the arm's error.
     pub fn add(&mut self, r: &StepRecord<'_>) {
         self.steps += 1;
+        let e = Effects(r.effects);
+        self.effects_seen |= r.effects;
+        self.saturated += u64::from(e.has(Effects::SATURATED));
+        self.dropped += u64::from(e.has(Effects::COMMAND_DROPPED));
+        self.held += u64::from(e.has(Effects::COMMAND_HELD));
         self.breached += u64::from(r.barrier_breached);
         self.faults += u64::from(r.fault);
         let all_finite = [r.q, r.qd, r.tau, r.z1, r.z2, r.wa_norm]
@@ -112,7 +144,7 @@ impl SummaryBuilder {
         let after = r.t >= self.tc;
         self.after_tc += u64::from(after);
         for i in 0..self.names.len() {
-            let e = r.z1[i].abs();
+            let e = (r.q[i] - r.q_d[i]).abs();
             self.max_ratio[i] = nan_max(self.max_ratio[i], r.z1g[i].abs() / r.kc[i]);
             let tau2 = r.tau[i] * r.tau[i] * self.dt;
             self.effort[i] += tau2;
@@ -154,6 +186,12 @@ impl SummaryBuilder {
             dt_s: self.dt,
             tc_s: self.tc,
             joints,
+            effects: EffectsSummary {
+                active: Effects(self.effects_seen).names(),
+                saturated_steps: self.saturated,
+                dropped_commands: self.dropped,
+                held_commands: self.held,
+            },
             constraint_satisfied_after_tc: satisfied,
             barrier_breached_steps: self.breached,
             fault_steps: self.faults,
@@ -193,9 +231,13 @@ mod tests {
             t,
             q: z1,
             qd: z1,
+            q_measured: z1,
+            qd_measured: z1,
             qdd: z1,
             tau,
-            q_d: z1,
+            disturbance: tau,
+            effects: 0,
+            q_d: &[0.0],
             qd_d: z1,
             kc,
             z1,

@@ -76,8 +76,8 @@ impl Verifier {
             let n = self.n;
             let input = ControllerInput {
                 t: ns_to_s(s.header.t_ns),
-                q: &s.q[..n],
-                qd: &s.qd[..n],
+                q: &s.q_measured[..n],
+                qd: &s.qd_measured[..n],
                 q_d: &d.q_d[..n],
                 qd_d: &d.qd_d[..n],
                 kc: &d.kc_in[..n],

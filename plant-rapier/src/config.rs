@@ -343,6 +343,42 @@ impl PlantConfig {
         Ok(())
     }
 
+    /// The effects this configuration turns on (those a state can show
+    /// without depending on the run: saturation shows when it happens).
+    pub fn configured_effects(&self) -> crate::Effects {
+        use crate::Effects as E;
+        let d = &self.disturbance;
+        let s = &self.sensor;
+        let a = &self.actuation;
+        let mut bits = 0;
+        for (on, bit) in [
+            (
+                !(self.friction.viscous.is_zero() && self.friction.coulomb.is_zero()),
+                E::FRICTION,
+            ),
+            (self.payload.is_some(), E::PAYLOAD),
+            (
+                !(d.constant.is_zero()
+                    && d.step.is_zero()
+                    && d.sin_amplitude.is_zero()
+                    && d.noise_std.is_zero()),
+                E::DISTURBANCE,
+            ),
+            (
+                !(s.q_noise_std.is_zero() && s.qd_noise_std.is_zero()),
+                E::SENSOR_NOISE,
+            ),
+            (!s.q_resolution.is_zero(), E::QUANTISED),
+            (a.delay_periods > 0, E::DELAYED),
+            (a.drop_probability > 0.0, E::COMMAND_DROPPED),
+        ] {
+            if on {
+                bits |= bit;
+            }
+        }
+        E(bits)
+    }
+
     /// Checks the per-joint lengths against an arm of `n` joints and the
     /// payload's link against `link_names`.
     pub fn check_for(&self, n: usize, link_names: &[String]) -> Result<(), PlantError> {

@@ -97,7 +97,10 @@ impl Scenario {
         let mut s = Scenario {
             name: format!("default for {}", model.name),
             duration_s: 10.0,
-            reference: ReferenceConfig { joints: reference },
+            reference: ReferenceConfig {
+                joints: reference,
+                rate_hz: None,
+            },
             envelope: EnvelopeConfig {
                 joints: envelope,
                 from_limits: false,

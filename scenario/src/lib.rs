@@ -123,6 +123,9 @@ pub struct Scenario {
     pub duration_s: f64,
     /// Control and plant rate (default: 1000, Hz).
     pub rate_hz: f64,
+    /// Seed of every random effect (sensor noise, disturbance noise, lost
+    /// commands); the same seed reproduces a run bit for bit (default: 0).
+    pub seed: u64,
     /// Initial state.
     pub initial: Initial,
     /// Reference q_d(t).
@@ -131,7 +134,7 @@ pub struct Scenario {
     pub envelope: EnvelopeConfig,
     /// Controller parameters (SPEC §11).
     pub controller: ControllerParams,
-    /// Plant integration settings.
+    /// Plant integration settings and effects.
     pub plant: PlantConfig,
 }
 
@@ -142,6 +145,7 @@ impl Default for Scenario {
             robot: None,
             duration_s: 20.0,
             rate_hz: 1000.0,
+            seed: 0,
             initial: Initial::default(),
             reference: ReferenceConfig::paper(),
             envelope: EnvelopeConfig::paper(),
@@ -230,6 +234,8 @@ pub struct Plan {
     pub reference: Reference,
     /// Control period in integer nanoseconds.
     pub period_ns: u64,
+    /// Period of the reference samples in integer nanoseconds.
+    pub reference_period_ns: u64,
     /// Number of control steps.
     pub steps: u64,
 }
@@ -259,6 +265,12 @@ impl Plan {
     /// Sim time of step `k` in nanoseconds.
     pub fn t_ns(&self, k: u64) -> u64 {
         k * self.period_ns
+    }
+
+    /// Time of the newest reference sample at or before `t_ns`: the one a
+    /// controller at `t_ns` uses.
+    pub fn reference_t_ns(&self, t_ns: u64) -> u64 {
+        t_ns / self.reference_period_ns * self.reference_period_ns
     }
 }
 
@@ -298,6 +310,15 @@ impl Scenario {
             return Err(invalid(
                 "rate_hz",
                 self.rate_hz,
+                "a rate from 1 to 100000 Hz",
+            ));
+        }
+        if let Some(r) = self.reference.rate_hz
+            && !(1.0..=100_000.0).contains(&r)
+        {
+            return Err(invalid(
+                "reference.rate_hz",
+                r,
                 "a rate from 1 to 100000 Hz",
             ));
         }
@@ -451,7 +472,18 @@ pub fn plan(
         file: source.clone(),
         cause,
     })?;
+    scenario
+        .plant
+        .check_for(dof, &model.link_names())
+        .map_err(|cause| ScenarioError::Plant {
+            file: source.clone(),
+            cause,
+        })?;
     let period_ns = (1e9 / scenario.rate_hz).round() as u64;
+    let reference_period_ns = match scenario.reference.rate_hz {
+        Some(r) => (1e9 / r).round() as u64,
+        None => period_ns,
+    };
     let steps = (scenario.duration_s * 1e9 / period_ns as f64).round() as u64;
     Ok(Plan {
         scenario,
@@ -460,6 +492,7 @@ pub fn plan(
         robot,
         reference,
         period_ns,
+        reference_period_ns,
         steps,
     })
 }

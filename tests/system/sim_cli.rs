@@ -69,10 +69,13 @@ fn csv_has_one_round_tripping_row_per_step() {
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let mut want = vec!["t".to_string()];
     for i in 0..2 {
-        for c in ["q", "qd", "qdd", "tau", "qref", "kc", "z1_", "z2_", "wa"] {
+        for c in [
+            "q", "qd", "qdd", "tau", "qref", "kc", "z1_", "z2_", "wa", "qm", "qdm", "d",
+        ] {
             want.push(format!("{c}{i}"));
         }
     }
+    want.push("effects".into());
     assert_eq!(header, want);
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())

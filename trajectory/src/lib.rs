@@ -95,6 +95,11 @@ pub enum TrajectoryError {
 pub struct ReferenceConfig {
     /// q_d,i(t) per joint (rad or m).
     pub joints: Vec<Sinusoid>,
+    /// Rate at which the trajectory publishes samples, Hz (default: unset,
+    /// the control rate). The controller uses the newest sample not later
+    /// than the state, so a slower reference is held between samples.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_hz: Option<f64>,
 }
 
 impl ReferenceConfig {
@@ -115,6 +120,7 @@ impl ReferenceConfig {
                     omega: 1.0,
                 },
             ],
+            rate_hz: None,
         }
     }
 }

@@ -37,20 +37,32 @@ pub const STATE_FINAL: u32 = 1;
 /// The plant's state at step `header.seq` (t_k = k Δt).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("testbed.JointState.v1")]
+#[type_name("testbed.JointState.v2")]
 pub struct JointState {
     /// seq = k, t_ns = t_k.
     pub header: Header,
     /// Joints in use.
     pub dof: u32,
-    /// [`STATE_FINAL`] and, later, which plant effects are active.
+    /// [`STATE_FINAL`].
     pub flags: u32,
-    /// Joint positions q(t_k).
+    /// The true joint positions q(t_k) (for analysis; the controller gets
+    /// `q_measured`).
     pub q: Joints,
-    /// Joint velocities q̇(t_k).
+    /// The true joint velocities q̇(t_k).
     pub qd: Joints,
-    /// The torque the plant applied over [t_{k−1}, t_k] (zero for k = 0).
+    /// What the position sensors report (noise, quantisation).
+    pub q_measured: Joints,
+    /// What the velocity sensors report.
+    pub qd_measured: Joints,
+    /// The motor torque the plant applied over [t_{k−1}, t_k] (zero for k = 0).
     pub tau_applied: Joints,
+    /// The disturbance d applied over [t_{k−1}, t_k].
+    pub disturbance: Joints,
+    /// Which plant effects acted on this state: the bits of
+    /// `plant_rapier::Effects` (friction, payload, saturated, …).
+    pub effects: u32,
+    /// Padding (keeps the layout explicit).
+    pub reserved: u32,
     /// Deadline misses so far (real-time mode).
     pub deadline_misses: u64,
 }

@@ -177,7 +177,10 @@ fn trim(j: &Joints, dof: u32) -> &[f64] {
 impl LogMessage for JointState {
     const TOPIC: &'static str = "/joint_state";
     const SCHEMA: &'static str = "testbed.JointState";
-    const ABOUT: &'static str = "The plant's state at step seq (t = seq x period).";
+    const ABOUT: &'static str = "The plant's state at step seq (t = seq x period): q, qd true; \
+        q_measured, qd_measured as the sensors report them; effects: bits 0 friction, \
+        1 payload, 2 disturbance, 3 saturated, 4 sensor_noise, 5 quantised, 6 delayed, \
+        7 command_dropped, 8 command_held.";
     fn header(&self) -> Header {
         self.header
     }
@@ -188,7 +191,11 @@ impl LogMessage for JointState {
             ("flags", Field::U(self.flags.into())),
             ("q", Field::J(trim(&self.q, d))),
             ("qd", Field::J(trim(&self.qd, d))),
+            ("q_measured", Field::J(trim(&self.q_measured, d))),
+            ("qd_measured", Field::J(trim(&self.qd_measured, d))),
             ("tau_applied", Field::J(trim(&self.tau_applied, d))),
+            ("disturbance", Field::J(trim(&self.disturbance, d))),
+            ("effects", Field::U(self.effects.into())),
             ("deadline_misses", Field::U(self.deadline_misses)),
         ]
     }
@@ -199,7 +206,12 @@ impl LogMessage for JointState {
             flags: m.u32("flags")?,
             q: m.j("q")?,
             qd: m.j("qd")?,
+            q_measured: m.j("q_measured")?,
+            qd_measured: m.j("qd_measured")?,
             tau_applied: m.j("tau_applied")?,
+            disturbance: m.j("disturbance")?,
+            effects: m.u32("effects")?,
+            reserved: 0,
             deadline_misses: m.u("deadline_misses")?,
         })
     }

@@ -37,6 +37,10 @@ pub struct RunMetadata {
     pub joint_names: Vec<String>,
     /// Wall-clock start, ns since the Unix epoch.
     pub start_time_unix_ns: u64,
+    /// The seed of every random effect.
+    pub seed: u64,
+    /// The plant effects the scenario turns on, by name.
+    pub plant_effects: Vec<&'static str>,
 }
 
 impl RunMetadata {
@@ -49,6 +53,8 @@ impl RunMetadata {
             ("scenario_source".into(), self.scenario_source.clone()),
             ("robot".into(), self.robot.clone()),
             ("joint_names".into(), self.joint_names.join(",")),
+            ("seed".into(), self.seed.to_string()),
+            ("plant_effects".into(), self.plant_effects.join(",")),
             (
                 "start_time_unix_ns".into(),
                 self.start_time_unix_ns.to_string(),

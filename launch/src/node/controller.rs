@@ -30,7 +30,8 @@ impl RefSource {
     /// Fills the reference for sim time `t_ns`; false if none is available.
     fn fill(&mut self, plan: &scenario::Plan, t_ns: u64) -> Result<bool, NodeError> {
         let Some((sub, recent)) = self.topic.as_mut() else {
-            plan.reference.sample_into(ns_to_s(t_ns), &mut self.buf);
+            let t_ref = plan.reference_t_ns(t_ns);
+            plan.reference.sample_into(ns_to_s(t_ref), &mut self.buf);
             return Ok(true);
         };
         while let Some(r) = sub.receive()? {
@@ -103,8 +104,8 @@ pub fn run(ctx: &mut NodeContext) -> Result<(), NodeError> {
                 let r = &reference.buf;
                 let input = ControllerInput {
                     t: ns_to_s(s.header.t_ns),
-                    q: &s.q[..n],
-                    qd: &s.qd[..n],
+                    q: &s.q_measured[..n],
+                    qd: &s.qd_measured[..n],
                     q_d: &r.q_d,
                     qd_d: &r.qd_d,
                     kc: &r.kc,

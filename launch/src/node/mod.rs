@@ -231,6 +231,8 @@ fn logger_metadata(ctx: &NodeContext, out: &std::path::Path) -> crate::log::RunM
         scenario_source: plan.source.clone(),
         robot: plan.robot.label(),
         joint_names: plan.robot.model.joint_names(),
+        seed: plan.scenario.seed,
+        plant_effects: plan.scenario.plant.configured_effects().names(),
         start_time_unix_ns: std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(0, |d| d.as_nanos() as u64),

@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use plant_rapier::Plant;
+use plant_rapier::Rig;
 use wire::{
     Command, Delivery, Header, JointState, MAX_DOF, NODE_RUNNING, STATE_FINAL, Timing, Topic,
     TopicPublisher, TopicSubscriber, joints, monotonic_ns,
@@ -24,20 +24,24 @@ struct Ports {
 
 /// What the plant knows at each step.
 struct Stepper {
-    plant: Plant,
+    rig: Rig,
     n: usize,
-    dt: f64,
     period_ns: u64,
     steps: u64,
     q: Vec<f64>,
     qd: Vec<f64>,
-    tau: Vec<f64>,
+    q_meas: Vec<f64>,
+    qd_meas: Vec<f64>,
     misses: u64,
 }
 
 impl Stepper {
+    /// State k as published: the true state, the sensors' reading (drawn
+    /// here, once per state) and the effects of the period that led to it.
     fn state_msg(&mut self, k: u64) -> JointState {
-        self.plant.state_into(&mut self.q, &mut self.qd);
+        self.rig.true_state_into(&mut self.q, &mut self.qd);
+        self.rig.measure_into(&mut self.q_meas, &mut self.qd_meas);
+        let first = k == 0;
         JointState {
             header: Header {
                 seq: k,
@@ -48,31 +52,38 @@ impl Stepper {
             flags: if k == self.steps { STATE_FINAL } else { 0 },
             q: joints(&self.q),
             qd: joints(&self.qd),
-            // What the plant really applied: the command after saturation.
-            tau_applied: if k == 0 {
+            q_measured: joints(&self.q_meas),
+            qd_measured: joints(&self.qd_meas),
+            // What the plant really applied: the command after delay, loss
+            // and saturation.
+            tau_applied: if first {
                 [0.0; MAX_DOF]
             } else {
-                joints(self.plant.applied_torque())
+                joints(self.rig.applied_torque())
             },
+            disturbance: if first {
+                [0.0; MAX_DOF]
+            } else {
+                joints(self.rig.disturbance())
+            },
+            effects: self.rig.effects().0,
+            reserved: 0,
             deadline_misses: self.misses,
         }
     }
 
-    /// Takes the torque of `cmd`; a command the plant cannot apply is a fault.
-    fn take(&mut self, cmd: &Command) -> Result<(), NodeError> {
-        if cmd.dof as usize != self.n {
+    /// Steps one period with `cmd` (None: no new command, the last is held);
+    /// a command the plant cannot apply is a fault.
+    fn step(&mut self, cmd: Option<&Command>) -> Result<(), NodeError> {
+        if let Some(c) = cmd
+            && c.dof as usize != self.n
+        {
             return Err(NodeError::Protocol(format!(
                 "command {} has {} joints, the arm {}",
-                cmd.header.seq, cmd.dof, self.n
+                c.header.seq, c.dof, self.n
             )));
         }
-        self.tau.copy_from_slice(&cmd.tau[..self.n]);
-        Ok(())
-    }
-
-    /// Steps the arm over one period with the held command.
-    fn step(&mut self) -> Result<(), NodeError> {
-        self.plant.step(&self.tau, self.dt)?;
+        self.rig.step(cmd.map(|c| &c.tau[..self.n]))?;
         Ok(())
     }
 }
@@ -81,9 +92,9 @@ impl Stepper {
 pub fn run(ctx: &mut NodeContext) -> Result<(), NodeError> {
     let plan = ctx.plan.clone();
     let s = &plan.scenario;
-    let mut plant = Plant::new(&plan.robot.model, &s.plant)?;
-    plant.set_state(&s.initial.q, &s.initial.qd)?;
-    let n = plant.dof();
+    let mut rig = Rig::new(&plan.robot.model, &s.plant, s.seed, plan.period_ns)?;
+    rig.set_state(&s.initial.q, &s.initial.qd)?;
+    let n = rig.dof();
     let delivery = match ctx.mode {
         Mode::Lockstep => Delivery::Lossless,
         Mode::Realtime => Delivery::DropWhenFull,
@@ -94,14 +105,14 @@ pub fn run(ctx: &mut NodeContext) -> Result<(), NodeError> {
         command: ctx.bus.subscriber(Topic::Command)?,
     };
     let mut st = Stepper {
-        plant,
+        rig,
         n,
-        dt: plan.dt(),
         period_ns: plan.period_ns,
         steps: plan.steps,
         q: vec![0.0; n],
         qd: vec![0.0; n],
-        tau: vec![0.0; n],
+        q_meas: vec![0.0; n],
+        qd_meas: vec![0.0; n],
         misses: 0,
     };
     let epoch = ctx.ready_and_wait_for_start()?;
@@ -117,8 +128,7 @@ fn lockstep(ctx: &mut NodeContext, ports: &Ports, st: &mut Stepper) -> Result<()
     ports.state.send(state)?;
     for k in 0..st.steps {
         let cmd = wait_for_command(ctx, &ports.command, k)?;
-        st.take(&cmd)?;
-        st.step()?;
+        st.step(Some(&cmd))?;
         ports.timing.send(Timing {
             header: Header {
                 seq: k,
@@ -174,6 +184,7 @@ fn realtime(
     ports.state.send(state)?;
     let mut last_wake = monotonic_ns();
     let mut latest: Option<Command> = None;
+    let mut taken_seq: Option<u64> = None;
     for k in 1..=st.steps {
         let deadline = epoch + k * st.period_ns;
         clock::sleep_until(deadline);
@@ -189,11 +200,13 @@ fn realtime(
         if missed {
             st.misses += 1;
         }
-        // Zero-order hold: a missing command keeps the newest one received.
-        if let Some(c) = latest {
-            st.take(&c)?;
+        // A command not taken before goes to the actuators; without one
+        // they hold the last (zero-order hold).
+        let fresh = latest.filter(|c| taken_seq.is_none_or(|s| c.header.seq > s));
+        if let Some(c) = fresh {
+            taken_seq = Some(c.header.seq);
         }
-        st.step()?;
+        st.step(fresh.as_ref())?;
         ports.timing.send(Timing {
             header: Header {
                 seq: k - 1,

@@ -34,22 +34,27 @@ pub fn run(ctx: &mut NodeContext) -> Result<(), NodeError> {
         Mode::Realtime => None,
     };
     let mut buf = RefBuf::new(n);
-    let mut publish = |k: u64| -> Result<(), NodeError> {
-        let t_ns = plan.t_ns(k);
+    // Sample j describes t_j = j × the reference period (the control period
+    // unless the scenario sets `reference.rate_hz`).
+    let ref_period = plan.reference_period_ns;
+    let mut publish = |j: u64| -> Result<(), NodeError> {
+        let t_ns = j * ref_period;
         plan.reference.sample_into(ns_to_s(t_ns), &mut buf);
-        send(&out, &buf, k, t_ns)
+        send(&out, &buf, j, t_ns)
     };
     let epoch = ctx.ready_and_wait_for_start()?;
-    let last = plan.steps; // samples for t_0 … t_steps
+    let end_ns = plan.t_ns(plan.steps);
+    let last = end_ns / ref_period; // samples for t_0 … the end of the run
     match states {
         None => {
             clock::tighten_timer_slack();
             publish(0)?;
-            for k in 1..=last {
-                // Sample k goes out at the deadline of step k−1: one period early.
-                clock::sleep_until(epoch + (k - 1) * plan.period_ns);
-                publish(k)?;
-                if k % 32 == 0 {
+            for j in 1..=last {
+                // Each sample goes out one control period before its time.
+                let due = (j * ref_period).saturating_sub(plan.period_ns);
+                clock::sleep_until(epoch + due);
+                publish(j)?;
+                if j % 32 == 0 {
                     ctx.check()?;
                 }
             }
@@ -59,11 +64,11 @@ pub fn run(ctx: &mut NodeContext) -> Result<(), NodeError> {
             while next <= last {
                 let mut newest = None;
                 while let Some(s) = states.receive()? {
-                    newest = Some(s.header.seq);
+                    newest = Some(s.header.t_ns);
                 }
                 states.drain_events()?;
-                if let Some(seq) = newest {
-                    while next <= seq.min(last) {
+                if let Some(t_ns) = newest {
+                    while next <= last && next * ref_period <= t_ns {
                         publish(next)?;
                         next += 1;
                     }
