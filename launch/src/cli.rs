@@ -45,6 +45,8 @@ enum Command {
     Bench(BenchArgs),
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
     Replay(ReplayArgs),
+    /// List the shipped scenarios and what each one demonstrates.
+    Scenarios,
     /// Run one node of a stack (the launcher starts these; start one by hand
     /// with `testbed run --external <node>` to debug or replace it).
     Node {
@@ -77,8 +79,9 @@ impl NodeName {
 
 #[derive(Debug, Args)]
 struct ScenarioArgs {
-    /// Scenario file (TOML) [default: the built-in paper scenario, scenarios/paper.toml].
-    #[arg(long, value_name = "FILE")]
+    /// Scenario file (TOML), or the name of a shipped one (`testbed
+    /// scenarios` lists them) [default: the paper's, scenarios/paper.toml].
+    #[arg(long, value_name = "FILE|NAME")]
     scenario: Option<PathBuf>,
     /// Run this arm (URDF) instead of the scenario's; with no --scenario,
     /// the default scenario for the arm (see `testbed robot`).
@@ -172,6 +175,10 @@ pub fn run() -> Result<ExitCode> {
         Command::Run(args) => run_stack(args),
         Command::Replay(args) => replay(args),
         Command::Bench(args) => bench(args),
+        Command::Scenarios => {
+            print!("{}", scenario_list());
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Robot { path } => {
             print!("{}", crate::robot_info::describe(&path)?);
             Ok(ExitCode::SUCCESS)
@@ -190,7 +197,42 @@ fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario::Plan> {
         rate_hz: rate,
         robot: common.robot.clone(),
     };
-    Ok(scenario::load(common.scenario.as_deref(), &overrides)?)
+    let path = common.scenario.as_deref().map(resolve_scenario);
+    Ok(scenario::load(path.as_deref(), &overrides)?)
+}
+
+/// A scenario argument that is not a file but names a shipped scenario
+/// becomes that scenario's file.
+fn resolve_scenario(arg: &std::path::Path) -> PathBuf {
+    if arg.exists() || arg.components().count() > 1 {
+        return arg.to_path_buf();
+    }
+    match arg.to_str().and_then(scenario::find_shipped) {
+        Some(s) => s.path(),
+        None => arg.to_path_buf(),
+    }
+}
+
+/// `testbed scenarios`: name, file and what each shipped scenario shows.
+fn scenario_list() -> String {
+    let mut out = String::new();
+    for s in scenario::SHIPPED {
+        out.push_str(&format!("{}\n    {}\n", s.name, s.path().display()));
+        let mut line = String::from("   ");
+        for word in s.about().split_whitespace() {
+            if line.len() + word.len() > 76 {
+                out.push_str(&line);
+                out.push('\n');
+                line = String::from("   ");
+            }
+            line.push(' ');
+            line.push_str(word);
+        }
+        out.push_str(&line);
+        out.push_str("\n\n");
+    }
+    out.push_str("Run one with `testbed sim --scenario NAME` or `testbed run --scenario NAME`.\n");
+    out
 }
 
 fn print_report(report: &Report, json: bool) -> Result<()> {

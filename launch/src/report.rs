@@ -173,6 +173,17 @@ pub fn table(r: &Report) -> String {
         s.fault_steps,
         if s.finite { "yes" } else { "NO" }
     );
+    let e = &s.effects;
+    let active = if e.active.is_empty() {
+        "none".to_string()
+    } else {
+        e.active.join(", ")
+    };
+    let _ = writeln!(
+        out,
+        "plant effects: {active}; saturated {} steps, commands lost {}, held {}",
+        e.saturated_steps, e.dropped_commands, e.held_commands
+    );
     if let Some(t) = &r.timing {
         let _ = writeln!(
             out,

@@ -13,6 +13,7 @@
 //! assert_eq!(s.duration_s, 20.0); // the paper's default
 //! ```
 
+mod catalogue;
 mod default_for_arm;
 
 use std::path::{Path, PathBuf};
@@ -22,6 +23,7 @@ use plant_rapier::{ArmModel, PlantConfig, PlantError};
 use serde::{Deserialize, Serialize};
 use trajectory::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError};
 
+pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
 pub use default_for_arm::max_inverse_inertia;
 
 /// The paper's scenario as shipped in `scenarios/paper.toml`.

@@ -5,5 +5,6 @@
 mod log_replay;
 mod robots;
 mod run_cli;
+mod scenarios;
 mod sim_cli;
 mod util;

@@ -1,0 +1,224 @@
+//! The shipped scenarios and the plant effects they turn on, end to end.
+
+use std::path::Path;
+
+use crate::util::{fails, json, ok, repo_root, testbed};
+
+/// Every shipped scenario, as listed by `testbed scenarios`.
+fn shipped() -> Vec<String> {
+    let out = ok(testbed().arg("scenarios"));
+    let text = String::from_utf8(out.stdout).unwrap();
+    text.lines()
+        .filter(|l| !l.starts_with(' ') && !l.is_empty() && !l.starts_with("Run "))
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn scenarios_lists_every_file_with_what_it_shows() {
+    let listed = shipped();
+    let mut files: Vec<String> = std::fs::read_dir(repo_root().join("scenarios"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter_map(|f| f.strip_suffix(".toml").map(str::to_string))
+        .collect();
+    files.sort();
+    let mut sorted = listed.clone();
+    sorted.sort();
+    assert_eq!(sorted, files);
+    let text = String::from_utf8(ok(testbed().arg("scenarios")).stdout).unwrap();
+    assert!(text.contains("payload_pickup") && text.contains("2 kg mass"));
+}
+
+/// The controller keeps every shipped scenario inside its envelope after
+/// T_c, with finite signals, and each scenario's effects show in the
+/// summary. Runs by name, as the README says.
+#[test]
+fn every_shipped_scenario_keeps_its_envelope() {
+    for name in shipped() {
+        let s = json(&ok(testbed().args(["sim", "--json", "--scenario", &name])));
+        assert_eq!(s["finite"], true, "{name}: {s}");
+        assert_eq!(s["constraint_satisfied_after_tc"], true, "{name}: {s}");
+        let active: Vec<&str> = s["effects"]["active"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap())
+            .collect();
+        let want: &[&str] = match name.as_str() {
+            "payload_pickup" => &["payload"],
+            "friction_noise" => &["friction", "sensor_noise", "quantised"],
+            "disturbance" => &["disturbance"],
+            "actuation_delay" => &["delayed", "command_dropped", "command_held"],
+            "tight_envelope" => &["disturbance"],
+            "saturation_slow_reference" => &["saturated"],
+            _ => &[],
+        };
+        for w in want {
+            assert!(active.contains(w), "{name}: {w} not in {active:?}");
+        }
+    }
+}
+
+fn csv_of(args: &[&str], dir: &Path, name: &str) -> Vec<u8> {
+    let path = dir.join(name);
+    ok(testbed().args(args).arg("--csv").arg(&path));
+    std::fs::read(&path).unwrap()
+}
+
+/// Every random effect at once (sensor noise, quantisation, disturbance
+/// noise, lost commands, delay, friction, a payload picked up): the four
+/// processes in lockstep give the in-process loop's bits; the same seed
+/// gives the same run; another seed another run.
+#[test]
+fn seeded_effects_reproduce_exactly_across_processes_and_seeds_differ() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = |seed: u64| {
+        let path = dir.path().join(format!("all_effects_{seed}.toml"));
+        std::fs::write(
+            &path,
+            format!(
+                "name = \"all_effects\"\nseed = {seed}\nduration_s = 3.0\n\
+                 [reference]\nrate_hz = 250.0\njoints = [{{ sin = 1.0, omega = 2.0 }}, {{ cos = 1.0, omega = 1.0 }}]\n\
+                 [plant.friction]\nviscous = 0.2\ncoulomb = 0.3\n\
+                 [plant.payload]\nlink = \"link2\"\nmass = 0.5\noffset = [0.31, 0.0, 0.0]\nattach_at_s = 1.5\n\
+                 [plant.disturbance]\nnoise_std = 0.5\nsin_amplitude = 1.0\n\
+                 [plant.sensor]\nq_noise_std = 0.0005\nqd_noise_std = 0.01\nq_resolution = 0.001\n\
+                 [plant.actuation]\ndelay_periods = 1\ndrop_probability = 0.1\n"
+            ),
+        )
+        .unwrap();
+        path.display().to_string()
+    };
+    let (s1, s2) = (scenario(1), scenario(2));
+    let sim1 = csv_of(&["sim", "--scenario", &s1], dir.path(), "sim1.csv");
+    let again = csv_of(&["sim", "--scenario", &s1], dir.path(), "again.csv");
+    let sim2 = csv_of(&["sim", "--scenario", &s2], dir.path(), "sim2.csv");
+    assert!(sim1 == again, "the same seed gave a different run");
+    assert!(sim1 != sim2, "seeds 1 and 2 gave the same run");
+    let runs = dir.path().join("runs");
+    let lockstep = csv_of(
+        &[
+            "run",
+            "--mode",
+            "lockstep",
+            "--scenario",
+            &s1,
+            "--runs-dir",
+            runs.to_str().unwrap(),
+        ],
+        dir.path(),
+        "lockstep.csv",
+    );
+    assert!(sim1 == lockstep, "lockstep differs from sim");
+    // Every effect left its mark in the rows.
+    let text = String::from_utf8(sim1).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "effects").unwrap();
+    let seen = lines
+        .map(|l| l.split(',').nth(col).unwrap().parse::<u32>().unwrap())
+        .fold(0, |a, b| a | b);
+    // friction, payload, disturbance, sensor noise, quantised, delayed,
+    // command dropped, command held.
+    assert_eq!(seen & 0b1_1111_0111, 0b1_1111_0111, "{seen:b}");
+}
+
+/// The seed and every effect setting travel with the log.
+#[test]
+fn the_log_records_the_seed_and_the_effects() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = json(&ok(testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--scenario",
+            "friction_noise",
+            "--duration",
+            "0.3",
+            "--json",
+            "--runs-dir",
+        ])
+        .arg(dir.path())));
+    let buf = std::fs::read(s["log"].as_str().unwrap()).unwrap();
+    let summary = mcap::Summary::read(&buf).unwrap().unwrap();
+    let idx = summary
+        .metadata_indexes
+        .iter()
+        .find(|m| m.name == "testbed.run")
+        .unwrap();
+    let meta = mcap::read::metadata(&buf, idx).unwrap().metadata;
+    assert_eq!(meta["seed"], "7");
+    assert_eq!(meta["plant_effects"], "friction,sensor_noise,quantised");
+    let toml = &meta["scenario_toml"];
+    for key in [
+        "seed = 7",
+        "[plant.friction]",
+        "coulomb = [1.0, 0.5]",
+        "q_noise_std = 0.0005",
+    ] {
+        assert!(toml.contains(key), "scenario_toml lacks {key}:\n{toml}");
+    }
+    // And each logged state says what acted on it.
+    let state = mcap::MessageStream::new(&buf)
+        .unwrap()
+        .map(|m| m.unwrap())
+        .find(|m| m.channel.topic == "/joint_state")
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&state.data).unwrap();
+    assert_eq!(v["effects"], 0b11_0001);
+    assert_ne!(v["q"], v["q_measured"]);
+}
+
+#[test]
+fn bad_effect_settings_name_the_file_and_key() {
+    let dir = tempfile::tempdir().unwrap();
+    for (text, key) in [
+        (
+            "[plant.payload]\nlink = \"hand\"\nmass = 1.0\n",
+            "plant.payload.link",
+        ),
+        (
+            "[plant.payload]\nlink = \"link2\"\nmass = -1.0\n",
+            "plant.payload.mass",
+        ),
+        (
+            "[plant.friction]\nviscous = [0.1, 0.2, 0.3]\n",
+            "plant.friction.viscous",
+        ),
+        (
+            "[plant.friction]\ncoulomb = nan\n",
+            "plant.friction.coulomb",
+        ),
+        (
+            "[plant.sensor]\nq_noise_std = -0.1\n",
+            "plant.sensor.q_noise_std",
+        ),
+        (
+            "[plant.actuation]\ndrop_probability = 1.5\n",
+            "plant.actuation.drop_probability",
+        ),
+        (
+            "[plant.disturbance]\nnoise_bandwidth_hz = 0.0\n",
+            "plant.disturbance.noise_bandwidth_hz",
+        ),
+        (
+            "[plant]\neffort_limit = [1.0, inf]\n",
+            "plant.effort_limit[1]",
+        ),
+        (
+            "[reference]\nrate_hz = 0.5\njoints = [{}, {}]\n",
+            "reference.rate_hz",
+        ),
+        ("[plant.sensor]\nnoise = 1.0\n", "noise"),
+    ] {
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, text).unwrap();
+        let err = fails(testbed().args(["sim", "--scenario"]).arg(&path));
+        assert!(
+            err.contains("bad.toml") && err.contains(key),
+            "{text}: {err}"
+        );
+    }
+}
