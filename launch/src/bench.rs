@@ -16,8 +16,10 @@ use serde::Serialize;
 use crate::clock;
 use crate::closed_loop::{self, StepCosts};
 use crate::mode::Mode;
+use crate::node::placement::{self, Placement};
 use crate::run::timing::{Percentiles, TimingStats};
 use crate::run::{self, RunError, RunOptions};
+use wire::NodeKind;
 
 /// What to measure.
 #[derive(Debug, Clone)]
@@ -32,6 +34,10 @@ pub struct BenchOptions {
     pub duration_s: Option<f64>,
     /// The largest shipped arm.
     pub large_arm: PathBuf,
+    /// Place the nodes as `testbed run` does by default (pinned, and in
+    /// real time SCHED_FIFO with locked memory); the timer floor then runs
+    /// with the plant's placement, so that the two compare like for like.
+    pub realtime_setup: bool,
 }
 
 /// Why a bench failed.
@@ -83,6 +89,8 @@ pub struct TimerFloor {
     pub deadline_misses: u64,
     /// |actual − nominal period|, µs.
     pub period_jitter_us: Percentiles,
+    /// What the system refused of the plant's placement (empty: all applied).
+    pub placement_refused: Vec<String>,
 }
 
 /// Figures for one arm.
@@ -119,6 +127,8 @@ pub struct BenchReport {
     pub machine: Machine,
     /// Repeats per part.
     pub repeats: usize,
+    /// Whether the nodes were pinned and, in real time, ran under SCHED_FIFO.
+    pub realtime_setup: bool,
     /// The paper scenario's figures, at the top level of the JSON.
     #[serde(flatten)]
     pub paper: ArmBench,
@@ -156,8 +166,24 @@ pub fn machine() -> Machine {
     }
 }
 
-/// A bare absolute-deadline loop at `rate_hz` for `seconds`.
-pub fn timer_floor(rate_hz: f64, seconds: f64) -> TimerFloor {
+/// A bare absolute-deadline loop at `rate_hz` for `seconds`, in a thread
+/// of its own placed as `placement` says.
+pub fn timer_floor(rate_hz: f64, seconds: f64, placement: &Placement) -> TimerFloor {
+    let placement = placement.clone();
+    std::thread::scope(|s| {
+        s.spawn(move || {
+            let refused = placement.apply();
+            TimerFloor {
+                placement_refused: refused,
+                ..sleep_loop(rate_hz, seconds)
+            }
+        })
+        .join()
+        .unwrap_or_else(|_| sleep_loop(rate_hz, seconds))
+    })
+}
+
+fn sleep_loop(rate_hz: f64, seconds: f64) -> TimerFloor {
     clock::tighten_timer_slack();
     let period = (1e9 / rate_hz).round() as u64;
     let cycles = (seconds * rate_hz).round() as u64;
@@ -185,6 +211,7 @@ pub fn timer_floor(rate_hz: f64, seconds: f64) -> TimerFloor {
         cycles,
         deadline_misses: misses,
         period_jitter_us: t.period_jitter_us,
+        placement_refused: Vec::new(),
     }
 }
 
@@ -207,6 +234,7 @@ fn stack(plan: &Plan, mode: Mode, opts: &BenchOptions) -> Result<run::RunOutcome
         external: Vec::new(),
         runs_dir: opts.runs_dir.clone(),
         progress: false,
+        realtime_setup: opts.realtime_setup,
     })?)
 }
 
@@ -289,10 +317,17 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
         "timer floor: bare sleep loop, {} s",
         opts.realtime_s
     ));
-    let floor = timer_floor(paper.scenario.rate_hz, opts.realtime_s);
+    let placement = if opts.realtime_setup {
+        let cpus = std::thread::available_parallelism().map_or(1, usize::from);
+        placement::for_node(NodeKind::Plant, Mode::Realtime, cpus)
+    } else {
+        Placement::default()
+    };
+    let floor = timer_floor(paper.scenario.rate_hz, opts.realtime_s, &placement);
     Ok(BenchReport {
         machine: machine(),
         repeats: opts.repeats,
+        realtime_setup: opts.realtime_setup,
         paper: arms[0].clone(),
         timer_floor: floor,
         arms,

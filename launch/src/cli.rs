@@ -120,6 +120,10 @@ struct RunArgs {
     /// Folder for run folders.
     #[arg(long, value_name = "DIR", default_value = "runs")]
     runs_dir: PathBuf,
+    /// Leave the nodes where the OS puts them: no CPU pinning, and in real
+    /// time no SCHED_FIFO and no locked memory.
+    #[arg(long)]
+    no_realtime_setup: bool,
 }
 
 #[derive(Debug, Args)]
@@ -142,6 +146,9 @@ struct BenchArgs {
     /// Folder for run folders.
     #[arg(long, value_name = "DIR", default_value = "runs")]
     runs_dir: PathBuf,
+    /// Measure without pinning, SCHED_FIFO or locked memory.
+    #[arg(long)]
+    no_realtime_setup: bool,
 }
 
 #[derive(Debug, Args)]
@@ -298,6 +305,7 @@ fn run_stack(args: RunArgs) -> Result<ExitCode> {
         external: args.external.iter().map(|n| n.kind()).collect(),
         runs_dir: args.runs_dir.clone(),
         progress: std::io::stderr().is_terminal(),
+        realtime_setup: !args.no_realtime_setup,
     };
     let outcome = match run::run(opts) {
         Ok(o) => o,
@@ -362,6 +370,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
         runs_dir: args.runs_dir,
         duration_s: args.duration,
         large_arm: args.large_arm,
+        realtime_setup: !args.no_realtime_setup,
     };
     let report = launch::bench::run(&opts, |what| eprintln!("testbed bench: {what}"))?;
     if args.json {

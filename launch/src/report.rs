@@ -233,6 +233,15 @@ pub fn bench_table(b: &launch::bench::BenchReport) -> String {
         "machine: {} ({} CPUs), kernel {}; medians of {} runs",
         m.cpu, m.cores, m.kernel, b.repeats
     );
+    let _ = writeln!(
+        out,
+        "placement: {}",
+        if b.realtime_setup {
+            "plant and controller pinned to one CPU, SCHED_FIFO and locked memory in real time"
+        } else {
+            "left to the OS (--no-realtime-setup)"
+        }
+    );
     for a in &b.arms {
         let _ = writeln!(
             out,
@@ -276,8 +285,11 @@ pub fn bench_table(b: &launch::bench::BenchReport) -> String {
     let f = &b.timer_floor;
     let _ = writeln!(
         out,
-        "\ntimer floor (bare absolute-deadline sleep loop, no IPC, no work):"
+        "\ntimer floor (bare absolute-deadline sleep loop, no IPC, no work, placed as the plant):"
     );
+    for r in &f.placement_refused {
+        let _ = writeln!(out, "  refused: {r}");
+    }
     let _ = writeln!(
         out,
         "  {} cycles, {} late by a whole period or more",

@@ -83,10 +83,10 @@ fn mass_matrix_columns_at_random_states() {
 /// At random moving states with random torques, Rapier's mean acceleration
 /// over one period matches RK4's (the exact mean acceleration of the closed
 /// form, to 1e-12). Rapier's semi-implicit Euler is first order in the
-/// substep: measured worst error 9.3e-4 of the largest acceleration at 8
-/// substeps (1.9e-3 at 4, 7.5e-3 at 1). The bound 2e-3 leaves margin for
-/// other states while still catching a missing Coriolis term (which is of
-/// order 1 here, with |q̇| up to 4 rad/s).
+/// substep: measured worst error 1.5e-3 of the largest acceleration at the
+/// default 6 substeps (1.2e-3 at 8, 2.3e-3 at 4, 7.5e-3 at 1). The bound
+/// 2e-3 leaves margin for other states while still catching a missing
+/// Coriolis term (which is of order 1 here, with |q̇| up to 4 rad/s).
 #[test]
 fn one_step_acceleration_at_random_states() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
@@ -110,8 +110,8 @@ fn one_step_acceleration_at_random_states() {
 }
 
 /// The default substeps keep a 5 s passive swing near the hanging posture
-/// within 1e-3 rad of RK4 (measured 2.9e-5 at 8 substeps; the error is
-/// first order in the substep).
+/// within 1e-3 rad of RK4 (measured 3.9e-5 at 6 substeps, 2.9e-5 at 8; the
+/// error is first order in the substep).
 #[test]
 fn open_loop_swing_near_hanging_tracks_rk4_for_5_s() {
     let mut p = plant(&continuous());
@@ -129,7 +129,8 @@ fn open_loop_swing_near_hanging_tracks_rk4_for_5_s() {
 }
 
 /// From the paper's initial state the passive arm is chaotic, so errors
-/// grow fast; over 0.25 s the measured gap is 4.1e-4 rad at 8 substeps.
+/// grow fast; over 0.25 s the measured gap is 5.4e-4 rad at 6 substeps
+/// (4.1e-4 at 8).
 #[test]
 fn open_loop_from_paper_state_tracks_rk4_briefly() {
     let mut p = plant(&continuous());

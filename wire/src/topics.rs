@@ -55,6 +55,16 @@ impl Topic {
         }
     }
 
+    /// Whether some reader blocks on this topic's wake-ups. The others are
+    /// read by polling (the logger every 10 ms, the controller when a state
+    /// arrives), so their publishers skip the notify syscalls.
+    pub fn has_waiters(self) -> bool {
+        matches!(
+            self,
+            Topic::JointState | Topic::Command | Topic::Control | Topic::Status
+        )
+    }
+
     /// Status has one publisher per node; every other topic has one owner.
     fn max_publishers(self) -> usize {
         match self {
@@ -185,14 +195,15 @@ impl Debug for Bus {
 pub struct TopicPublisher<T: Debug + ZeroCopySend + Copy + 'static> {
     topic: Topic,
     publisher: Publisher<ipc::Service, T, ()>,
-    notifier: Notifier<ipc::Service>,
+    /// None on topics without waiters.
+    notifier: Option<Notifier<ipc::Service>>,
 }
 
-/// A subscriber with its listener.
+/// A subscriber, with its listener unless it is read by polling.
 pub struct TopicSubscriber<T: Debug + ZeroCopySend + Copy + 'static> {
     topic: Topic,
     subscriber: Subscriber<ipc::Service, T, ()>,
-    listener: Listener<ipc::Service>,
+    listener: Option<Listener<ipc::Service>>,
 }
 
 impl Bus {
@@ -301,11 +312,16 @@ impl Bus {
         let publisher = builder
             .create()
             .map_err(|e| ipc("create publisher", topic.name())(format!("{e:?}")))?;
-        let notifier = self
-            .event(topic)?
-            .notifier_builder()
-            .create()
-            .map_err(|e| ipc("create notifier", topic.name())(format!("{e:?}")))?;
+        let notifier = if topic.has_waiters() {
+            Some(
+                self.event(topic)?
+                    .notifier_builder()
+                    .create()
+                    .map_err(|e| ipc("create notifier", topic.name())(format!("{e:?}")))?,
+            )
+        } else {
+            None
+        };
         Ok(TopicPublisher {
             topic,
             publisher,
@@ -313,10 +329,28 @@ impl Bus {
         })
     }
 
-    /// A subscriber on `topic`.
+    /// A subscriber on `topic` that can block until a sample arrives
+    /// ([`TopicSubscriber::wait_event`]); only topics with waiters have
+    /// wake-ups ([`Topic::has_waiters`]).
     pub fn subscriber<T: Debug + ZeroCopySend + Copy + 'static>(
         &self,
         topic: Topic,
+    ) -> Result<TopicSubscriber<T>, WireError> {
+        self.subscriber_with(topic, topic.has_waiters())
+    }
+
+    /// A subscriber read by polling: no listener, so publishers do not wake it.
+    pub fn polling_subscriber<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        topic: Topic,
+    ) -> Result<TopicSubscriber<T>, WireError> {
+        self.subscriber_with(topic, false)
+    }
+
+    fn subscriber_with<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        topic: Topic,
+        listen: bool,
     ) -> Result<TopicSubscriber<T>, WireError> {
         let service = self.service::<T>(topic)?;
         let subscriber = service
@@ -324,11 +358,16 @@ impl Bus {
             .buffer_size(SUBSCRIBER_BUFFER)
             .create()
             .map_err(|e| ipc("create subscriber", topic.name())(format!("{e:?}")))?;
-        let listener = self
-            .event(topic)?
-            .listener_builder()
-            .create()
-            .map_err(|e| ipc("create listener", topic.name())(format!("{e:?}")))?;
+        let listener = if listen {
+            Some(
+                self.event(topic)?
+                    .listener_builder()
+                    .create()
+                    .map_err(|e| ipc("create listener", topic.name())(format!("{e:?}")))?,
+            )
+        } else {
+            None
+        };
         Ok(TopicSubscriber {
             topic,
             subscriber,
@@ -349,9 +388,10 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicPublisher<T> {
             .write_payload(value)
             .send()
             .map_err(|e| ipc("send", self.topic.name())(format!("{e:?}")))?;
-        self.notifier
-            .notify()
-            .map_err(|e| ipc("notify", self.topic.name())(format!("{e:?}")))?;
+        if let Some(n) = &self.notifier {
+            n.notify()
+                .map_err(|e| ipc("notify", self.topic.name())(format!("{e:?}")))?;
+        }
         Ok(delivered)
     }
 }
@@ -366,24 +406,31 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
         }
     }
 
-    /// The listener to attach to a WaitSet.
-    pub fn listener(&self) -> &Listener<ipc::Service> {
-        &self.listener
-    }
-
     /// Consumes pending wake-ups (a WaitSet spins until they are drained).
     pub fn drain_events(&self) -> Result<(), WireError> {
-        self.listener
-            .try_wait(|_| {})
-            .map(|_| ())
-            .map_err(|e| ipc("listener", self.topic.name())(format!("{e:?}")))
+        match &self.listener {
+            Some(l) => l
+                .try_wait(|_| {})
+                .map(|_| ())
+                .map_err(|e| ipc("listener", self.topic.name())(format!("{e:?}"))),
+            None => Ok(()),
+        }
     }
 
-    /// Blocks until a wake-up arrives or `timeout` passes.
-    pub fn wait_event(&self, timeout: Duration) -> Result<(), WireError> {
-        self.listener
-            .timed_wait(|_| {}, timeout)
-            .map(|_| ())
-            .map_err(|e| ipc("listener", self.topic.name())(format!("{e:?}")))
+    /// Blocks until a wake-up arrives or `timeout` passes; true if one
+    /// arrived. A polling subscriber has no wake-ups: it sleeps for `timeout`.
+    pub fn wait_event(&self, timeout: Duration) -> Result<bool, WireError> {
+        match &self.listener {
+            Some(l) => {
+                let mut woken = false;
+                l.timed_wait(|_| woken = true, timeout)
+                    .map_err(|e| ipc("listener", self.topic.name())(format!("{e:?}")))?;
+                Ok(woken)
+            }
+            None => {
+                std::thread::sleep(timeout);
+                Ok(false)
+            }
+        }
     }
 }

@@ -135,9 +135,11 @@ pub fn run(ctx: &mut NodeContext) -> Result<(), NodeError> {
         if finished {
             break;
         }
-        states.wait_event(Duration::from_millis(100))?;
+        // Checked on a timeout and every 256 states, not on every wake-up.
+        if !states.wait_event(Duration::from_millis(100))? || handled.is_multiple_of(256) {
+            ctx.check()?;
+        }
         states.drain_events()?;
-        ctx.check()?;
     }
     ctx.done_and_wait_for_stop(handled)
 }

@@ -41,7 +41,7 @@ struct Sub<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> {
 impl<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> Sub<M> {
     fn new(ctx: &NodeContext, topic: Topic) -> Result<Self, NodeError> {
         Ok(Self {
-            sub: ctx.bus.subscriber(topic)?,
+            sub: ctx.bus.polling_subscriber(topic)?,
             count: TopicCount::default(),
         })
     }
@@ -52,7 +52,7 @@ impl<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> Sub<M> {
             log.write(&m)
                 .map_err(|e| NodeError::Protocol(e.to_string()))?;
         }
-        let _ = self.sub.listener().try_wait(|_| {});
+        let _ = self.sub.drain_events();
         Ok(())
     }
 

@@ -8,6 +8,7 @@
 
 pub mod controller;
 pub mod logger;
+pub mod placement;
 pub mod plant;
 pub mod trajectory;
 
@@ -45,6 +46,9 @@ pub struct NodeArgs {
     /// Logger only: where the scenario originally came from (for the log's metadata).
     #[arg(long, value_name = "TEXT")]
     pub source: Option<String>,
+    /// CPUs, scheduling and memory locking.
+    #[command(flatten)]
+    pub placement: placement::Placement,
 }
 
 /// Why a node stopped.
@@ -193,6 +197,9 @@ impl NodeContext {
 
 /// Runs node `kind` to completion.
 pub fn run(kind: NodeKind, args: &NodeArgs) -> Result<(), NodeError> {
+    for refused in args.placement.apply() {
+        eprintln!("testbed node {}: warning: {refused}", kind.name());
+    }
     let mut ctx = NodeContext::new(kind, args)?;
     let result = match kind {
         NodeKind::Plant => plant::run(&mut ctx),

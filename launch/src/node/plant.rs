@@ -143,6 +143,7 @@ fn lockstep(ctx: &mut NodeContext, ports: &Ports, st: &mut Stepper) -> Result<()
         ports.state.send(state)?;
         if (k + 1) % PROGRESS_EVERY == 0 {
             ctx.report(NODE_RUNNING, k + 1)?;
+            ctx.check()?;
         }
     }
     Ok(())
@@ -166,9 +167,13 @@ fn wait_for_command(
                 )));
             }
         }
-        sub.wait_event(Duration::from_millis(100))?;
+        // The launcher and the signals are checked when the wait times out
+        // and every PROGRESS_EVERY steps, not on each wake-up: a check costs
+        // syscalls on the critical path.
+        if !sub.wait_event(Duration::from_millis(100))? {
+            ctx.check()?;
+        }
         sub.drain_events()?;
-        ctx.check()?;
     }
 }
 

@@ -30,7 +30,10 @@ pub fn run(ctx: &mut NodeContext) -> Result<(), NodeError> {
         .bus
         .publisher::<ReferenceSample>(Topic::Reference, delivery)?;
     let states = match ctx.mode {
-        Mode::Lockstep => Some(ctx.bus.subscriber::<JointState>(Topic::JointState)?),
+        Mode::Lockstep => Some(
+            ctx.bus
+                .polling_subscriber::<JointState>(Topic::JointState)?,
+        ),
         Mode::Realtime => None,
     };
     let mut buf = RefBuf::new(n);

@@ -57,6 +57,9 @@ pub struct RunOptions {
     pub runs_dir: PathBuf,
     /// Show a progress bar (real time, on a terminal).
     pub progress: bool,
+    /// Pin the nodes to CPUs and, in real time, run the loop under
+    /// SCHED_FIFO with locked memory (see [`crate::node::placement`]).
+    pub realtime_setup: bool,
 }
 
 /// What a finished run produced.
@@ -203,6 +206,10 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let log = std::path::absolute(run_dir.join("run.mcap"))
         .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?;
 
+    let cpus = std::thread::available_parallelism().map_or(1, usize::from);
+    let _off_loop = opts
+        .realtime_setup
+        .then(|| crate::node::placement::OffLoopCpu::enter(cpus));
     let exe = std::env::current_exe().map_err(|cause| RunError::Spawn {
         node: "plant",
         cause,
@@ -212,7 +219,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     for kind in NODES {
         let external = opts.external.contains(&kind);
         let parent = if external { None } else { me };
-        let args = node_args(
+        let mut args = node_args(
             kind,
             &prefix,
             &scenario_file,
@@ -220,6 +227,9 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
             (&log, &plan.source),
             parent,
         );
+        if opts.realtime_setup {
+            args.extend(crate::node::placement::for_node(kind, opts.mode, cpus).to_args());
+        }
         if external {
             eprintln!(
                 "testbed: waiting for the {} node; start it with:\n  testbed node {} {}",

@@ -1,0 +1,201 @@
+//! Where and how a node runs: which CPUs, which scheduling policy, whether
+//! its memory is locked. The launcher decides (see [`for_node`]); each node
+//! applies its own placement at start-up, and says clearly when the system
+//! refuses part of it (the run goes on, with worse timing).
+
+use nix::sched::{CpuSet, sched_setaffinity};
+use nix::sys::mman::{MlockAllFlags, mlockall};
+use nix::unistd::Pid;
+use thread_priority::{
+    RealtimeThreadSchedulePolicy, ThreadPriority, ThreadPriorityValue, ThreadSchedulePolicy,
+    set_thread_priority_and_policy, thread_native_id,
+};
+use wire::NodeKind;
+
+use crate::mode::Mode;
+
+/// A node's placement, as given on its command line.
+#[derive(Debug, Clone, Default, PartialEq, Eq, clap::Args)]
+pub struct Placement {
+    /// Pin the node to these CPUs (comma-separated indices).
+    #[arg(long, value_delimiter = ',', value_name = "CPU,…")]
+    pub cpus: Vec<usize>,
+    /// Run under SCHED_FIFO at this priority (1–99).
+    #[arg(long, value_name = "PRIORITY", value_parser = clap::value_parser!(u8).range(1..=99))]
+    pub fifo: Option<u8>,
+    /// Lock the node's memory (mlockall), so no page fault stalls the loop.
+    #[arg(long)]
+    pub lock_memory: bool,
+}
+
+impl Placement {
+    /// The command-line form, for the launcher.
+    pub fn to_args(&self) -> Vec<String> {
+        let mut args = Vec::new();
+        if !self.cpus.is_empty() {
+            args.push("--cpus".to_string());
+            args.push(
+                self.cpus
+                    .iter()
+                    .map(usize::to_string)
+                    .collect::<Vec<_>>()
+                    .join(","),
+            );
+        }
+        if let Some(p) = self.fifo {
+            args.push("--fifo".to_string());
+            args.push(p.to_string());
+        }
+        if self.lock_memory {
+            args.push("--lock-memory".to_string());
+        }
+        args
+    }
+
+    /// Applies the placement to this process; returns what the system
+    /// refused, one sentence each.
+    pub fn apply(&self) -> Vec<String> {
+        let mut refused = Vec::new();
+        if !self.cpus.is_empty() {
+            let mut set = CpuSet::new();
+            let pinned = self
+                .cpus
+                .iter()
+                .try_for_each(|&c| set.set(c))
+                .and_then(|()| sched_setaffinity(Pid::from_raw(0), &set));
+            if let Err(e) = pinned {
+                refused.push(format!("cannot pin to CPUs {:?} ({e})", self.cpus));
+            }
+        }
+        if let Some(p) = self.fifo {
+            let priority = ThreadPriorityValue::try_from(p).map(ThreadPriority::Crossplatform);
+            let set = priority.map_err(|e| e.to_string()).and_then(|priority| {
+                set_thread_priority_and_policy(
+                    thread_native_id(),
+                    priority,
+                    ThreadSchedulePolicy::Realtime(RealtimeThreadSchedulePolicy::Fifo),
+                )
+                .map_err(|e| format!("{e:?}"))
+            });
+            if let Err(e) = set {
+                refused.push(format!(
+                    "SCHED_FIFO priority {p} refused ({e}); the loop runs under the normal \
+                     scheduler and its jitter follows the machine's load. Run as root, or grant \
+                     CAP_SYS_NICE or an rtprio limit (ulimit -r), to allow it"
+                ));
+            }
+        }
+        if self.lock_memory
+            && let Err(e) = mlockall(MlockAllFlags::MCL_CURRENT | MlockAllFlags::MCL_FUTURE)
+        {
+            refused.push(format!(
+                "cannot lock memory ({e}); page faults may stall the loop. Raise the \
+                 memlock limit (ulimit -l) or grant CAP_IPC_LOCK"
+            ));
+        }
+        refused
+    }
+}
+
+/// Keeps the calling thread off the loop's CPU (the last one) until
+/// dropped, then restores its CPU set: the launcher wakes every 10 ms to
+/// supervise and should not preempt the plant or the controller.
+pub struct OffLoopCpu(Option<CpuSet>);
+
+impl OffLoopCpu {
+    /// Moves the calling thread to every CPU but the last (when there are two or more).
+    pub fn enter(cpus: usize) -> Self {
+        if cpus < 2 {
+            return Self(None);
+        }
+        let Ok(before) = nix::sched::sched_getaffinity(Pid::from_raw(0)) else {
+            return Self(None);
+        };
+        let mut set = CpuSet::new();
+        if (0..cpus - 1).try_for_each(|c| set.set(c)).is_err()
+            || sched_setaffinity(Pid::from_raw(0), &set).is_err()
+        {
+            return Self(None);
+        }
+        Self(Some(before))
+    }
+}
+
+impl Drop for OffLoopCpu {
+    fn drop(&mut self) {
+        if let Some(before) = &self.0 {
+            let _ = sched_setaffinity(Pid::from_raw(0), before);
+        }
+    }
+}
+
+/// The launcher's placement of `kind` on a machine with `cpus` CPUs.
+///
+/// The plant and the controller wake each other every period: on one CPU
+/// that round trip costs about 14 µs, across CPUs 50–70 µs (NOTES.md), so
+/// they share the last CPU and the trajectory and the logger get the others.
+/// In real time the plant and the controller also run under SCHED_FIFO
+/// (the plant higher: it owns the clock) with locked memory. In lockstep the
+/// pair keeps its CPU busy, and a FIFO task that never sleeps would only be
+/// throttled, so lockstep pins without raising priority.
+pub fn for_node(kind: NodeKind, mode: Mode, cpus: usize) -> Placement {
+    let loop_node = matches!(kind, NodeKind::Plant | NodeKind::Controller);
+    let cpu_list = if cpus < 2 {
+        Vec::new()
+    } else if loop_node {
+        vec![cpus - 1]
+    } else {
+        (0..cpus - 1).collect()
+    };
+    let realtime = mode == Mode::Realtime && loop_node;
+    Placement {
+        cpus: cpu_list,
+        fifo: match (realtime, kind) {
+            (true, NodeKind::Plant) => Some(80),
+            (true, _) => Some(79),
+            _ => None,
+        },
+        lock_memory: realtime,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_loop_shares_one_cpu_and_the_rest_get_the_others() {
+        let p = for_node(NodeKind::Plant, Mode::Realtime, 2);
+        assert_eq!(p.cpus, [1]);
+        assert_eq!(p.fifo, Some(80));
+        assert!(p.lock_memory);
+        let c = for_node(NodeKind::Controller, Mode::Realtime, 4);
+        assert_eq!((c.cpus.as_slice(), c.fifo), (&[3][..], Some(79)));
+        let l = for_node(NodeKind::Logger, Mode::Realtime, 4);
+        assert_eq!(
+            l,
+            Placement {
+                cpus: vec![0, 1, 2],
+                fifo: None,
+                lock_memory: false
+            }
+        );
+        let lockstep = for_node(NodeKind::Plant, Mode::Lockstep, 2);
+        assert_eq!((lockstep.fifo, lockstep.lock_memory), (None, false));
+        assert!(for_node(NodeKind::Plant, Mode::Realtime, 1).cpus.is_empty());
+    }
+
+    #[test]
+    fn arguments_round_trip() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Cli {
+            #[command(flatten)]
+            p: Placement,
+        }
+        let p = for_node(NodeKind::Plant, Mode::Realtime, 4);
+        let mut argv = vec!["x".to_string()];
+        argv.extend(p.to_args());
+        assert_eq!(Cli::parse_from(argv).p, p);
+    }
+}
