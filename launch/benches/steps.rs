@@ -1,5 +1,6 @@
-//! One controller step and one plant step, for the paper's two-link arm and
-//! the largest shipped arm (UR5, 6 joints), at seeded random states.
+//! One controller step and one plant step, for the paper's two-link arm,
+//! the UR5 (6 joints) and the KUKA iiwa 14 (7 joints), at seeded random
+//! states, with the default plant settings.
 //! `cargo bench -p launch --bench steps`.
 
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
@@ -10,9 +11,10 @@ use plant_rapier::{ArmModel, Plant, PlantConfig};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const ARMS: [(&str, &str); 2] = [
+const ARMS: [(&str, &str); 3] = [
     ("two_link", include_str!("../../robots/two_link.urdf")),
     ("ur5", include_str!("../../robots/ur5.urdf")),
+    ("iiwa14", include_str!("../../robots/iiwa14.urdf")),
 ];
 
 fn controller_step(c: &mut Criterion) {
@@ -54,12 +56,16 @@ fn plant_step(c: &mut Criterion) {
         let q: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
         plant.set_state(&q, &vec![0.0; n]).unwrap();
         let tau: Vec<f64> = (0..n).map(|_| rng.random_range(-2.0..2.0)).collect();
-        c.bench_function(&format!("plant_step_{name}_{n}dof_8substeps"), |b| {
-            b.iter(|| {
-                plant.step(&tau, 1e-3).unwrap();
-                std::hint::black_box(plant.applied_torque()[0])
-            })
-        });
+        let substeps = plant.substeps();
+        c.bench_function(
+            &format!("plant_step_{name}_{n}dof_{substeps}substeps"),
+            |b| {
+                b.iter(|| {
+                    plant.step(&tau, 1e-3).unwrap();
+                    std::hint::black_box(plant.applied_torque()[0])
+                })
+            },
+        );
     }
 }
 

@@ -71,6 +71,30 @@ fn robot_command_reports_joint_order_and_masses() {
     assert!(text.contains("moving mass 16.9939 kg"), "{text}");
 }
 
+/// The 7-joint KUKA iiwa 14: read, merged, and run. Its default scenario
+/// needs 5.2 kHz (the light wrist bounds the scalar gain K2 by Δt·K2·λ ≤ 1)
+/// and, with one K2 for every joint, does not hold the shoulder's gravity
+/// load inside a 0.25 rad envelope (README, Robots): this checks that it
+/// runs, not that it tracks.
+#[test]
+fn the_seven_joint_iiwa_loads_and_runs() {
+    let text =
+        String::from_utf8(ok(testbed().args(["robot", "robots/iiwa14.urdf"])).stdout).unwrap();
+    assert!(text.contains("7 actuated joints"), "{text}");
+    assert!(text.contains("merged fixed joint iiwa_joint_ee"), "{text}");
+    assert!(text.contains("moving mass 25.6100 kg"), "{text}");
+    let s = json(&ok(testbed().args([
+        "sim",
+        "--json",
+        "--robot",
+        "robots/iiwa14.urdf",
+        "--duration",
+        "0.5",
+    ])));
+    assert_eq!(s["finite"], true, "{s}");
+    assert_eq!(s["dof"], 7);
+}
+
 /// URDFs a user may bring that the plant cannot simulate: each is a clear
 /// error naming the file and what is wrong, with a non-zero exit, never a panic.
 #[test]
