@@ -1,6 +1,6 @@
 //! `testbed run`: real processes over iceoryx2.
 
-use std::process::Stdio;
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use nix::sys::signal::{Signal, kill};
@@ -305,4 +305,100 @@ fn bench_reports_every_figure() {
     assert!(b["machine"]["cores"].as_u64().unwrap() >= 1);
     let err = crate::util::fails(testbed().args(["bench", "--realtime-s", "0"]));
     assert!(err.contains("--realtime-s"), "{err}");
+}
+
+/// A field of /proc/<pid>/status ("Cpus_allowed_list", "Uid", …).
+fn proc_status(pid: u32, key: &str) -> Option<String> {
+    let text = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    text.lines()
+        .find_map(|l| l.strip_prefix(&format!("{key}:")))
+        .map(|v| v.trim().to_string())
+}
+
+/// The scheduling policy of `pid` (0 normal, 1 SCHED_FIFO): field 41 of
+/// /proc/<pid>/stat, counted after the command name in parentheses.
+fn policy(pid: u32) -> Option<u32> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let rest = &stat[stat.rfind(')')? + 2..];
+    rest.split(' ').nth(38)?.parse().ok()
+}
+
+fn is_root() -> bool {
+    proc_status(std::process::id(), "Uid").is_some_and(|u| u.split_whitespace().nth(1) == Some("0"))
+}
+
+/// In real time the plant and the controller share the last CPU under
+/// SCHED_FIFO; the logger and the trajectory run on the other CPUs.
+#[test]
+fn realtime_nodes_are_placed_as_documented() {
+    let cpus = std::thread::available_parallelism().unwrap().get();
+    assert!(cpus >= 2, "this test needs two CPUs");
+    let dir = tempfile::tempdir().unwrap();
+    let mut launcher = testbed()
+        .args(["run", "--duration", "4", "--runs-dir"])
+        .arg(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let nodes = wait_for_nodes(launcher.id());
+    let last = (cpus - 1).to_string();
+    let others = if cpus == 2 {
+        "0".to_string()
+    } else {
+        format!("0-{}", cpus - 2)
+    };
+    // Each node places itself as it starts: give it a moment.
+    let placed = |pid: u32, cpus: &str, fifo: bool| {
+        (0..100).any(|_| {
+            let ok = proc_status(pid, "Cpus_allowed_list").as_deref() == Some(cpus)
+                && (policy(pid) == Some(1)) == fifo;
+            if !ok {
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            ok
+        })
+    };
+    let root = is_root();
+    for (name, pid, _) in &nodes {
+        let (want_cpus, fifo) = match name.as_str() {
+            "plant" | "controller" => (&last, root),
+            _ => (&others, false),
+        };
+        assert!(
+            placed(*pid, want_cpus, fifo),
+            "{name}: CPUs {:?}, policy {:?}; wanted {want_cpus}, FIFO {fifo}",
+            proc_status(*pid, "Cpus_allowed_list"),
+            policy(*pid)
+        );
+    }
+    assert!(wait_bounded(&mut launcher, 30).success());
+}
+
+/// Where the system refuses SCHED_FIFO, each loop node says so, naming
+/// what would allow it, and the run goes on.
+#[test]
+fn refused_realtime_scheduling_is_said_and_the_run_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    // Without CAP_SYS_NICE (and with the default rtprio limit of 0).
+    let mut cmd = Command::new("setpriv");
+    if is_root() {
+        cmd.args(["--bounding-set", "-sys_nice"]);
+    }
+    cmd.args(["--inh-caps", "-sys_nice", env!("CARGO_BIN_EXE_testbed")])
+        .args(["run", "--duration", "0.5", "--json", "--runs-dir"])
+        .arg(dir.path())
+        .current_dir(crate::util::repo_root());
+    let out = ok(&mut cmd);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    for node in ["plant", "controller"] {
+        assert!(
+            stderr.contains(&format!(
+                "testbed node {node}: warning: SCHED_FIFO priority"
+            )) && stderr.contains("CAP_SYS_NICE"),
+            "{stderr}"
+        );
+    }
+    assert!(stderr.contains("Operation not permitted"), "{stderr}");
+    assert_eq!(json(&out)["steps"], 500);
 }

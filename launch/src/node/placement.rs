@@ -75,7 +75,12 @@ impl Placement {
                     priority,
                     ThreadSchedulePolicy::Realtime(RealtimeThreadSchedulePolicy::Fifo),
                 )
-                .map_err(|e| format!("{e:?}"))
+                .map_err(|e| match e {
+                    thread_priority::Error::OS(code) => {
+                        nix::errno::Errno::from_raw(code).to_string()
+                    }
+                    other => format!("{other:?}"),
+                })
             });
             if let Err(e) = set {
                 refused.push(format!(
