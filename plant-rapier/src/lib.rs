@@ -1,9 +1,13 @@
 //! The simulated arm: a Rapier multibody (f64) built from a URDF.
 //!
-//! Where it sits: the `plant-rapier` process (or `testbed sim`'s in-process
-//! loop) owns a [`Plant`], publishes its joint state each period and steps it
-//! with the latest torque held over the period. The controller never sees
-//! anything in here: M, C and G live only in Rapier.
+//! Where it sits: the plant process (or `testbed sim`'s in-process loop)
+//! owns a [`Rig`]: the Rapier [`Plant`] with what a real arm adds that the
+//! controller does not know (friction, a payload, the disturbance d(t),
+//! saturation, sensor noise and quantisation, actuation delay, lost
+//! commands; see [`PlantConfig`]). Each period it publishes the true and
+//! the measured joint state and steps with the command that reached the
+//! motors. The controller never sees anything in here: M, C and G live
+//! only in Rapier.
 //!
 //! ```
 //! use plant_rapier::{ArmModel, Plant, PlantConfig, TWO_LINK_URDF};
