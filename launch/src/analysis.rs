@@ -133,6 +133,8 @@ pub struct LogAnalysis {
     pub series: Option<Series>,
     /// Wall time between the first and the last logged joint state, s.
     pub wall_span_s: f64,
+    /// CLOCK_MONOTONIC of the first and the last logged joint state, ns.
+    pub wall_window_ns: (u64, u64),
 }
 
 impl LogAnalysis {
@@ -293,6 +295,7 @@ pub fn analyse(path: &Path, mut opts: AnalyseOptions<'_>) -> Result<LogAnalysis,
     let wall_span_s = wall.1.saturating_sub(wall.0) as f64 / 1e9;
     Ok(LogAnalysis {
         wall_span_s,
+        wall_window_ns: wall,
         expected_rows: plan.steps,
         missing_rows: assembler.missing(),
         summary: summary.finish(),

@@ -2,12 +2,15 @@
 //!
 //! For the paper scenario and the largest shipped arm it measures the
 //! in-process loop, the full stack in lockstep with the logger, and the full
-//! stack in real time; and, in the same run, the floor the machine sets: a
-//! bare absolute-deadline sleep loop with no IPC and no work. On a shared VM
-//! the host, not the code, sets the timing tail, so the testbed's figures
-//! are reported beside that floor.
+//! stack in real time; and, beside each real-time run (same window, same
+//! CPU, same priority), the floor the machine sets: a bare absolute-deadline
+//! sleep loop with no IPC and no work. On a shared VM the host, not the
+//! code, sets the timing tail, and it changes from minute to minute, so the
+//! testbed's figures are reported beside a floor measured at the same time.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use scenario::{Overrides, Plan};
@@ -72,6 +75,8 @@ pub struct RealtimeFigures {
     pub cycles: u64,
     /// Commands that missed their deadline.
     pub deadline_misses: u64,
+    /// Plant wake-ups late by a whole period or more: the floor's kind of miss.
+    pub late_wakeups: u64,
     /// |actual − nominal period|, µs.
     pub period_jitter_us: Percentiles,
     /// State → command, µs.
@@ -83,7 +88,7 @@ pub struct RealtimeFigures {
 /// The bare sleep loop: what the machine allows with no IPC and no work.
 #[derive(Debug, Clone, Serialize)]
 pub struct TimerFloor {
-    /// Cycles.
+    /// Cycles inside the real-time run's window.
     pub cycles: u64,
     /// Wake-ups later than the next deadline.
     pub deadline_misses: u64,
@@ -116,6 +121,8 @@ pub struct ArmBench {
     pub plant_step_us: f64,
     /// Real time at the scenario rate.
     pub realtime: RealtimeFigures,
+    /// The bare sleep loop over the same window (see [`FloorProbe`]).
+    pub timer_floor: TimerFloor,
     /// Peak resident memory, kB: the in-process loop (this process) and each node.
     pub peak_rss_kb: Vec<(String, u64)>,
 }
@@ -129,11 +136,10 @@ pub struct BenchReport {
     pub repeats: usize,
     /// Whether the nodes were pinned and, in real time, ran under SCHED_FIFO.
     pub realtime_setup: bool,
-    /// The paper scenario's figures, at the top level of the JSON.
+    /// The paper scenario's figures (its `timer_floor` among them), at the
+    /// top level of the JSON.
     #[serde(flatten)]
     pub paper: ArmBench,
-    /// The bare sleep loop, same length, same bench run.
-    pub timer_floor: TimerFloor,
     /// Every arm's figures.
     pub arms: Vec<ArmBench>,
 }
@@ -166,52 +172,78 @@ pub fn machine() -> Machine {
     }
 }
 
-/// A bare absolute-deadline loop at `rate_hz` for `seconds`, in a thread
-/// of its own placed as `placement` says.
-pub fn timer_floor(rate_hz: f64, seconds: f64, placement: &Placement) -> TimerFloor {
-    let placement = placement.clone();
-    std::thread::scope(|s| {
-        s.spawn(move || {
-            let refused = placement.apply();
-            TimerFloor {
-                placement_refused: refused,
-                ..sleep_loop(rate_hz, seconds)
-            }
-        })
-        .join()
-        .unwrap_or_else(|_| sleep_loop(rate_hz, seconds))
-    })
+/// A bare absolute-deadline sleep loop (no IPC, no work) in a thread of its
+/// own, placed like the plant, running while the testbed's real-time run
+/// does: the floor is measured in the same window, on the same CPU, at the
+/// same priority. Its grid is offset by half a period from the plant's
+/// likely phase so that the two rarely wake together.
+struct FloorProbe {
+    stop: Arc<AtomicBool>,
+    period_ns: u64,
+    handle: std::thread::JoinHandle<ProbeRecord>,
 }
 
-fn sleep_loop(rate_hz: f64, seconds: f64) -> TimerFloor {
-    clock::tighten_timer_slack();
-    let period = (1e9 / rate_hz).round() as u64;
-    let cycles = (seconds * rate_hz).round() as u64;
-    let epoch = clock::monotonic_ns() + period;
-    let mut stats = TimingStats::new(period);
-    let mut last = epoch;
-    let mut misses = 0;
-    for k in 0..cycles {
-        let deadline = epoch + k * period;
-        clock::sleep_until(deadline);
-        let wake = clock::monotonic_ns();
-        if wake >= deadline + period {
-            misses += 1;
-        }
-        stats.add(&wire::Timing {
-            period_ns: if k == 0 { 0 } else { (wake - last) as i64 },
-            round_trip_ns: -1,
-            controller_compute_ns: -1,
-            ..wire::Timing::default()
+/// Every (deadline, wake-up) in ns, and what the system refused of the placement.
+type ProbeRecord = (Vec<(u64, u64)>, Vec<String>);
+
+impl FloorProbe {
+    fn start(rate_hz: f64, max_seconds: f64, placement: &Placement) -> Self {
+        let period_ns = (1e9 / rate_hz).round() as u64;
+        let stop = Arc::new(AtomicBool::new(false));
+        let placement = placement.clone();
+        let flag = Arc::clone(&stop);
+        // Every wake-up is kept (deadline, wake); the buffer is allocated
+        // up front so the loop itself never allocates.
+        let capacity = (max_seconds * rate_hz).ceil() as usize + 1;
+        let handle = std::thread::spawn(move || {
+            let refused = placement.apply();
+            clock::tighten_timer_slack();
+            let mut wakes = Vec::with_capacity(capacity);
+            let epoch = clock::monotonic_ns() + period_ns + period_ns / 2;
+            for k in 0..capacity as u64 {
+                if flag.load(Ordering::Relaxed) {
+                    break;
+                }
+                let deadline = epoch + k * period_ns;
+                clock::sleep_until(deadline);
+                wakes.push((deadline, clock::monotonic_ns()));
+            }
+            (wakes, refused)
         });
-        last = wake;
+        Self {
+            stop,
+            period_ns,
+            handle,
+        }
     }
-    let t = stats.finish(Mode::Realtime, rate_hz);
-    TimerFloor {
-        cycles,
-        deadline_misses: misses,
-        period_jitter_us: t.period_jitter_us,
-        placement_refused: Vec::new(),
+
+    /// Stops the loop; the figures of the deadlines inside `window` (ns).
+    fn finish(self, window: (u64, u64), rate_hz: f64) -> TimerFloor {
+        self.stop.store(true, Ordering::Relaxed);
+        let (wakes, refused) = self.handle.join().unwrap_or_default();
+        let period = self.period_ns;
+        let mut stats = TimingStats::new(period);
+        let mut last: Option<u64> = None;
+        for &(deadline, wake) in wakes
+            .iter()
+            .filter(|(d, _)| (window.0..=window.1).contains(d))
+        {
+            stats.add(&wire::Timing {
+                wake_late_ns: wake as i64 - deadline as i64,
+                period_ns: last.map_or(0, |l| (wake - l) as i64),
+                round_trip_ns: -1,
+                controller_compute_ns: -1,
+                ..wire::Timing::default()
+            });
+            last = Some(wake);
+        }
+        let t = stats.finish(Mode::Realtime, rate_hz);
+        TimerFloor {
+            cycles: t.cycles,
+            deadline_misses: t.late_wakeups,
+            period_jitter_us: t.period_jitter_us,
+            placement_refused: refused,
+        }
     }
 }
 
@@ -283,7 +315,21 @@ fn bench_arm(
     let mut rt_plan = plan.clone();
     rt_plan.steps = (opts.realtime_s * plan.scenario.rate_hz).round() as u64;
     rt_plan.scenario.duration_s = opts.realtime_s;
-    let rt = stack(&rt_plan, Mode::Realtime, opts)?;
+    let placement = if opts.realtime_setup {
+        let cpus = std::thread::available_parallelism().map_or(1, usize::from);
+        placement::for_node(NodeKind::Plant, Mode::Realtime, cpus)
+    } else {
+        Placement::default()
+    };
+    // Start-up and shut-down take a few seconds at most; the probe keeps
+    // running until the run is over, and only the run's window counts.
+    let probe = FloorProbe::start(plan.scenario.rate_hz, opts.realtime_s + 60.0, &placement);
+    let rt = stack(&rt_plan, Mode::Realtime, opts);
+    let floor = probe.finish(
+        rt.as_ref().map_or((0, 0), |r| r.analysis.wall_window_ns),
+        plan.scenario.rate_hz,
+    );
+    let rt = rt?;
     let t = &rt.analysis.timing;
     let dropped = rt.analysis.contents.logger_dropped().unwrap_or(0);
     Ok(ArmBench {
@@ -299,10 +345,12 @@ fn bench_arm(
         realtime: RealtimeFigures {
             cycles: t.cycles,
             deadline_misses: t.deadline_misses,
+            late_wakeups: t.late_wakeups,
             period_jitter_us: t.period_jitter_us,
             round_trip_us: t.round_trip_us,
             logger_dropped: dropped,
         },
+        timer_floor: floor,
         peak_rss_kb: rss,
     })
 }
@@ -313,23 +361,11 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
     let large = load(Some(&opts.large_arm), opts)?;
     let mut arms = vec![bench_arm(&paper, opts, &mut progress)?];
     arms.push(bench_arm(&large, opts, &mut progress)?);
-    progress(&format!(
-        "timer floor: bare sleep loop, {} s",
-        opts.realtime_s
-    ));
-    let placement = if opts.realtime_setup {
-        let cpus = std::thread::available_parallelism().map_or(1, usize::from);
-        placement::for_node(NodeKind::Plant, Mode::Realtime, cpus)
-    } else {
-        Placement::default()
-    };
-    let floor = timer_floor(paper.scenario.rate_hz, opts.realtime_s, &placement);
     Ok(BenchReport {
         machine: machine(),
         repeats: opts.repeats,
         realtime_setup: opts.realtime_setup,
         paper: arms[0].clone(),
-        timer_floor: floor,
         arms,
     })
 }

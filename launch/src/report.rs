@@ -187,11 +187,12 @@ pub fn table(r: &Report) -> String {
     if let Some(t) = &r.timing {
         let _ = writeln!(
             out,
-            "\ntiming ({} at {} Hz): {} cycles, {} deadline misses",
+            "\ntiming ({} at {} Hz): {} cycles, {} deadline misses, {} wake-ups late by a period",
             t.mode.as_str(),
             t.rate_hz,
             t.cycles,
-            t.deadline_misses
+            t.deadline_misses,
+            t.late_wakeups
         );
         let _ = writeln!(
             out,
@@ -262,8 +263,9 @@ pub fn bench_table(b: &launch::bench::BenchReport) -> String {
         let r = &a.realtime;
         let _ = writeln!(
             out,
-            "  real time       {} cycles, {} deadline misses, {} samples dropped by the logger",
-            r.cycles, r.deadline_misses, r.logger_dropped
+            "  real time       {} cycles, {} deadline misses, {} wake-ups late by a period, \
+             {} samples dropped by the logger",
+            r.cycles, r.deadline_misses, r.late_wakeups, r.logger_dropped
         );
         let _ = writeln!(
             out,
@@ -275,6 +277,21 @@ pub fn bench_table(b: &launch::bench::BenchReport) -> String {
             "    round trip us     {}",
             percentiles(&r.round_trip_us)
         );
+        let f = &a.timer_floor;
+        let _ = writeln!(
+            out,
+            "  timer floor     bare sleep loop beside it, same window, CPU and priority: \
+             {} cycles, {} late by a whole period",
+            f.cycles, f.deadline_misses
+        );
+        let _ = writeln!(
+            out,
+            "    period jitter us  {}",
+            percentiles(&f.period_jitter_us)
+        );
+        for refused in &f.placement_refused {
+            let _ = writeln!(out, "    refused: {refused}");
+        }
         let rss: Vec<String> = a
             .peak_rss_kb
             .iter()
@@ -282,23 +299,5 @@ pub fn bench_table(b: &launch::bench::BenchReport) -> String {
             .collect();
         let _ = writeln!(out, "  peak memory     {}", rss.join(", "));
     }
-    let f = &b.timer_floor;
-    let _ = writeln!(
-        out,
-        "\ntimer floor (bare absolute-deadline sleep loop, no IPC, no work, placed as the plant):"
-    );
-    for r in &f.placement_refused {
-        let _ = writeln!(out, "  refused: {r}");
-    }
-    let _ = writeln!(
-        out,
-        "  {} cycles, {} late by a whole period or more",
-        f.cycles, f.deadline_misses
-    );
-    let _ = writeln!(
-        out,
-        "  period jitter us  {}",
-        percentiles(&f.period_jitter_us)
-    );
     out
 }

@@ -78,6 +78,7 @@ fn short_realtime_run_reports_timing() {
     }
     // Every cycle either got its command in time (and has a round trip) or
     // is a counted miss.
+    assert!(t["late_wakeups"].as_u64().unwrap() <= 1000, "{t}");
     let misses = t["deadline_misses"].as_u64().unwrap();
     assert_eq!(
         t["round_trip_us"]["count"].as_u64().unwrap() + misses,
@@ -289,7 +290,9 @@ fn bench_reports_every_figure() {
         );
     }
     assert_eq!(b["realtime"]["cycles"], 300);
-    assert_eq!(b["timer_floor"]["cycles"], 300);
+    // The floor counts its wake-ups inside the run's window: one per period.
+    let floor = b["timer_floor"]["cycles"].as_i64().unwrap();
+    assert!((floor - 300).abs() <= 2, "{b}");
     for k in ["period_jitter_us", "round_trip_us"] {
         assert!(b["realtime"][k]["p99"].as_f64().is_some(), "{k} in {b}");
     }

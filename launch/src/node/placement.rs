@@ -140,7 +140,10 @@ impl Drop for OffLoopCpu {
 /// that round trip costs about 14 µs, across CPUs 50–70 µs (NOTES.md), so
 /// they share the last CPU and the trajectory and the logger get the others.
 /// In real time the plant and the controller also run under SCHED_FIFO
-/// (the plant higher: it owns the clock) with locked memory. In lockstep the
+/// with locked memory, the controller one level above the plant: a state
+/// the plant publishes then wakes the controller at once, even when the
+/// plant is catching up after the host stalled it, so the answer is there
+/// by the next tick (with the plant higher, every catch-up tick was a miss). In lockstep the
 /// pair keeps its CPU busy, and a FIFO task that never sleeps would only be
 /// throttled, so lockstep pins without raising priority.
 pub fn for_node(kind: NodeKind, mode: Mode, cpus: usize) -> Placement {
@@ -156,7 +159,7 @@ pub fn for_node(kind: NodeKind, mode: Mode, cpus: usize) -> Placement {
     Placement {
         cpus: cpu_list,
         fifo: match (realtime, kind) {
-            (true, NodeKind::Plant) => Some(80),
+            (true, NodeKind::Controller) => Some(80),
             (true, _) => Some(79),
             _ => None,
         },
@@ -172,10 +175,10 @@ mod tests {
     fn the_loop_shares_one_cpu_and_the_rest_get_the_others() {
         let p = for_node(NodeKind::Plant, Mode::Realtime, 2);
         assert_eq!(p.cpus, [1]);
-        assert_eq!(p.fifo, Some(80));
+        assert_eq!(p.fifo, Some(79));
         assert!(p.lock_memory);
         let c = for_node(NodeKind::Controller, Mode::Realtime, 4);
-        assert_eq!((c.cpus.as_slice(), c.fifo), (&[3][..], Some(79)));
+        assert_eq!((c.cpus.as_slice(), c.fifo), (&[3][..], Some(80)));
         let l = for_node(NodeKind::Logger, Mode::Realtime, 4);
         assert_eq!(
             l,

@@ -52,6 +52,10 @@ pub struct TimingSummary {
     pub cycles: u64,
     /// Cycles whose command had not arrived by the next deadline.
     pub deadline_misses: u64,
+    /// Plant wake-ups late by a whole period or more (real time): what a
+    /// bare sleep loop counts as a miss, so the one figure to compare with
+    /// the bench's timer floor.
+    pub late_wakeups: u64,
     /// |actual − nominal period| of the plant's wake-ups (real time).
     pub period_jitter_us: Percentiles,
     /// How late the plant woke after each deadline (real time).
@@ -68,6 +72,7 @@ pub struct TimingStats {
     period_ns: u64,
     cycles: u64,
     misses: u64,
+    late_wakeups: u64,
     jitter: Vec<f64>,
     late: Vec<f64>,
     round_trip: Vec<f64>,
@@ -92,6 +97,7 @@ impl TimingStats {
                 .push((t.period_ns - self.period_ns as i64).unsigned_abs() as f64 / 1e3);
         }
         self.late.push(t.wake_late_ns.max(0) as f64 / 1e3);
+        self.late_wakeups += u64::from(t.wake_late_ns >= self.period_ns as i64);
         if t.round_trip_ns >= 0 {
             self.round_trip.push(t.round_trip_ns as f64 / 1e3);
         }
@@ -107,6 +113,7 @@ impl TimingStats {
             rate_hz,
             cycles: self.cycles,
             deadline_misses: self.misses,
+            late_wakeups: self.late_wakeups,
             period_jitter_us: Percentiles::of(self.jitter.clone()),
             wake_late_us: Percentiles::of(self.late.clone()),
             round_trip_us: Percentiles::of(self.round_trip.clone()),
@@ -142,6 +149,15 @@ mod tests {
         }
         let t = s.finish(Mode::Realtime, 1000.0);
         assert_eq!((t.cycles, t.deadline_misses), (3, 1));
+        assert_eq!(t.late_wakeups, 0);
+        let mut late = TimingStats::new(1_000_000);
+        for wake_late_ns in [999_999, 1_000_000, 2_500_000] {
+            late.add(&Timing {
+                wake_late_ns,
+                ..Timing::default()
+            });
+        }
+        assert_eq!(late.finish(Mode::Realtime, 1000.0).late_wakeups, 2);
         assert_eq!(t.period_jitter_us.max, 2.0);
         assert_eq!(t.period_jitter_us.count, 2);
         assert_eq!(t.round_trip_us.count, 0);
