@@ -386,6 +386,15 @@ impl LogMessage for Timing {
 mod tests {
     use super::*;
 
+    /// The schema's legend of the effect bits follows the plant's own list.
+    #[test]
+    fn effect_bits_are_described_as_the_plant_defines_them() {
+        let about = JointState::ABOUT.split_whitespace().collect::<Vec<_>>().join(" ");
+        for (bit, name) in plant_rapier::Effects::all_names().enumerate() {
+            assert!(about.contains(&format!("{bit} {name}")), "{bit} {name}: {about}");
+        }
+    }
+
     #[test]
     fn round_trip_keeps_every_bit_and_nan() {
         let mut s = JointState {
