@@ -389,9 +389,15 @@ mod tests {
     /// The schema's legend of the effect bits follows the plant's own list.
     #[test]
     fn effect_bits_are_described_as_the_plant_defines_them() {
-        let about = JointState::ABOUT.split_whitespace().collect::<Vec<_>>().join(" ");
+        let about = JointState::ABOUT
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
         for (bit, name) in plant_rapier::Effects::all_names().enumerate() {
-            assert!(about.contains(&format!("{bit} {name}")), "{bit} {name}: {about}");
+            assert!(
+                about.contains(&format!("{bit} {name}")),
+                "{bit} {name}: {about}"
+            );
         }
     }
 
