@@ -175,7 +175,8 @@ pub fn machine() -> Machine {
 /// A bare absolute-deadline sleep loop (no IPC, no work) in a thread of its
 /// own, running while the testbed's real-time run does: the floor is
 /// measured in the same window, on the loop's CPU, just above the loop's
-/// priority.
+/// priority, with deadlines on the plant's grid: both timers fire at the
+/// same instants, so the host treats them alike.
 struct FloorProbe {
     stop: Arc<AtomicBool>,
     period_ns: u64,
@@ -198,7 +199,8 @@ impl FloorProbe {
             let refused = placement.apply();
             clock::tighten_timer_slack();
             let mut wakes = Vec::with_capacity(capacity);
-            let epoch = clock::monotonic_ns() + period_ns + period_ns / 2;
+            // The plant's grid: its epoch is a whole multiple of the period.
+            let epoch = (clock::monotonic_ns() + period_ns).div_ceil(period_ns) * period_ns;
             for k in 0..capacity as u64 {
                 if flag.load(Ordering::Relaxed) {
                     break;

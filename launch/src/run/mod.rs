@@ -345,7 +345,11 @@ fn supervise(
     }
 
     // Step 0 a little in the future, so every node is waiting for it.
-    let epoch = monotonic_ns() + 20_000_000;
+    // On a whole multiple of the period: the plant's deadlines then fall on
+    // the same CLOCK_MONOTONIC grid as any other loop at that rate (the
+    // bench's timer floor runs on it too).
+    let period = opts.plan.period_ns;
+    let epoch = (monotonic_ns() + 20_000_000).div_ceil(period) * period;
     control.send(control_msg(CONTROL_START, epoch))?;
     let started = Instant::now();
     let bar = progress_bar(opts);
