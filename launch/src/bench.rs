@@ -166,7 +166,7 @@ pub fn machine() -> Machine {
         .unwrap_or_else(|| "unknown".into());
     Machine {
         cpu,
-        cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        cores: placement::cpu_count(),
         kernel: std::fs::read_to_string("/proc/sys/kernel/osrelease")
             .map_or_else(|_| "unknown".into(), |s| s.trim().to_string()),
     }
@@ -320,7 +320,7 @@ fn bench_arm(
     // never delays the floor's wake-ups (the floor may delay the loop by
     // the microsecond a wake-up takes, which counts against the testbed).
     let placement = if opts.realtime_setup {
-        let cpus = std::thread::available_parallelism().map_or(1, usize::from);
+        let cpus = placement::cpu_count();
         let controller = placement::for_node(NodeKind::Controller, Mode::Realtime, cpus);
         Placement {
             fifo: controller.fifo.map(|p| p + 1),

@@ -107,18 +107,10 @@ impl Rig {
                 })
             }
         };
-        let mut static_effects = 0;
-        for (on, bit) in [
-            (plant.has_friction(), Effects::FRICTION),
-            (disturbance.on(), Effects::DISTURBANCE),
-            (sensor.noisy(), Effects::SENSOR_NOISE),
-            (sensor.quantised(), Effects::QUANTISED),
-            (a.delay_periods > 0, Effects::DELAYED),
-        ] {
-            if on {
-                static_effects |= bit;
-            }
-        }
+        // On for the whole run; the payload and lost commands are flagged
+        // when they happen.
+        let static_effects =
+            config.configured_effects().0 & !(Effects::PAYLOAD | Effects::COMMAND_DROPPED);
         let mut rig = Self {
             plant,
             period_ns,

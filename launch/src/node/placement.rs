@@ -134,6 +134,11 @@ impl Drop for OffLoopCpu {
     }
 }
 
+/// CPUs this process may use (1 when unknown).
+pub fn cpu_count() -> usize {
+    std::thread::available_parallelism().map_or(1, usize::from)
+}
+
 /// The launcher's placement of `kind` on a machine with `cpus` CPUs.
 ///
 /// The plant and the controller wake each other every period: on one CPU

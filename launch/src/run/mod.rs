@@ -206,7 +206,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let log = std::path::absolute(run_dir.join("run.mcap"))
         .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?;
 
-    let cpus = std::thread::available_parallelism().map_or(1, usize::from);
+    let cpus = crate::node::placement::cpu_count();
     let _off_loop = opts
         .realtime_setup
         .then(|| crate::node::placement::OffLoopCpu::enter(cpus));

@@ -55,11 +55,6 @@ impl Disturbance {
         })
     }
 
-    /// Whether any part is non-zero.
-    pub(crate) fn on(&self) -> bool {
-        self.on
-    }
-
     /// d at the start of the next period, t seconds; called once per period.
     pub(crate) fn advance(&mut self, t: f64) -> &[f64] {
         if !self.on {

@@ -26,14 +26,6 @@ impl Sensor {
         }
     }
 
-    pub(crate) fn noisy(&self) -> bool {
-        self.q_std.iter().chain(&self.qd_std).any(|s| *s > 0.0)
-    }
-
-    pub(crate) fn quantised(&self) -> bool {
-        self.resolution.iter().any(|r| *r > 0.0)
-    }
-
     /// Turns the true state in `q`, `qd` into the reading, in place.
     pub(crate) fn read(&mut self, q: &mut [f64], qd: &mut [f64]) {
         for i in 0..q.len() {
