@@ -31,6 +31,9 @@ pub struct ControllerInput<'a> {
 pub struct Controller {
     p: ControllerParams,
     n: usize,
+    /// K1_i and K2_i resolved for the n joints.
+    k1: Vec<f64>,
+    k2: Vec<f64>,
     actor: Rbf,
     critic: Rbf,
     /// Ŵ_a, N×n, column-major: column j (joint j) is `wa[j*N..(j+1)*N]`.
@@ -58,7 +61,11 @@ impl Controller {
         }
         let nn = params.neurons;
         let rbf = || Rbf::new(nn, params.center_min, params.center_max, params.width);
+        let k1 = params.k1.resolve("controller.k1", dof)?;
+        let k2 = params.k2.resolve("controller.k2", dof)?;
         Ok(Self {
+            k1,
+            k2,
             actor: rbf(),
             critic: rbf(),
             n: dof,
@@ -163,7 +170,8 @@ impl Controller {
             out.kc[i] = kc;
             out.d[i] = d_raw;
             let z1 = out.z1[i];
-            out.alpha[i] = -p.k1 * z1 - p.a * gamma_dot * gamma_dot * z1 * z1_sq / (p.beta * d)
+            out.alpha[i] = -self.k1[i] * z1
+                - p.a * gamma_dot * gamma_dot * z1 * z1_sq / (p.beta * d)
                 + input.qd_d[i]
                 + (kc_dot / kc) * z1;
             out.z2[i] = input.qd[i] - out.alpha[i];
@@ -184,7 +192,7 @@ impl Controller {
         for j in 0..n {
             let col = &self.wa[j * nn..(j + 1) * nn];
             out.tau_actor[j] = dot(col, &self.sa);
-            out.tau_feedback[j] = -p.k2 * out.z2[j];
+            out.tau_feedback[j] = -self.k2[j] * out.z2[j];
             out.tau[j] = out.tau_actor[j] + out.tau_feedback[j] + out.tau_barrier[j];
             out.wa_norm[j] = dot(col, col).sqrt();
         }

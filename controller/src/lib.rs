@@ -24,12 +24,14 @@
 //! the paper (SPEC §8); with them the actor's contribution stays small and
 //! the loop behaves as feedback plus barrier.
 
+mod gain;
 mod law;
 mod params;
 mod rbf;
 mod shifting;
 mod weight_update;
 
+pub use gain::Gain;
 pub use law::{Controller, ControllerInput, barrier_lyapunov};
 pub use params::{BarrierMode, ControllerParams, Integrator};
 pub use rbf::Rbf;

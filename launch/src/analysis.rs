@@ -175,8 +175,12 @@ fn plan_from(contents: &LogContents) -> Result<(Plan, Mode), AnalysisError> {
     // The robot is the attached URDF, wherever the original file was.
     scenario.robot = None;
     let robot = match &contents.urdf {
-        Some(urdf) => RobotSource::from_text(urdf, &format!("{} (robot.urdf)", path.display()))
-            .map_err(|e| meta_err(path, e.to_string()))?,
+        Some(urdf) => RobotSource::from_text(
+            urdf,
+            &format!("{} (robot.urdf)", path.display()),
+            &scenario.plant.lock,
+        )
+        .map_err(|e| meta_err(path, e.to_string()))?,
         None => return Err(meta_err(path, "the log has no robot.urdf attachment")),
     };
     let mode = match get("mode")?.as_str() {

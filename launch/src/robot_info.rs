@@ -1,28 +1,49 @@
-//! `testbed robot PATH`: what the testbed makes of an arm.
+//! `testbed robot PATH`: what the testbed makes of an arm, and the default
+//! scenario it would run on it, with the reasons for each choice.
 
 use std::fmt::Write;
 use std::path::Path;
 
 use anyhow::Result;
-use scenario::{RobotSource, Scenario};
+use plant_rapier::{ArmModel, Locks};
+use scenario::{ArmDefault, RobotSource};
 
 /// A readable description of the arm at `path`, or the reason it cannot be used.
 pub fn describe(path: &Path) -> Result<String> {
-    let robot = RobotSource::from_file(path)?;
+    let robot = RobotSource::from_file(path, &Locks::new())?;
     let m = &robot.model;
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "robot '{}' ({}): {} actuated joints",
+        "robot '{}' ({}): {} actuated joints{}",
         m.name,
         path.display(),
-        m.dof()
+        m.dof(),
+        if m.mimic.is_empty() {
+            String::new()
+        } else {
+            format!(" and {} mimic joints", m.mimic.len())
+        }
     );
-    let _ = writeln!(out, "\njoint order (q, q̇ and τ index):");
+    joints(&mut out, m);
+    links(&mut out, m);
+    let d = ArmDefault::new(&robot.urdf).map_err(|cause| scenario::ScenarioError::Plant {
+        file: robot.label(),
+        cause,
+    })?;
+    default_scenario(&mut out, &d);
+    Ok(out)
+}
+
+fn joints(out: &mut String, m: &ArmModel) {
     let _ = writeln!(
         out,
-        "  {:>2}  {:<24} {:<11} {:<22} {:<22} {:>10}",
-        "i", "joint", "type", "axis", "limits", "effort"
+        "\njoint order (q, q̇ and τ index; tree order from the root):"
+    );
+    let _ = writeln!(
+        out,
+        "  {:>2}  {:<26} {:<11} {:<22} {:<22} {:>9} {:>9} {:>9}",
+        "i", "joint", "type", "axis", "limits", "effort", "damping", "friction"
     );
     for (i, &ji) in m.actuated.iter().enumerate() {
         let j = &m.joints[ji];
@@ -33,29 +54,96 @@ pub fn describe(path: &Path) -> Result<String> {
         let effort = j.effort.map_or_else(|| "none".into(), |e| format!("{e}"));
         let _ = writeln!(
             out,
-            "  {i:>2}  {:<24} {:<11} {axis:<22} {limits:<22} {effort:>10}",
+            "  {i:>2}  {:<26} {:<11} {axis:<22} {limits:<22} {effort:>9} {:>9} {:>9}",
             j.name,
-            j.kind.as_str()
+            j.kind.as_str(),
+            j.damping,
+            j.friction
         );
     }
+    for c in &m.mimic {
+        let j = &m.joints[c.joint];
+        let _ = writeln!(
+            out,
+            "  mimic joint {} ({}) = {} × {} + {} (coupled, not controlled)",
+            j.name,
+            j.kind.as_str(),
+            c.multiplier,
+            m.joints[m.actuated[c.leader]].name,
+            c.offset
+        );
+    }
+    if m.has_urdf_dynamics() {
+        let _ = writeln!(
+            out,
+            "  URDF <dynamics> damping and friction act in the plant ([plant] urdf_dynamics = false turns them off)"
+        );
+    }
+}
+
+fn links(out: &mut String, m: &ArmModel) {
     let _ = writeln!(
         out,
-        "\nlinks (root '{}' is fixed to the world):",
+        "\nlinks (root '{}' is fixed to the world; its mass properties do not matter):",
         m.links[m.root].name
     );
     for l in &m.links {
-        let _ = writeln!(out, "  {:<24} {:>9.4} kg", l.name, l.mass);
+        let _ = writeln!(out, "  {:<26} {:>9.4} kg", l.name, l.mass);
     }
     let _ = writeln!(out, "  moving mass {:.4} kg", m.moving_mass());
     for merged in &m.merged {
         let _ = writeln!(out, "  merged fixed joint {merged}");
     }
-    let s = Scenario::for_arm(m)?;
+    for ig in &m.ignored {
+        let _ = writeln!(out, "  ignored link {}: {}", ig.name, ig.reason);
+    }
+    for note in &m.notes {
+        let _ = writeln!(out, "  note: {note}");
+    }
+}
+
+fn default_scenario(out: &mut String, d: &ArmDefault) {
+    let s = &d.scenario;
+    let g = &d.gains;
     let _ = writeln!(
         out,
-        "\ndefault scenario (--robot without --scenario): {} s at {} Hz, K1 = {:.3}, K2 = {:.3}",
-        s.duration_s, s.rate_hz, s.controller.k1, s.controller.k2
+        "\ndefault scenario (--robot without --scenario): {} s at {} Hz, {} controlled joints",
+        s.duration_s,
+        s.rate_hz,
+        g.joints.len()
     );
+    if let Some(why) = &g.rate_reason {
+        let _ = writeln!(out, "  rate raised from 1000 Hz: {why}");
+    }
+    for (name, why) in &d.locked {
+        let at = s.plant.lock.get(name).copied().unwrap_or(0.0);
+        let _ = writeln!(out, "  locked {name} at {at:.4}: {why}");
+    }
+    let _ = writeln!(
+        out,
+        "  {:>2}  {:<26} {:>9} {:>10} {:>11} {:>9} {:>8}  why K1",
+        "i", "joint", "K1", "K2", "max M⁻¹_ii", "load N m", "effort"
+    );
+    for (i, j) in g.joints.iter().enumerate() {
+        let effort = j.effort.map_or_else(|| "none".into(), |e| format!("{e}"));
+        let _ = writeln!(
+            out,
+            "  {i:>2}  {:<26} {:>9.3} {:>10.4} {:>11.4} {:>9.3} {:>8}  {}",
+            j.name, j.k1, j.k2, j.minv_diag, j.load, effort, j.k1_reason
+        );
+    }
+    let _ = writeln!(
+        out,
+        "  K2_i = 1/(Δt·max M⁻¹_ii), scaled so that Δt·λmax(K2^½ M⁻¹ K2^½) = {:.3} (< 2 is stable)",
+        g.stability_number
+    );
+    let below = g.below_half();
+    if !below.is_empty() {
+        let _ = writeln!(
+            out,
+            "  K2_i below the analysis's 1/2 (allowed, SPEC §7; [plant] armature raises it): {}",
+            below.join(", ")
+        );
+    }
     let _ = writeln!(out, "  initial q = {:?}", s.initial.q);
-    Ok(out)
 }

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::PlantError;
+use crate::{Locks, PlantError};
 
 /// How the plant integrates, and the effects it adds on top of the rigid
 /// body dynamics.
@@ -24,6 +24,12 @@ pub struct PlantConfig {
     /// Effort limit per joint, N m (N for prismatic joints); replaces the
     /// URDF's `<limit effort>` (default: unset, the URDF's).
     pub effort_limit: Option<PerJoint>,
+    /// Apply the URDF's `<dynamics damping friction>` to its joints
+    /// (default: true).
+    pub urdf_dynamics: bool,
+    /// Motor armature (rotor inertia × gear ratio²) per controlled joint,
+    /// which URDFs omit, kg m² (kg for prismatic joints) (default: 0).
+    pub armature: PerJoint,
     /// Joint friction.
     pub friction: FrictionConfig,
     /// A payload mass fixed to a link.
@@ -34,6 +40,12 @@ pub struct PlantConfig {
     pub sensor: SensorConfig,
     /// What happens to a command between the controller and the motors.
     pub actuation: ActuationConfig,
+    /// Joints held still, by URDF name and position (rad or m):
+    /// `[plant.lock]` with `finger_joint1 = 0.02`. A locked joint is
+    /// simulated as fixed and is not controlled; a joint that mimics it is
+    /// held where the coupling puts it (default: none; the default scenario
+    /// of an arm locks its gripper and finger joints).
+    pub lock: Locks,
 }
 
 impl Default for PlantConfig {
@@ -48,6 +60,9 @@ impl Default for PlantConfig {
             disturbance: DisturbanceConfig::default(),
             sensor: SensorConfig::default(),
             actuation: ActuationConfig::default(),
+            lock: Locks::new(),
+            urdf_dynamics: true,
+            armature: PerJoint::default(),
         }
     }
 }
@@ -272,6 +287,14 @@ impl PlantConfig {
         if let Some(e) = &self.effort_limit {
             e.check("plant.effort_limit")?;
         }
+        self.armature.check("plant.armature")?;
+        if let Some((name, v)) = self.lock.iter().find(|(_, v)| !v.is_finite()) {
+            return Err(invalid(
+                &format!("plant.lock.{name}"),
+                v,
+                "a finite position",
+            ));
+        }
         let f = &self.friction;
         f.viscous.check("plant.friction.viscous")?;
         f.coulomb.check("plant.friction.coulomb")?;
@@ -388,6 +411,7 @@ impl PlantConfig {
         if let Some(e) = &self.effort_limit {
             e.resolve("plant.effort_limit", n)?;
         }
+        self.armature.resolve("plant.armature", n)?;
         self.friction.viscous.resolve("plant.friction.viscous", n)?;
         self.friction.coulomb.resolve("plant.friction.coulomb", n)?;
         let d = &self.disturbance;

@@ -38,7 +38,10 @@ pub use config::{
     SensorConfig,
 };
 pub use effects::Effects;
-pub use model::{ArmModel, JointInfo, JointKind, LinkInfo, MergedLink, Origin};
+pub use model::{
+    ArmModel, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks, MergedLink,
+    MimicJoint, MimicSpec, Origin,
+};
 pub use plant::Plant;
 pub use rig::Rig;
 
@@ -105,13 +108,13 @@ pub enum PlantError {
         /// Its kind.
         kind: String,
     },
-    /// `<mimic>` joints are not supported.
-    #[error(
-        "joint '{joint}' has <mimic>; mimic joints are not supported (make it an independent joint or fixed)"
-    )]
+    /// A `<mimic>` that cannot be simulated.
+    #[error("joint '{joint}' has <mimic>: {reason}")]
     Mimic {
         /// The joint.
         joint: String,
+        /// What is wrong with it.
+        reason: String,
     },
     /// An actuated joint with a zero axis.
     #[error("joint '{joint}' has a zero-length axis")]

@@ -20,11 +20,24 @@ struct Dof {
     axis_in_parent: Vector,
 }
 
+/// A joint that follows a controlled one by `<mimic>`: where it lives and
+/// how it is coupled, to keep `set_state` consistent with the coupling.
+#[derive(Debug, Clone)]
+struct Coupled {
+    link_id: usize,
+    assembly_id: usize,
+    coord: usize,
+    leader: usize,
+    multiplier: f64,
+    offset: f64,
+}
+
 /// An arm simulated by Rapier in double precision.
 pub struct Plant {
     world: PhysicsWorld,
     multibody: MultibodyJointHandle,
     dofs: Vec<Dof>,
+    coupled: Vec<Coupled>,
     names: Vec<String>,
     substeps: u32,
     bodies: Vec<RigidBodyHandle>,
@@ -161,41 +174,23 @@ impl Plant {
         mb.frictions_mut().fill(0.0);
         mb.armature_mut().fill(0.0);
 
-        let mut dofs = Vec::with_capacity(model.dof());
-        for &ji in &model.actuated {
-            let j = &model.joints[ji];
-            let child = handles[j.child];
-            let link = multibody_joints.rigid_body_link(child).ok_or_else(|| {
-                PlantError::Engine(format!("joint '{}' is not in the multibody", j.name))
-            })?;
-            let (mb, _) = multibody_joints
-                .get(multibody)
-                .ok_or_else(|| PlantError::Engine("multibody vanished".into()))?;
-            let l = mb
-                .link(link.id)
-                .ok_or_else(|| PlantError::Engine(format!("no link for joint '{}'", j.name)))?;
-            let prismatic = j.kind == JointKind::Prismatic;
-            let frame1 = l.joint().data.local_frame1;
-            dofs.push(Dof {
-                link_id: link.id,
-                assembly_id: l.assembly_id(),
-                coord: if prismatic { 0 } else { 3 },
-                prismatic,
-                parent: handles[j.parent],
-                child,
-                axis_in_parent: frame1.rotation * Vector::X,
-            });
-        }
+        let dofs = model
+            .actuated
+            .iter()
+            .map(|&ji| dof_of(model, ji, &handles, multibody_joints, multibody))
+            .collect::<Result<Vec<_>, _>>()?;
+        let coupled = couple_mimics(model, &dofs, &handles, multibody_joints, multibody)?;
         let ndofs = multibody_joints
             .get(multibody)
             .map(|(mb, _)| mb.ndofs())
             .unwrap_or(0);
-        if ndofs != dofs.len() {
+        if ndofs != dofs.len() + coupled.len() {
             return Err(PlantError::Engine(format!(
-                "the multibody has {ndofs} degrees of freedom but the URDF {} actuated joints",
-                dofs.len()
+                "the multibody has {ndofs} degrees of freedom but the URDF {} moving joints",
+                dofs.len() + coupled.len()
             )));
         }
+        joint_dynamics(model, config, &dofs, &coupled, multibody_joints, multibody)?;
         let scenario_effort = match &config.effort_limit {
             Some(e) => Some(e.resolve("plant.effort_limit", n)?),
             None => None,
@@ -229,6 +224,7 @@ impl Plant {
             link_mprops,
             total: vec![0.0; n],
             dofs,
+            coupled,
             substeps: config.substeps,
             bodies: handles,
             effort,
@@ -289,10 +285,20 @@ impl Plant {
         let Some((mb, _)) = multibody_joints.get_mut(self.multibody) else {
             return Err(PlantError::Engine("multibody vanished".into()));
         };
-        for (i, d) in self.dofs.iter().enumerate() {
-            if let Some(link) = mb.link_mut(d.link_id) {
-                let now = link.joint().coords()[d.coord];
-                link.joint.apply_displacement(&[q[i] - now]);
+        let targets = self
+            .dofs
+            .iter()
+            .enumerate()
+            .map(|(i, d)| (d.link_id, d.coord, q[i]))
+            .chain(
+                self.coupled
+                    .iter()
+                    .map(|c| (c.link_id, c.coord, c.multiplier * q[c.leader] + c.offset)),
+            );
+        for (link_id, coord, target) in targets {
+            if let Some(link) = mb.link_mut(link_id) {
+                let now = link.joint().coords()[coord];
+                link.joint.apply_displacement(&[target - now]);
             }
         }
         mb.forward_kinematics(bodies, false);
@@ -300,6 +306,9 @@ impl Plant {
         let mut v = mb.generalized_velocity_mut();
         for (i, d) in self.dofs.iter().enumerate() {
             v[d.assembly_id] = qd[i];
+        }
+        for c in &self.coupled {
+            v[c.assembly_id] = c.multiplier * qd[c.leader];
         }
         Ok(())
     }
@@ -482,4 +491,129 @@ impl Plant {
 /// subtracts it, so it always opposes the motion.
 fn friction(qd: f64, viscous: f64, coulomb: f64, smoothing_velocity: f64) -> f64 {
     viscous * qd + coulomb * (qd / smoothing_velocity).tanh()
+}
+
+/// Where controlled joint `ji` lives in the multibody.
+fn dof_of(
+    model: &ArmModel,
+    ji: usize,
+    handles: &[RigidBodyHandle],
+    joints: &MultibodyJointSet,
+    multibody: MultibodyJointHandle,
+) -> Result<Dof, PlantError> {
+    let j = &model.joints[ji];
+    let child = handles[j.child];
+    let (link_id, assembly_id, frame1) = locate(joints, multibody, child, &j.name)?;
+    let prismatic = j.kind == JointKind::Prismatic;
+    Ok(Dof {
+        link_id,
+        assembly_id,
+        coord: if prismatic { 0 } else { 3 },
+        prismatic,
+        parent: handles[j.parent],
+        child,
+        axis_in_parent: frame1.rotation * Vector::X,
+    })
+}
+
+/// A joint's link id, assembly id and parent-side frame in the multibody.
+fn locate(
+    joints: &MultibodyJointSet,
+    multibody: MultibodyJointHandle,
+    child: RigidBodyHandle,
+    name: &str,
+) -> Result<(usize, usize, Pose), PlantError> {
+    let link = joints
+        .rigid_body_link(child)
+        .ok_or_else(|| PlantError::Engine(format!("joint '{name}' is not in the multibody")))?;
+    let (mb, _) = joints
+        .get(multibody)
+        .ok_or_else(|| PlantError::Engine("multibody vanished".into()))?;
+    let l = mb
+        .link(link.id)
+        .ok_or_else(|| PlantError::Engine(format!("no link for joint '{name}'")))?;
+    Ok((link.id, l.assembly_id(), l.joint().data.local_frame1))
+}
+
+/// Couples every `<mimic>` joint to its leader: q = multiplier · q_leader + offset.
+fn couple_mimics(
+    model: &ArmModel,
+    dofs: &[Dof],
+    handles: &[RigidBodyHandle],
+    joints: &mut MultibodyJointSet,
+    multibody: MultibodyJointHandle,
+) -> Result<Vec<Coupled>, PlantError> {
+    let mut coupled = Vec::with_capacity(model.mimic.len());
+    for m in &model.mimic {
+        let j = &model.joints[m.joint];
+        let (link_id, assembly_id, _) = locate(joints, multibody, handles[j.child], &j.name)?;
+        let coord = if j.kind == JointKind::Prismatic { 0 } else { 3 };
+        let leader = &dofs[m.leader];
+        let (mb, _) = joints
+            .get_mut(multibody)
+            .ok_or_else(|| PlantError::Engine("multibody vanished".into()))?;
+        mb.add_dof_coupling(MultibodyDofCoupling {
+            link1: leader.link_id,
+            dof1: 0,
+            axis1: leader.coord,
+            link2: link_id,
+            dof2: 0,
+            axis2: coord,
+            coeff: m.multiplier,
+            offset: m.offset,
+        });
+        coupled.push(Coupled {
+            link_id,
+            assembly_id,
+            coord,
+            leader: m.leader,
+            multiplier: m.multiplier,
+            offset: m.offset,
+        });
+    }
+    Ok(coupled)
+}
+
+/// URDF damping and dry friction on every moving joint (unless the scenario
+/// turns them off) and the scenario's armature on the controlled ones.
+fn joint_dynamics(
+    model: &ArmModel,
+    config: &PlantConfig,
+    dofs: &[Dof],
+    coupled: &[Coupled],
+    joints: &mut MultibodyJointSet,
+    multibody: MultibodyJointHandle,
+) -> Result<(), PlantError> {
+    let armature = config.armature.resolve("plant.armature", dofs.len())?;
+    let massless = model.joints_moving_no_mass();
+    for (i, name) in model.joint_names().iter().enumerate() {
+        if massless.contains(name) && armature[i] <= 0.0 {
+            let link = &model.links[model.joints[model.actuated[i]].child].name;
+            return Err(PlantError::BadInertia {
+                link: link.clone(),
+                reason: format!(
+                    "joint '{name}' moves this link, but it and everything it carries have no mass: \
+                     lock the joint ([plant.lock]), give it armature ([plant] armature) or give the link an <inertial>"
+                ),
+            });
+        }
+    }
+    let (mb, _) = joints
+        .get_mut(multibody)
+        .ok_or_else(|| PlantError::Engine("multibody vanished".into()))?;
+    let at = dofs
+        .iter()
+        .map(|d| d.assembly_id)
+        .chain(coupled.iter().map(|c| c.assembly_id));
+    for (ji, a) in model.moving_joints().zip(at) {
+        let j = &model.joints[ji];
+        if config.urdf_dynamics {
+            mb.damping_mut()[a] = j.damping;
+            mb.frictions_mut()[a] = j.friction;
+        }
+    }
+    for (d, arm) in dofs.iter().zip(&armature) {
+        mb.armature_mut()[d.assembly_id] = *arm;
+    }
+    Ok(())
 }

@@ -1,99 +1,141 @@
 //! A scenario that works on any arm: what `--robot PATH` runs when no
 //! scenario file is given.
 //!
-//! Per joint, a smooth sinusoid about the middle of its range; an envelope
-//! of about 0.25 rad; an initial state outside the envelope, so the
-//! deferred constraint is exercised; and gains scaled to the arm. The
-//! paper's gains suit the paper's arm only: the discrete loop needs
-//! Δt·K2·λ_max(M⁻¹) < 2 (SPEC §11), so K2 is chosen from the arm's inertia,
-//! measured by probing the plant (the controller itself still gets no model).
+//! Gripper and finger joints (and joints that move no mass) are locked, so
+//! the controller drives the arm. Per joint: a smooth sinusoid about the
+//! middle of its range, an envelope of about 0.25 rad, an initial state
+//! outside the envelope so the deferred constraint is exercised, and gains
+//! K1_i, K2_i chosen from what the plant reports (the controller itself
+//! still gets no model; see [`crate::gains`]).
 
-use plant_rapier::{ArmModel, JointKind, Plant, PlantConfig, PlantError};
+use plant_rapier::{ArmModel, JointKind, Locks, PlantError};
 use trajectory::{EnvelopeConfig, ReferenceConfig, Sinusoid};
 
+use crate::gains::{GainChoice, choose_gains};
 use crate::{Initial, Scenario};
 
-/// Largest gain the paper uses.
-const PAPER_GAIN: f64 = 15.0;
-/// Δt·K2·λ_max(M⁻¹) aimed for: half the stability limit, since M
-/// changes with the posture.
-const MARGIN: f64 = 1.0;
-/// Smallest K2 worth running; below it the rate is raised.
-const MIN_GAIN: f64 = 5.0;
-const MAX_RATE_HZ: f64 = 10_000.0;
+/// Joint names that mark a gripper or a finger (compared in lower case).
+const GRIPPER_WORDS: [&str; 6] = ["finger", "gripper", "grip", "hand", "jaw", "claw"];
 
-/// The largest eigenvalue of M(q)⁻¹ at `q` (rad⁻¹ s⁻² per N m), from the
-/// plant's response to unit joint torques at rest.
-pub fn max_inverse_inertia(model: &ArmModel, q: &[f64]) -> Result<f64, PlantError> {
-    let n = model.dof();
-    let config = PlantConfig {
-        saturate: false,
-        ..PlantConfig::default()
-    };
-    let h = 1e-5;
-    let accel = |tau: &[f64]| -> Result<Vec<f64>, PlantError> {
-        let mut p = Plant::new(model, &config)?;
-        p.set_state(q, &vec![0.0; n])?;
-        p.step(tau, h)?;
-        Ok(p.state().1.iter().map(|v| v / h).collect())
-    };
-    let a0 = accel(&vec![0.0; n])?;
-    let mut minv = nalgebra::DMatrix::zeros(n, n);
-    for k in 0..n {
-        let mut tau = vec![0.0; n];
-        tau[k] = 1.0;
-        let a = accel(&tau)?;
-        for i in 0..n {
-            minv[(i, k)] = a[i] - a0[i];
-        }
-    }
-    let sym = (&minv + minv.transpose()) * 0.5;
-    Ok(sym
-        .symmetric_eigenvalues()
-        .iter()
-        .copied()
-        .fold(0.0, f64::max))
+/// The default scenario for an arm and why it is what it is.
+#[derive(Debug, Clone)]
+pub struct ArmDefault {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Joints the scenario locks, with the reason.
+    pub locked: Vec<(String, String)>,
+    /// The gains and the reasons for them.
+    pub gains: GainChoice,
 }
 
-impl Scenario {
-    /// The default scenario for `model` (see the module docs).
-    pub fn for_arm(model: &ArmModel) -> Result<Self, PlantError> {
-        let mut reference = Vec::new();
-        let mut envelope = Vec::new();
-        for (i, &ji) in model.actuated.iter().enumerate() {
-            let j = &model.joints[ji];
-            let (center, half) = match j.limits {
-                Some((lo, hi)) => (0.5 * (lo + hi), 0.5 * (hi - lo)),
-                None => (0.0, f64::INFINITY),
-            };
-            let (amp, kc) = match j.kind {
-                JointKind::Prismatic => (0.3 * half, 0.15 * half),
-                _ => ((0.3 * half).min(0.5), 0.25f64.min(0.3 * half)),
-            };
-            let omega = 0.8 + 0.2 * (i % 3) as f64;
-            // Alternate sin and cos so the joints do not all start at rest.
-            reference.push(if i % 2 == 0 {
-                Sinusoid {
-                    offset: center,
-                    sin: amp,
-                    cos: 0.0,
-                    omega,
-                }
-            } else {
-                Sinusoid {
-                    offset: center,
-                    sin: 0.0,
-                    cos: amp,
-                    omega,
-                }
-            });
-            envelope.push(Sinusoid {
-                offset: kc,
-                sin: 0.2 * kc,
-                cos: 0.0,
-                omega: 0.5,
-            });
+/// Whether a joint's name says it belongs to a gripper or a hand.
+fn is_gripper(name: &str) -> bool {
+    let lower = name.to_lowercase();
+    GRIPPER_WORDS.iter().any(|w| lower.contains(w))
+}
+
+/// Where a locked joint is held: the middle of its range, or 0.
+fn lock_position(limits: Option<(f64, f64)>) -> f64 {
+    limits.map_or(0.0, |(lo, hi)| 0.5 * (lo + hi))
+}
+
+/// The joints the default scenario locks: grippers and fingers, and joints
+/// that move no mass, as long as some joint is left to control.
+fn default_locks(full: &ArmModel) -> Vec<(String, f64, String)> {
+    let massless = full.joints_moving_no_mass();
+    let mut locks: Vec<(String, f64, String)> = Vec::new();
+    for &ji in &full.actuated {
+        let j = &full.joints[ji];
+        let why = if is_gripper(&j.name) {
+            "a gripper or finger joint: the controller drives the arm"
+        } else if massless.contains(&j.name) {
+            "it moves no mass, so its acceleration is undefined"
+        } else {
+            continue;
+        };
+        locks.push((j.name.clone(), lock_position(j.limits), why.to_string()));
+    }
+    if locks.len() == full.dof() {
+        // Nothing would be left: lock only what cannot be simulated.
+        locks.retain(|(name, ..)| massless.contains(name));
+    }
+    locks
+}
+
+/// The widest envelope offset a joint may be given: 0.6 rad, or 0.3 of
+/// its half range.
+fn kc_cap(model: &ArmModel) -> Vec<f64> {
+    model
+        .actuated
+        .iter()
+        .map(|&ji| {
+            let half = model.joints[ji]
+                .limits
+                .map_or(f64::INFINITY, |(lo, hi)| 0.5 * (hi - lo));
+            match model.joints[ji].kind {
+                JointKind::Prismatic => 0.15 * half,
+                _ => (0.3 * half).min(0.6),
+            }
+        })
+        .collect()
+}
+
+/// Per joint: the reference about `offsets`, the envelope (offset `kc` when
+/// given), and the initial position.
+fn shape(
+    model: &ArmModel,
+    offsets: &[f64],
+    kc: Option<&[f64]>,
+) -> (Vec<Sinusoid>, Vec<Sinusoid>, Vec<f64>) {
+    let (mut reference, mut envelope, mut q0) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, &ji) in model.actuated.iter().enumerate() {
+        let j = &model.joints[ji];
+        let half = j.limits.map_or(f64::INFINITY, |(lo, hi)| 0.5 * (hi - lo));
+        let center = offsets[i];
+        let (amp, kc_default) = match j.kind {
+            JointKind::Prismatic => (0.3 * half, 0.15 * half),
+            _ => ((0.3 * half).min(0.5), 0.25f64.min(0.3 * half)),
+        };
+        let kc = kc.map_or(kc_default, |k| k[i]);
+        let omega = 0.8 + 0.2 * (i % 3) as f64;
+        // Alternate sin and cos so the joints do not all start at rest.
+        let (sin, cos) = if i % 2 == 0 { (amp, 0.0) } else { (0.0, amp) };
+        let r = Sinusoid {
+            offset: center,
+            sin,
+            cos,
+            omega,
+        };
+        let e = Sinusoid {
+            offset: kc,
+            sin: 0.2 * kc,
+            cos: 0.0,
+            omega: 0.5,
+        };
+        // Start 1.5 envelopes away from the reference: outside the bound,
+        // inside the joint limits.
+        let mut q = r.eval(0.0)[0] + 1.5 * e.eval(0.0)[0];
+        if let Some((lo, hi)) = j.limits {
+            let pad = 0.02 * (hi - lo);
+            q = q.clamp(lo + pad, hi - pad);
         }
+        reference.push(r);
+        envelope.push(e);
+        q0.push(q);
+    }
+    (reference, envelope, q0)
+}
+
+impl ArmDefault {
+    /// The default scenario for the arm in `urdf` (see the module docs).
+    pub fn new(urdf: &str) -> Result<Self, PlantError> {
+        let full = ArmModel::from_urdf_str(urdf)?;
+        let chosen = default_locks(&full);
+        let lock: Locks = chosen.iter().map(|(n, p, _)| (n.clone(), *p)).collect();
+        let model = ArmModel::from_urdf_str_locked(urdf, &lock)?;
+        let offsets = crate::posture::choose(&model)?;
+        let (reference, envelope, q0) = shape(&model, &offsets, None);
+        let n = q0.len();
         let mut s = Scenario {
             name: format!("default for {}", model.name),
             duration_s: 10.0,
@@ -105,38 +147,31 @@ impl Scenario {
                 joints: envelope,
                 from_limits: false,
             },
+            initial: Initial {
+                q: q0,
+                qd: vec![0.0; n],
+            },
             ..Scenario::default()
         };
-        // Start 1.5 envelopes away from the reference: outside the bound,
-        // inside the joint limits.
-        let mut q0 = Vec::new();
-        for (i, &ji) in model.actuated.iter().enumerate() {
-            let [qd0, _, _] = s.reference.joints[i].eval(0.0);
-            let [kc0, _, _] = s.envelope.joints[i].eval(0.0);
-            let mut q = qd0 + 1.5 * kc0;
-            if let Some((lo, hi)) = model.joints[ji].limits {
-                let pad = 0.02 * (hi - lo);
-                q = q.clamp(lo + pad, hi - pad);
-            }
-            q0.push(q);
-        }
-        let n = q0.len();
-        s.initial = Initial {
-            q: q0,
-            qd: vec![0.0; n],
-        };
+        s.plant.lock = lock;
+        let gains = choose_gains(&model, &s, &kc_cap(&model))?;
+        let (_, envelope, q0) = shape(&model, &offsets, Some(&gains.envelope));
+        s.envelope.joints = envelope;
+        s.initial.q = q0;
+        s.rate_hz = gains.rate_hz;
+        s.controller.k1 = controller::Gain::Each(gains.joints.iter().map(|g| g.k1).collect());
+        s.controller.k2 = controller::Gain::Each(gains.joints.iter().map(|g| g.k2).collect());
+        Ok(Self {
+            scenario: s,
+            locked: chosen.into_iter().map(|(n, _, why)| (n, why)).collect(),
+            gains,
+        })
+    }
+}
 
-        let lambda = max_inverse_inertia(model, &s.initial.q)?;
-        let mut rate = s.rate_hz;
-        let mut gain = PAPER_GAIN.min(MARGIN * rate / lambda.max(1e-9));
-        if gain < MIN_GAIN {
-            // A multiple of 100 Hz keeps the period a round number of ns.
-            rate = ((MIN_GAIN * lambda / MARGIN / 100.0).ceil() * 100.0).min(MAX_RATE_HZ);
-            gain = PAPER_GAIN.min(MARGIN * rate / lambda).max(0.6);
-        }
-        s.rate_hz = rate;
-        s.controller.k1 = gain.max(1.01);
-        s.controller.k2 = gain;
-        Ok(s)
+impl Scenario {
+    /// The default scenario for the arm in `urdf` (see the module docs).
+    pub fn for_arm(urdf: &str) -> Result<Self, PlantError> {
+        ArmDefault::new(urdf).map(|d| d.scenario)
     }
 }

@@ -9,22 +9,27 @@
 //!
 //! ```
 //! let s = scenario::Scenario::from_toml_str("[controller]\nk1 = 20.0\n", "inline").unwrap();
-//! assert_eq!(s.controller.k1, 20.0);
+//! assert_eq!(s.controller.k1, controller::Gain::All(20.0));
 //! assert_eq!(s.duration_s, 20.0); // the paper's default
 //! ```
 
 mod catalogue;
 mod default_for_arm;
+mod gains;
+mod posture;
+mod probe;
 
 use std::path::{Path, PathBuf};
 
 use controller::{ControllerError, ControllerParams};
-use plant_rapier::{ArmModel, PlantConfig, PlantError};
+use plant_rapier::{ArmModel, Locks, PlantConfig, PlantError};
 use serde::{Deserialize, Serialize};
 use trajectory::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError};
 
 pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
-pub use default_for_arm::max_inverse_inertia;
+pub use default_for_arm::ArmDefault;
+pub use gains::{GainChoice, JointGain};
+pub use probe::{Probe, max_inverse_inertia};
 
 /// The paper's scenario as shipped in `scenarios/paper.toml`.
 pub const PAPER_TOML: &str = include_str!("../../scenarios/paper.toml");
@@ -177,15 +182,15 @@ impl RobotSource {
         }
     }
 
-    /// Loads and checks a URDF file.
-    pub fn from_file(path: &Path) -> Result<Self, ScenarioError> {
+    /// Loads and checks a URDF file with the joints in `locks` held.
+    pub fn from_file(path: &Path, locks: &Locks) -> Result<Self, ScenarioError> {
         let file = path.display().to_string();
         let urdf = std::fs::read_to_string(path).map_err(|cause| ScenarioError::Io {
             file: file.clone(),
             cause,
         })?;
-        let model =
-            ArmModel::from_urdf_str(&urdf).map_err(|cause| ScenarioError::Plant { file, cause })?;
+        let model = ArmModel::from_urdf_str_locked(&urdf, locks)
+            .map_err(|cause| ScenarioError::Plant { file, cause })?;
         Ok(Self {
             path: Some(path.to_path_buf()),
             urdf,
@@ -193,12 +198,27 @@ impl RobotSource {
         })
     }
 
-    /// A URDF given as text (e.g. a log's attachment); `label` names it in messages.
-    pub fn from_text(urdf: &str, label: &str) -> Result<Self, ScenarioError> {
-        let model = ArmModel::from_urdf_str(urdf).map_err(|cause| ScenarioError::Plant {
-            file: label.to_string(),
-            cause,
+    /// The same URDF with other joints locked.
+    pub fn relocked(&self, locks: &Locks) -> Result<Self, ScenarioError> {
+        let model = ArmModel::from_urdf_str_locked(&self.urdf, locks).map_err(|cause| {
+            ScenarioError::Plant {
+                file: self.label(),
+                cause,
+            }
         })?;
+        Ok(Self {
+            model,
+            ..self.clone()
+        })
+    }
+
+    /// A URDF given as text (e.g. a log's attachment); `label` names it in messages.
+    pub fn from_text(urdf: &str, label: &str, locks: &Locks) -> Result<Self, ScenarioError> {
+        let model =
+            ArmModel::from_urdf_str_locked(urdf, locks).map_err(|cause| ScenarioError::Plant {
+                file: label.to_string(),
+                cause,
+            })?;
         Ok(Self {
             path: Some(PathBuf::from(label)),
             urdf: urdf.to_string(),
@@ -389,16 +409,19 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
         ),
     };
     let arm = match &overrides.robot {
-        Some(path) => Some(RobotSource::from_file(path)?),
+        Some(path) => Some(RobotSource::from_file(path, &Locks::new())?),
         None => None,
     };
     let (mut scenario, toml_text, source) = match (&arm, path) {
         (Some(arm), None) => {
-            let s = Scenario::for_arm(&arm.model).map_err(|cause| ScenarioError::Plant {
+            let s = Scenario::for_arm(&arm.urdf).map_err(|cause| ScenarioError::Plant {
                 file: arm.label(),
                 cause,
             })?;
-            let text = toml::to_string(&s).unwrap_or_default();
+            let text = toml::to_string(&s).map_err(|e| ScenarioError::Toml {
+                file: arm.label(),
+                message: format!("cannot write the default scenario: {e}"),
+            })?;
             (s, text, format!("default scenario for {}", arm.label()))
         }
         _ => (
@@ -415,12 +438,13 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
         scenario.rate_hz = r;
         scenario.validate(&format!("{source} with --rate {r}"))?;
     }
+    let locks = &scenario.plant.lock;
     let robot = match (arm, &scenario.robot, &base) {
-        (Some(arm), _, _) => Ok(arm),
+        (Some(arm), _, _) => arm.relocked(locks),
         (None, rel, base) => match (rel, base) {
-            (Some(rel), Some(base)) => RobotSource::from_file(&base.join(rel)),
-            (Some(rel), None) => RobotSource::from_file(Path::new(rel)),
-            (None, _) => Ok(RobotSource::builtin()),
+            (Some(rel), Some(base)) => RobotSource::from_file(&base.join(rel), locks),
+            (Some(rel), None) => RobotSource::from_file(Path::new(rel), locks),
+            (None, _) => RobotSource::builtin().relocked(locks),
         },
     }
     .map_err(|cause| ScenarioError::Robot {
@@ -457,6 +481,14 @@ pub fn plan(
         if len != dof && !(key == "envelope.joints" && scenario.envelope.from_limits) {
             return Err(mismatch(key, len));
         }
+    }
+    let c = &scenario.controller;
+    for (key, gain) in [("controller.k1", &c.k1), ("controller.k2", &c.k2)] {
+        gain.resolve(key, dof)
+            .map_err(|cause| ScenarioError::Controller {
+                file: source.clone(),
+                cause,
+            })?;
     }
     let model = &robot.model;
     let limits: Vec<Option<(f64, f64)>> = model

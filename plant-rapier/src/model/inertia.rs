@@ -1,0 +1,116 @@
+//! Mass properties: what a physical inertia is, and how two rigidly joined
+//! links add up.
+
+use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
+
+use super::{LinkInfo, Origin};
+use crate::PlantError;
+
+/// A link lighter than this fraction of the heaviest moving link is
+/// negligible: real URDFs use 1e-9 kg for frames that are not bodies.
+pub(super) const NEGLIGIBLE_MASS_RATIO: f64 = 1e-6;
+
+pub(crate) fn iso(o: &Origin) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(o.xyz[0], o.xyz[1], o.xyz[2]),
+        UnitQuaternion::from_euler_angles(o.rpy[0], o.rpy[1], o.rpy[2]),
+    )
+}
+
+pub(super) fn origin_of(t: &Isometry3<f64>) -> Origin {
+    let (r, p, y) = t.rotation.euler_angles();
+    let v = t.translation.vector;
+    Origin {
+        xyz: [v.x, v.y, v.z],
+        rpy: [r, p, y],
+    }
+}
+
+fn tensor(i: &[f64; 6]) -> Matrix3<f64> {
+    let [ixx, ixy, ixz, iyy, iyz, izz] = *i;
+    Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz)
+}
+
+/// The tensor about the COM in link axes, and the COM, of a link.
+fn link_inertia(l: &LinkInfo) -> (Matrix3<f64>, Vector3<f64>) {
+    let t = iso(&l.inertial_origin);
+    let r = t.rotation.to_rotation_matrix();
+    (
+        r.matrix() * tensor(&l.inertia) * r.matrix().transpose(),
+        t.translation.vector,
+    )
+}
+
+/// Adds `child`, placed at `t` in `parent`'s frame, to `parent`'s mass properties.
+pub(super) fn merge_mass(parent: &mut LinkInfo, child: &LinkInfo, t: &Isometry3<f64>) {
+    let m = parent.mass + child.mass;
+    if child.mass == 0.0 || m == 0.0 {
+        return;
+    }
+    let (ip, cp) = link_inertia(parent);
+    let (ic, cc) = link_inertia(child);
+    let r = t.rotation.to_rotation_matrix();
+    let ic = r.matrix() * ic * r.matrix().transpose();
+    let cc = t * Point3::from(cc);
+    let c = (parent.mass * cp + child.mass * cc.coords) / m;
+    // Parallel-axis theorem for each part about the combined COM.
+    let shift =
+        |mass: f64, d: Vector3<f64>| mass * (d.dot(&d) * Matrix3::identity() - d * d.transpose());
+    let i = ip + shift(parent.mass, cp - c) + ic + shift(child.mass, cc.coords - c);
+    parent.mass = m;
+    parent.inertial_origin = Origin {
+        xyz: [c.x, c.y, c.z],
+        rpy: [0.0; 3],
+    };
+    parent.inertia = [
+        i[(0, 0)],
+        i[(0, 1)],
+        i[(0, 2)],
+        i[(1, 1)],
+        i[(1, 2)],
+        i[(2, 2)],
+    ];
+}
+
+/// How far published files break the triangle inequality (relative to the
+/// largest moment) and are still simulated as given, with a note.
+const TRIANGLE_SLACK: f64 = 0.25;
+
+/// A physical inertia tensor is positive semi-definite (a point mass or a
+/// thin rod has zero moments) and its principal moments obey the triangle
+/// inequality. Rounding in published files is allowed for: a tensor that
+/// breaks the inequality by at most 25 % (published files do) is still positive semi-definite and
+/// simulates; the note returned says so.
+pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Option<String>, PlantError> {
+    let bad = |reason: String| {
+        Err(PlantError::BadInertia {
+            link: link.to_string(),
+            reason,
+        })
+    };
+    let mut ev: Vec<f64> = tensor(i).symmetric_eigenvalues().iter().copied().collect();
+    ev.sort_by(f64::total_cmp);
+    let scale = ev[2].abs().max(f64::MIN_POSITIVE);
+    if ev[0] < -1e-9 * scale {
+        return bad(format!(
+            "the inertia tensor is not positive semi-definite (principal moments {:.3e}, {:.3e}, {:.3e})",
+            ev[0], ev[1], ev[2]
+        ));
+    }
+    let short = (ev[2] - ev[0] - ev[1]) / scale;
+    if short > TRIANGLE_SLACK {
+        return bad(format!(
+            "principal moments {:.3e}, {:.3e}, {:.3e} break the triangle inequality",
+            ev[0], ev[1], ev[2]
+        ));
+    }
+    Ok((short > 1e-6).then(|| {
+        format!(
+            "link '{link}': principal moments {:.3e}, {:.3e}, {:.3e} break the triangle inequality by {:.2} % of the largest; simulated as given",
+            ev[0],
+            ev[1],
+            ev[2],
+            100.0 * short
+        )
+    }))
+}

@@ -1,0 +1,289 @@
+//! A URDF arm read into a checked, engine-neutral description.
+//!
+//! Parsing and checking happen here, once, so that the Rapier builder only
+//! ever sees a tree it can simulate, and every problem is reported with the
+//! link or joint it concerns. The loader is as lenient as the format is in
+//! practice: a link of zero or negligible mass contributes nothing whatever
+//! inertia it lists, the fixed root's mass properties are irrelevant,
+//! `<mimic>` joints become coupled joints, and joints a scenario locks
+//! become fixed ones.
+
+mod inertia;
+mod parse;
+mod tree;
+
+use std::collections::BTreeMap;
+
+use crate::PlantError;
+
+pub(crate) use inertia::iso;
+
+/// A rigid transform from a URDF `<origin xyz rpy>`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Origin {
+    /// Translation, m.
+    pub xyz: [f64; 3],
+    /// Fixed-axis roll, pitch, yaw, rad.
+    pub rpy: [f64; 3],
+}
+
+/// How a joint moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JointKind {
+    /// Rotation about the axis between limits.
+    Revolute,
+    /// Rotation about the axis without limits.
+    Continuous,
+    /// Translation along the axis.
+    Prismatic,
+    /// No motion: the child moves with the parent.
+    Fixed,
+}
+
+impl JointKind {
+    /// True for the kinds that move (driven or coupled).
+    pub fn is_actuated(self) -> bool {
+        !matches!(self, JointKind::Fixed)
+    }
+
+    /// The URDF spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            JointKind::Revolute => "revolute",
+            JointKind::Continuous => "continuous",
+            JointKind::Prismatic => "prismatic",
+            JointKind::Fixed => "fixed",
+        }
+    }
+}
+
+/// One link's mass properties.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkInfo {
+    /// URDF link name.
+    pub name: String,
+    /// Mass, kg (0 for a link with no `<inertial>`, or one ignored).
+    pub mass: f64,
+    /// Pose of the inertial frame in the link frame.
+    pub inertial_origin: Origin,
+    /// Inertia tensor about the COM in the inertial frame, kg m²,
+    /// as [ixx, ixy, ixz, iyy, iyz, izz].
+    pub inertia: [f64; 6],
+}
+
+/// A URDF `<mimic joint multiplier offset>`: q = multiplier · q_leader + offset.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MimicSpec {
+    /// The joint followed.
+    pub joint: String,
+    /// Multiplier (default 1).
+    pub multiplier: f64,
+    /// Offset (default 0).
+    pub offset: f64,
+}
+
+/// One joint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointInfo {
+    /// URDF joint name.
+    pub name: String,
+    /// Its kind.
+    pub kind: JointKind,
+    /// Index of the parent link in [`ArmModel::links`].
+    pub parent: usize,
+    /// Index of the child link.
+    pub child: usize,
+    /// Pose of the joint frame (= child link frame at q = 0) in the parent link frame.
+    pub origin: Origin,
+    /// Unit axis in the joint frame.
+    pub axis: [f64; 3],
+    /// Position limits (lower, upper) for revolute and prismatic joints.
+    pub limits: Option<(f64, f64)>,
+    /// Effort limit (N m or N) when the URDF gives a positive one.
+    pub effort: Option<f64>,
+    /// `<dynamics damping>`: viscous, N m s/rad or N s/m (0 when absent).
+    pub damping: f64,
+    /// `<dynamics friction>`: dry friction, N m or N (0 when absent).
+    pub friction: f64,
+    /// `<mimic>` as written.
+    pub mimic: Option<MimicSpec>,
+}
+
+/// A joint that moves with a controlled joint and is not controlled itself.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MimicJoint {
+    /// Index in [`ArmModel::joints`].
+    pub joint: usize,
+    /// The controlled joint it follows, as an index into [`ArmModel::actuated`]
+    /// (a chain of mimics is resolved to its first leader).
+    pub leader: usize,
+    /// q = multiplier · q_leader + offset.
+    pub multiplier: f64,
+    /// Offset, rad or m.
+    pub offset: f64,
+}
+
+/// A joint held at one position: simulated as a fixed joint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LockedJoint {
+    /// URDF joint name.
+    pub name: String,
+    /// Where it is held, rad or m.
+    pub position: f64,
+    /// The locked joint this one mimics, when it is locked for that reason.
+    pub follows: Option<String>,
+}
+
+/// A link whose mass properties the loader set to zero, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IgnoredLink {
+    /// URDF link name.
+    pub name: String,
+    /// The mass it listed, kg.
+    pub mass: f64,
+    /// Why it contributes nothing.
+    pub reason: String,
+}
+
+/// A checked arm: a tree of links rooted at one fixed link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmModel {
+    /// The robot's name.
+    pub name: String,
+    /// Links in file order.
+    pub links: Vec<LinkInfo>,
+    /// Joints in file order.
+    pub joints: Vec<JointInfo>,
+    /// Index of the root link (fixed to the world).
+    pub root: usize,
+    /// Joint indices depth-first from the root (parents before children,
+    /// siblings in file order).
+    pub topological: Vec<usize>,
+    /// Indices of the controlled joints in tree order (depth-first from the
+    /// root): the joint order used everywhere in the testbed. Mimic and
+    /// locked joints are not among them.
+    pub actuated: Vec<usize>,
+    /// Joints coupled to a controlled joint by `<mimic>`.
+    pub mimic: Vec<MimicJoint>,
+    /// Joints held still (by the scenario, or because they mimic one that is).
+    pub locked: Vec<LockedJoint>,
+    /// Links whose listed mass properties were ignored.
+    pub ignored: Vec<IgnoredLink>,
+    /// What the loader accepted that a user should know (slightly
+    /// unphysical inertias, say).
+    pub notes: Vec<String>,
+    /// Fixed joints folded into their parent link, described for users.
+    pub merged: Vec<String>,
+    /// Links folded away by a merge: where each one now sits, so that a
+    /// scenario can still name it (a payload at a tool link, say).
+    pub merged_links: Vec<MergedLink>,
+}
+
+/// A link that a fixed joint folded into another one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MergedLink {
+    /// The URDF name of the folded link.
+    pub name: String,
+    /// Index of the link it is now part of.
+    pub into: usize,
+    /// Its frame in that link's frame.
+    pub origin: Origin,
+}
+
+/// Joint name → position at which a scenario holds it.
+pub type Locks = BTreeMap<String, f64>;
+
+impl ArmModel {
+    /// Parses and checks a URDF document.
+    pub fn from_urdf_str(text: &str) -> Result<Self, PlantError> {
+        Self::from_urdf_str_locked(text, &Locks::new())
+    }
+
+    /// Parses and checks a URDF document with the joints in `locks` held
+    /// at the given positions.
+    pub fn from_urdf_str_locked(text: &str, locks: &Locks) -> Result<Self, PlantError> {
+        let robot =
+            urdf_rs::read_from_string(text).map_err(|e| PlantError::Parse(e.to_string()))?;
+        tree::build(&robot, locks)
+    }
+
+    /// The link called `name` (a merged one too): the index of the body it
+    /// is part of and its frame in that body's link frame.
+    pub fn locate_link(&self, name: &str) -> Option<(usize, Origin)> {
+        if let Some(i) = self.links.iter().position(|l| l.name == name) {
+            return Some((i, Origin::default()));
+        }
+        self.merged_links
+            .iter()
+            .find(|m| m.name == name)
+            .map(|m| (m.into, m.origin))
+    }
+
+    /// Names of every link a scenario may name: the URDF's, merged ones included.
+    pub fn link_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = self.links.iter().map(|l| l.name.clone()).collect();
+        names.extend(self.merged_links.iter().map(|m| m.name.clone()));
+        names
+    }
+
+    /// Number of controlled joints.
+    pub fn dof(&self) -> usize {
+        self.actuated.len()
+    }
+
+    /// Names of the controlled joints, in order.
+    pub fn joint_names(&self) -> Vec<String> {
+        self.actuated
+            .iter()
+            .map(|&i| self.joints[i].name.clone())
+            .collect()
+    }
+
+    /// Total mass of the links that move (every link but the root).
+    pub fn moving_mass(&self) -> f64 {
+        self.links
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != self.root)
+            .map(|(_, l)| l.mass)
+            .sum()
+    }
+
+    /// Mass carried by `link` and everything below it.
+    pub fn subtree_mass(&self, link: usize) -> f64 {
+        self.links[link].mass
+            + self
+                .joints
+                .iter()
+                .filter(|j| j.parent == link)
+                .map(|j| self.subtree_mass(j.child))
+                .sum::<f64>()
+    }
+
+    /// Controlled joints that move no mass at all: their acceleration is
+    /// undefined, so the plant refuses them unless they are locked.
+    pub fn joints_moving_no_mass(&self) -> Vec<String> {
+        self.actuated
+            .iter()
+            .filter(|&&ji| self.subtree_mass(self.joints[ji].child) <= 0.0)
+            .map(|&ji| self.joints[ji].name.clone())
+            .collect()
+    }
+
+    /// Whether any joint (controlled or mimic) has URDF damping or friction.
+    pub fn has_urdf_dynamics(&self) -> bool {
+        self.moving_joints()
+            .any(|ji| self.joints[ji].damping != 0.0 || self.joints[ji].friction != 0.0)
+    }
+
+    /// Every joint that moves: the controlled ones, then the mimic ones.
+    pub fn moving_joints(&self) -> impl Iterator<Item = usize> + '_ {
+        self.actuated
+            .iter()
+            .copied()
+            .chain(self.mimic.iter().map(|m| m.joint))
+    }
+}
+
+#[cfg(test)]
+mod tests;

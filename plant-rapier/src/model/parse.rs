@@ -1,0 +1,164 @@
+//! URDF elements into the model's plain types: numbers checked for being
+//! numbers, names resolved; no physics judged yet.
+
+use std::collections::HashMap;
+
+use super::{JointInfo, JointKind, LinkInfo, MimicSpec, Origin};
+use crate::PlantError;
+
+fn finite(field: String, v: f64) -> Result<f64, PlantError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(PlantError::NotFinite { field, value: v })
+    }
+}
+
+fn origin(field: &str, o: &urdf_rs::Pose) -> Result<Origin, PlantError> {
+    let mut out = Origin::default();
+    for k in 0..3 {
+        out.xyz[k] = finite(format!("{field} origin xyz"), o.xyz.0[k])?;
+        out.rpy[k] = finite(format!("{field} origin rpy"), o.rpy.0[k])?;
+    }
+    Ok(out)
+}
+
+/// A link's mass properties as written; only a negative mass is refused
+/// here (what a link of no mass lists is judged later).
+pub(super) fn link_info(l: &urdf_rs::Link) -> Result<LinkInfo, PlantError> {
+    let field = format!("link '{}'", l.name);
+    let mass = finite(format!("{field} mass"), l.inertial.mass.value)?;
+    if mass < 0.0 {
+        return Err(PlantError::BadInertia {
+            link: l.name.clone(),
+            reason: format!("mass {mass} is negative"),
+        });
+    }
+    let i = &l.inertial.inertia;
+    let inertia = [i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz];
+    for v in inertia {
+        finite(format!("{field} inertia"), v)?;
+    }
+    Ok(LinkInfo {
+        name: l.name.clone(),
+        mass,
+        inertial_origin: origin(&format!("{field} inertial"), &l.inertial.origin)?,
+        inertia,
+    })
+}
+
+fn kind_of(j: &urdf_rs::Joint) -> Result<JointKind, PlantError> {
+    use urdf_rs::JointType as T;
+    match j.joint_type {
+        T::Revolute => Ok(JointKind::Revolute),
+        T::Continuous => Ok(JointKind::Continuous),
+        T::Prismatic => Ok(JointKind::Prismatic),
+        T::Fixed => Ok(JointKind::Fixed),
+        T::Floating | T::Planar | T::Spherical => Err(PlantError::UnsupportedJoint {
+            joint: j.name.clone(),
+            kind: format!("{:?}", j.joint_type).to_lowercase(),
+        }),
+    }
+}
+
+fn mimic(j: &urdf_rs::Joint, field: &str) -> Result<Option<MimicSpec>, PlantError> {
+    let Some(m) = &j.mimic else {
+        return Ok(None);
+    };
+    Ok(Some(MimicSpec {
+        joint: m.joint.clone(),
+        multiplier: finite(
+            format!("{field} mimic multiplier"),
+            m.multiplier.unwrap_or(1.0),
+        )?,
+        offset: finite(format!("{field} mimic offset"), m.offset.unwrap_or(0.0))?,
+    }))
+}
+
+/// A joint with its links resolved and its numbers checked.
+pub(super) fn joint_info(
+    j: &urdf_rs::Joint,
+    index: &HashMap<String, usize>,
+) -> Result<JointInfo, PlantError> {
+    let kind = kind_of(j)?;
+    let link = |name: &str, role: &'static str| {
+        index
+            .get(name)
+            .copied()
+            .ok_or_else(|| PlantError::MissingLink {
+                joint: j.name.clone(),
+                role,
+                link: name.to_string(),
+            })
+    };
+    let parent = link(&j.parent.link, "parent")?;
+    let child = link(&j.child.link, "child")?;
+    if parent == child {
+        return Err(PlantError::Cycle {
+            link: j.child.link.clone(),
+        });
+    }
+    let field = format!("joint '{}'", j.name);
+    let mut axis = [0.0; 3];
+    for (k, a) in axis.iter_mut().enumerate() {
+        *a = finite(format!("{field} axis"), j.axis.xyz.0[k])?;
+    }
+    let norm = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
+    if kind.is_actuated() {
+        if norm < 1e-9 {
+            return Err(PlantError::ZeroAxis {
+                joint: j.name.clone(),
+            });
+        }
+        axis.iter_mut().for_each(|a| *a /= norm);
+    }
+    let lower = finite(format!("{field} limit lower"), j.limit.lower)?;
+    let upper = finite(format!("{field} limit upper"), j.limit.upper)?;
+    let effort = finite(format!("{field} limit effort"), j.limit.effort)?;
+    // A revolute or prismatic joint without a usable <limit> (lower = upper,
+    // as urdf-rs fills a missing one) moves freely rather than being locked.
+    let limits = match kind {
+        JointKind::Revolute | JointKind::Prismatic if lower < upper => Some((lower, upper)),
+        JointKind::Revolute | JointKind::Prismatic if lower > upper => {
+            return Err(PlantError::BadLimits {
+                joint: j.name.clone(),
+                lower,
+                upper,
+            });
+        }
+        _ => None,
+    };
+    let (damping, friction) = match &j.dynamics {
+        Some(d) => (
+            finite(format!("{field} dynamics damping"), d.damping)?,
+            finite(format!("{field} dynamics friction"), d.friction)?,
+        ),
+        None => (0.0, 0.0),
+    };
+    for (what, v) in [("damping", damping), ("friction", friction)] {
+        if v < 0.0 {
+            return Err(PlantError::InvalidConfig {
+                key: format!("{field} dynamics {what}"),
+                value: v.to_string(),
+                need: "≥ 0".into(),
+            });
+        }
+    }
+    Ok(JointInfo {
+        name: j.name.clone(),
+        kind,
+        parent,
+        child,
+        origin: origin(&field, &j.origin)?,
+        axis,
+        limits,
+        effort: (kind.is_actuated() && effort > 0.0).then_some(effort),
+        damping,
+        friction,
+        mimic: if kind.is_actuated() {
+            mimic(j, &field)?
+        } else {
+            None
+        },
+    })
+}

@@ -1,0 +1,287 @@
+//! The loader on small URDFs written inline.
+
+#![allow(clippy::unwrap_used)]
+
+use super::*;
+
+fn arm(joints: &str, links: &str) -> String {
+    format!(
+        r#"<robot name="t">
+  <link name="base"/>
+  <link name="a"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  {links}
+  {joints}
+</robot>"#
+    )
+}
+
+const J1: &str = r#"<joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"#;
+
+fn err(text: &str) -> String {
+    ArmModel::from_urdf_str(text).unwrap_err().to_string()
+}
+
+#[test]
+fn the_two_link_arm_reads_as_specified() {
+    let m = ArmModel::from_urdf_str(crate::TWO_LINK_URDF).unwrap();
+    assert_eq!(m.joint_names(), ["joint1", "joint2"]);
+    assert_eq!(m.links[m.root].name, "base_link");
+    assert!((m.moving_mass() - 2.85).abs() < 1e-12);
+    assert_eq!(m.joints[0].axis, [0.0, -1.0, 0.0]);
+    assert_eq!(m.joints[1].origin.xyz, [0.35, 0.0, 0.0]);
+}
+
+/// The 0.2 kg tool on a fixed joint 0.2 m along link3 (0.5 kg, COM at
+/// 0.1 m, I = 0.5·0.2²/12 about it) folds into link3 by the parallel-axis theorem.
+#[test]
+fn fixed_joint_mass_merges_into_the_parent() {
+    let m =
+        ArmModel::from_urdf_str(include_str!("../../../robots/three_link_planar.urdf")).unwrap();
+    assert_eq!(m.dof(), 3);
+    assert!(m.links.iter().all(|l| l.name != "tool"));
+    let l3 = m.links.iter().find(|l| l.name == "link3").unwrap();
+    let c = (0.5 * 0.1 + 0.2 * 0.2) / 0.7;
+    assert!((l3.mass - 0.7).abs() < 1e-12);
+    assert!((l3.inertial_origin.xyz[0] - c).abs() < 1e-12);
+    let i_rod = 0.00166667; // 0.5·0.2²/12 as the URDF writes it
+    let iyy = i_rod + 0.5 * (0.1 - c) * (0.1 - c) + 0.0001 + 0.2 * (0.2 - c) * (0.2 - c);
+    assert!(
+        (l3.inertia[3] - iyy).abs() < 1e-9,
+        "{} vs {iyy}",
+        l3.inertia[3]
+    );
+    assert_eq!(m.merged, ["tool_mount (tool into link3)"]);
+}
+
+#[test]
+fn a_joint_that_moves_no_mass_is_listed() {
+    let j2 = J1
+        .replace("j1", "j2")
+        .replace("base", "a")
+        .replace("<child link=\"a\"/>", "<child link=\"b\"/>");
+    let m = ArmModel::from_urdf_str(&arm(&format!("{J1}{j2}"), "<link name=\"b\"/>")).unwrap();
+    assert_eq!(m.joints_moving_no_mass(), ["j2"]);
+}
+
+#[test]
+fn malformed_urdfs_are_named_errors() {
+    assert!(err("not xml at all").starts_with("not a valid URDF"));
+    let missing = J1.replace("<child link=\"a\"/>", "<child link=\"ghost\"/>");
+    assert_eq!(
+        err(&arm(&missing, "")),
+        "joint 'j1': child link 'ghost' does not exist"
+    );
+    let floating =
+        r#"<joint name="free" type="floating"><parent link="base"/><child link="a"/></joint>"#;
+    assert!(err(&arm(floating, "")).contains("joint 'free' is floating"));
+    let mimic = J1.replace("</joint>", "<mimic joint=\"j0\"/></joint>");
+    assert!(err(&arm(&mimic, "")).contains("<mimic>: it follows joint 'j0', which does not exist"));
+    let neg = r#"<link name="b"><inertial><mass value="-1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>"#;
+    let jb = J1.replace("j1", "j2").replace("\"a\"", "\"b\"");
+    assert_eq!(
+        err(&arm(&format!("{J1}{jb}"), neg)),
+        "link 'b': mass -1 is negative"
+    );
+    let tri = r#"<link name="b"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.5"/></inertial></link>"#;
+    assert!(err(&arm(&format!("{J1}{jb}"), tri)).contains("triangle inequality"));
+    let loop_ = J1.replace("j1", "back").replace(
+        "<parent link=\"base\"/><child link=\"a\"/>",
+        "<parent link=\"a\"/><child link=\"base\"/>",
+    );
+    assert!(err(&arm(&format!("{J1}{loop_}"), "")).contains("loop"));
+    let bad = J1.replace("lower=\"-1\" upper=\"1\"", "lower=\"1\" upper=\"-1\"");
+    assert!(err(&arm(&bad, "")).contains("limit lower 1 is above upper -1"));
+    let nan = J1.replace("0 0 1", "0 NaN 1");
+    assert!(err(&arm(&nan, "")).contains("joint 'j1' axis"));
+    assert!(err(&arm("", "")).contains("several root links"));
+}
+
+fn link(name: &str, mass: &str, inertia: &str) -> String {
+    format!(
+        r#"<link name="{name}"><inertial><mass value="{mass}"/><inertia {inertia}/></inertial></link>"#
+    )
+}
+
+fn joint(name: &str, kind: &str, parent: &str, child: &str, extra: &str) -> String {
+    format!(
+        r#"<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/>{extra}</joint>"#
+    )
+}
+
+const I: &str = r#"ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1""#;
+
+/// What nearly every published URDF has: a massless fixed root listing an
+/// inertia, a frame link of 1e-9 kg with zero inertia, a point mass.
+#[test]
+fn real_world_mass_properties_are_accepted() {
+    let text = format!(
+        r#"<robot name="r">{}{}{}{}{}{}{}</robot>"#,
+        link("base", "0", I),
+        link("a", "1", I),
+        link(
+            "frame",
+            "1e-9",
+            r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0""#
+        ),
+        link(
+            "tip",
+            "0.5",
+            r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0""#
+        ),
+        joint("j1", "revolute", "base", "a", ""),
+        joint("f", "revolute", "a", "frame", ""),
+        joint("j3", "revolute", "frame", "tip", ""),
+    );
+    let m = ArmModel::from_urdf_str(&text).unwrap();
+    assert_eq!(m.joint_names(), ["j1", "f", "j3"]);
+    assert_eq!(m.ignored.len(), 1);
+    assert_eq!(m.ignored[0].name, "frame");
+    assert!(
+        m.ignored[0].reason.contains("negligible"),
+        "{:?}",
+        m.ignored
+    );
+    // 'f' carries the tip's point mass, so it moves mass.
+    assert!(m.joints_moving_no_mass().is_empty());
+}
+
+#[test]
+fn a_leftover_inertia_on_a_massless_moving_link_is_ignored_and_listed() {
+    let text = format!(
+        r#"<robot name="r"><link name="base"/>{}{}{}{}</robot>"#,
+        link("a", "1", I),
+        link("b", "0", I),
+        joint("j1", "revolute", "base", "a", ""),
+        joint("j2", "fixed", "a", "b", ""),
+    );
+    let m = ArmModel::from_urdf_str(&text).unwrap();
+    assert_eq!(m.ignored[0].name, "b");
+    assert!(m.ignored[0].reason.contains("zero mass"));
+    assert!((m.moving_mass() - 1.0).abs() < 1e-15);
+}
+
+#[test]
+fn joints_are_in_tree_order_whatever_the_file_order() {
+    let text = format!(
+        r#"<robot name="r"><link name="base"/>{}{}{}{}</robot>"#,
+        link("a", "1", I),
+        link("b", "1", I),
+        joint("second", "revolute", "a", "b", ""),
+        joint("first", "revolute", "base", "a", ""),
+    );
+    assert_eq!(
+        ArmModel::from_urdf_str(&text).unwrap().joint_names(),
+        ["first", "second"]
+    );
+}
+
+fn fingers(extra2: &str) -> String {
+    format!(
+        r#"<robot name="r"><link name="base"/>{}{}{}{}{}{}</robot>"#,
+        link("a", "1", I),
+        link("f1", "0.1", I),
+        link("f2", "0.1", I),
+        joint("arm", "revolute", "base", "a", ""),
+        joint("finger1", "prismatic", "a", "f1", ""),
+        joint("finger2", "prismatic", "a", "f2", extra2),
+    )
+}
+
+#[test]
+fn a_mimic_joint_is_coupled_not_controlled() {
+    let m = ArmModel::from_urdf_str(&fingers(
+        r#"<mimic joint="finger1" multiplier="-2" offset="0.1"/>"#,
+    ))
+    .unwrap();
+    assert_eq!(m.joint_names(), ["arm", "finger1"]);
+    assert_eq!(m.mimic.len(), 1);
+    let c = &m.mimic[0];
+    assert_eq!(m.joints[c.joint].name, "finger2");
+    assert_eq!((c.leader, c.multiplier, c.offset), (1, -2.0, 0.1));
+}
+
+#[test]
+fn a_chain_of_mimics_composes_to_its_first_leader() {
+    let text = format!(
+        r#"<robot name="r"><link name="base"/>{}{}{}{}{}{}</robot>"#,
+        link("a", "1", I),
+        link("b", "1", I),
+        link("c", "1", I),
+        joint("j1", "revolute", "base", "a", ""),
+        joint(
+            "j2",
+            "revolute",
+            "a",
+            "b",
+            r#"<mimic joint="j1" multiplier="2" offset="1"/>"#
+        ),
+        joint(
+            "j3",
+            "revolute",
+            "b",
+            "c",
+            r#"<mimic joint="j2" multiplier="3" offset="0.5"/>"#
+        ),
+    );
+    let m = ArmModel::from_urdf_str(&text).unwrap();
+    let j3 = m
+        .mimic
+        .iter()
+        .find(|c| m.joints[c.joint].name == "j3")
+        .unwrap();
+    // q3 = 3 (2 q1 + 1) + 0.5
+    assert_eq!((j3.leader, j3.multiplier, j3.offset), (0, 6.0, 3.5));
+    let looped = text.replace(
+        r#"<mimic joint="j1" multiplier="2" offset="1"/>"#,
+        r#"<mimic joint="j3"/>"#,
+    );
+    assert!(err(&looped).contains("loops back"), "{}", err(&looped));
+}
+
+#[test]
+fn locking_a_leader_locks_its_mimic_and_leaves_the_arm() {
+    let mut locks = Locks::new();
+    locks.insert("finger1".into(), 0.02);
+    let m = ArmModel::from_urdf_str_locked(
+        &fingers(r#"<mimic joint="finger1" multiplier="1"/>"#),
+        &locks,
+    )
+    .unwrap();
+    assert_eq!(m.joint_names(), ["arm"]);
+    assert!(m.mimic.is_empty());
+    let names: Vec<(&str, f64, Option<&str>)> = m
+        .locked
+        .iter()
+        .map(|l| (l.name.as_str(), l.position, l.follows.as_deref()))
+        .collect();
+    assert_eq!(
+        names,
+        [("finger1", 0.02, None), ("finger2", 0.02, Some("finger1"))]
+    );
+    // Both fingers are folded into the arm link, 0.02 m out along z.
+    let a = m.links.iter().find(|l| l.name == "a").unwrap();
+    assert!((a.mass - 1.2).abs() < 1e-12);
+    assert!((a.inertial_origin.xyz[2] - 0.2 * 0.02 / 1.2).abs() < 1e-12);
+}
+
+#[test]
+fn bad_locks_name_the_key() {
+    let text = fingers(r#"<mimic joint="finger1"/>"#);
+    let lock_err = |name: &str, at: f64| {
+        let mut locks = Locks::new();
+        locks.insert(name.into(), at);
+        ArmModel::from_urdf_str_locked(&text, &locks)
+            .unwrap_err()
+            .to_string()
+    };
+    assert!(
+        lock_err("ghost", 0.0)
+            .starts_with("plant.lock.ghost = 0 is invalid: it must be a joint of the arm")
+    );
+    assert!(lock_err("finger2", 0.0).contains("it follows 'finger1' (<mimic>), lock that one"));
+    assert!(lock_err("arm", 2.0).contains("within the joint's limits [-1, 1]"));
+    assert!(lock_err("arm", f64::NAN).contains("plant.lock.arm = NaN"));
+    let all: Locks = [("arm".to_string(), 0.0), ("finger1".to_string(), 0.0)].into();
+    let e = ArmModel::from_urdf_str_locked(&text, &all).unwrap_err();
+    assert_eq!(e, PlantError::NoActuatedJoints);
+}

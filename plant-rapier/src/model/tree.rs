@@ -1,0 +1,407 @@
+//! The link tree: root and order, mimic chains, locks, which mass matters,
+//! and fixed joints folded into their parents.
+
+use std::collections::HashMap;
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
+use super::inertia::{NEGLIGIBLE_MASS_RATIO, check_inertia, iso, merge_mass, origin_of};
+use super::parse::{joint_info, link_info};
+use super::{
+    ArmModel, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks, MergedLink,
+    MimicJoint,
+};
+use crate::PlantError;
+
+/// Parses, checks and simplifies a URDF robot.
+pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, PlantError> {
+    let mut index = HashMap::new();
+    let mut links = Vec::with_capacity(robot.links.len());
+    for (i, l) in robot.links.iter().enumerate() {
+        if index.insert(l.name.clone(), i).is_some() {
+            return Err(PlantError::Duplicate {
+                what: "link",
+                name: l.name.clone(),
+            });
+        }
+        links.push(link_info(l)?);
+    }
+    if links.is_empty() {
+        return Err(PlantError::NoLinks);
+    }
+    let mut joints = Vec::with_capacity(robot.joints.len());
+    let mut parent_of: Vec<Option<usize>> = vec![None; links.len()];
+    let mut joint_names = HashMap::new();
+    for (ji, j) in robot.joints.iter().enumerate() {
+        if joint_names.insert(j.name.clone(), ji).is_some() {
+            return Err(PlantError::Duplicate {
+                what: "joint",
+                name: j.name.clone(),
+            });
+        }
+        let info = joint_info(j, &index)?;
+        if let Some(other) = parent_of[info.child] {
+            return Err(PlantError::TwoParents {
+                link: links[info.child].name.clone(),
+                first: robot.joints[other].name.clone(),
+                second: j.name.clone(),
+            });
+        }
+        parent_of[info.child] = Some(ji);
+        joints.push(info);
+    }
+    let root = find_root(&links, &joints)?;
+    depth_first(&links, &joints, root)?;
+    let leaders = resolve_mimics(&joints)?;
+    let locked = apply_locks(&mut joints, &leaders, locks)?;
+    let (ignored, notes) = settle_masses(&mut links, &joints, root)?;
+    let folded = merge_fixed(links, joints);
+    let mut model = finish(robot.name.clone(), folded, &leaders, locked, ignored)?;
+    model.notes = notes;
+    Ok(model)
+}
+
+fn find_root(links: &[LinkInfo], joints: &[JointInfo]) -> Result<usize, PlantError> {
+    let mut has_parent = vec![false; links.len()];
+    for j in joints {
+        has_parent[j.child] = true;
+    }
+    let roots: Vec<usize> = (0..links.len()).filter(|&i| !has_parent[i]).collect();
+    match roots.as_slice() {
+        [r] => Ok(*r),
+        [] => Err(PlantError::NoRoot),
+        many => Err(PlantError::ManyRoots(
+            many.iter().map(|&i| links[i].name.clone()).collect(),
+        )),
+    }
+}
+
+/// Joints depth-first from the root, siblings in file order; a link never
+/// reached sits on a loop.
+fn depth_first(
+    links: &[LinkInfo],
+    joints: &[JointInfo],
+    root: usize,
+) -> Result<Vec<usize>, PlantError> {
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); links.len()];
+    for (ji, j) in joints.iter().enumerate() {
+        children[j.parent].push(ji);
+    }
+    let mut order = Vec::with_capacity(joints.len());
+    let mut reached = vec![false; links.len()];
+    reached[root] = true;
+    let mut stack: Vec<usize> = children[root].iter().rev().copied().collect();
+    while let Some(ji) = stack.pop() {
+        let child = joints[ji].child;
+        if reached[child] {
+            continue;
+        }
+        reached[child] = true;
+        order.push(ji);
+        stack.extend(children[child].iter().rev());
+    }
+    match reached.iter().position(|r| !r) {
+        Some(i) => Err(PlantError::Cycle {
+            link: links[i].name.clone(),
+        }),
+        None => Ok(order),
+    }
+}
+
+/// For each mimic joint: the first joint of its chain that mimics none,
+/// with the multiplier and offset composed along the chain.
+type Leaders = HashMap<String, (String, f64, f64)>;
+
+fn resolve_mimics(joints: &[JointInfo]) -> Result<Leaders, PlantError> {
+    let by_name: HashMap<&str, &JointInfo> = joints.iter().map(|j| (j.name.as_str(), j)).collect();
+    let mut out = Leaders::new();
+    for j in joints {
+        let mimic_err = |reason: String| PlantError::Mimic {
+            joint: j.name.clone(),
+            reason,
+        };
+        let (mut mult, mut offset) = (1.0, 0.0);
+        let mut cur = j;
+        let mut steps = 0;
+        while let Some(m) = &cur.mimic {
+            let Some(leader) = by_name.get(m.joint.as_str()) else {
+                return Err(mimic_err(format!(
+                    "it follows joint '{}', which does not exist",
+                    m.joint
+                )));
+            };
+            if !leader.kind.is_actuated() {
+                return Err(mimic_err(format!(
+                    "it follows joint '{}', which is fixed",
+                    m.joint
+                )));
+            }
+            // q_cur = m·q_leader + o, and q_j = mult·q_cur + offset.
+            offset += mult * m.offset;
+            mult *= m.multiplier;
+            cur = leader;
+            steps += 1;
+            if steps > joints.len() {
+                return Err(mimic_err("its <mimic> chain loops back on itself".into()));
+            }
+        }
+        if steps > 0 {
+            out.insert(j.name.clone(), (cur.name.clone(), mult, offset));
+        }
+    }
+    Ok(out)
+}
+
+/// Turns locked joints into fixed ones at their positions; a joint that
+/// mimics a locked one is locked where the coupling puts it.
+fn apply_locks(
+    joints: &mut [JointInfo],
+    leaders: &Leaders,
+    locks: &Locks,
+) -> Result<Vec<LockedJoint>, PlantError> {
+    let invalid = |name: &str, value: f64, need: String| PlantError::InvalidConfig {
+        key: format!("plant.lock.{name}"),
+        value: value.to_string(),
+        need,
+    };
+    for (name, &p) in locks {
+        let Some(j) = joints.iter().find(|j| &j.name == name) else {
+            let movable: Vec<&str> = joints
+                .iter()
+                .filter(|j| j.kind.is_actuated())
+                .map(|j| j.name.as_str())
+                .collect();
+            return Err(invalid(
+                name,
+                p,
+                format!("a joint of the arm ({})", movable.join(", ")),
+            ));
+        };
+        if !j.kind.is_actuated() {
+            return Err(invalid(
+                name,
+                p,
+                "a joint that moves (this one is fixed)".into(),
+            ));
+        }
+        if let Some((leader, ..)) = leaders.get(name) {
+            return Err(invalid(
+                name,
+                p,
+                format!("a joint that mimics none: it follows '{leader}' (<mimic>), lock that one"),
+            ));
+        }
+        match j.limits {
+            Some((lo, hi)) if !(p >= lo && p <= hi) => {
+                return Err(invalid(
+                    name,
+                    p,
+                    format!("within the joint's limits [{lo}, {hi}]"),
+                ));
+            }
+            _ if !p.is_finite() => return Err(invalid(name, p, "a finite number".into())),
+            _ => {}
+        }
+    }
+    let mut locked = Vec::new();
+    for j in joints.iter_mut().filter(|j| j.kind.is_actuated()) {
+        let (position, follows) = match (locks.get(&j.name), leaders.get(&j.name)) {
+            (Some(&p), _) => (p, None),
+            (None, Some((leader, m, o))) => match locks.get(leader) {
+                Some(&p) => (m * p + o, Some(leader.clone())),
+                None => continue,
+            },
+            (None, None) => continue,
+        };
+        let axis = Vector3::new(j.axis[0], j.axis[1], j.axis[2]);
+        let motion = match j.kind {
+            JointKind::Prismatic => Isometry3::from_parts(
+                Translation3::from(axis * position),
+                UnitQuaternion::identity(),
+            ),
+            _ => Isometry3::from_parts(
+                Translation3::identity(),
+                UnitQuaternion::from_scaled_axis(axis * position),
+            ),
+        };
+        j.origin = origin_of(&(iso(&j.origin) * motion));
+        j.kind = JointKind::Fixed;
+        j.mimic = None;
+        locked.push(LockedJoint {
+            name: j.name.clone(),
+            position,
+            follows,
+        });
+    }
+    Ok(locked)
+}
+
+/// Zeroes what cannot matter (links welded to the fixed root, links of
+/// zero or negligible mass) and checks the inertia of every link that moves.
+fn settle_masses(
+    links: &mut [LinkInfo],
+    joints: &[JointInfo],
+    root: usize,
+) -> Result<(Vec<IgnoredLink>, Vec<String>), PlantError> {
+    // Links reached from the root through fixed joints only never move.
+    let mut moves = vec![false; links.len()];
+    let mut welded = vec![false; links.len()];
+    welded[root] = true;
+    for ji in depth_first(links, joints, root)? {
+        let j = &joints[ji];
+        welded[j.child] = welded[j.parent] && j.kind == JointKind::Fixed;
+        moves[j.child] = !welded[j.child];
+    }
+    let heaviest = (0..links.len())
+        .filter(|&i| moves[i])
+        .map(|i| links[i].mass)
+        .fold(0.0, f64::max);
+    let threshold = NEGLIGIBLE_MASS_RATIO * heaviest;
+    let (mut ignored, mut notes) = (Vec::new(), Vec::new());
+    for (i, l) in links.iter_mut().enumerate() {
+        if !moves[i] {
+            l.mass = 0.0;
+            l.inertia = [0.0; 6];
+            continue;
+        }
+        if l.mass <= threshold {
+            if l.mass > 0.0 || l.inertia.iter().any(|v| *v != 0.0) {
+                let reason = if l.mass == 0.0 {
+                    "zero mass: the inertia it lists is ignored".to_string()
+                } else {
+                    format!(
+                        "mass {:e} kg is negligible (below {NEGLIGIBLE_MASS_RATIO:e} of the heaviest link's {heaviest} kg): it contributes nothing",
+                        l.mass
+                    )
+                };
+                ignored.push(IgnoredLink {
+                    name: l.name.clone(),
+                    mass: l.mass,
+                    reason,
+                });
+            }
+            l.mass = 0.0;
+            l.inertia = [0.0; 6];
+            continue;
+        }
+        notes.extend(check_inertia(&l.name, &l.inertia)?);
+    }
+    Ok((ignored, notes))
+}
+
+struct Folded {
+    links: Vec<LinkInfo>,
+    joints: Vec<JointInfo>,
+    merged: Vec<String>,
+    merged_links: Vec<MergedLink>,
+}
+
+/// Folds every fixed joint into its parent: the child's mass joins the
+/// parent link's, and the child's own joints hang from the parent. The
+/// plant then simulates only bodies that move independently.
+fn merge_fixed(mut links: Vec<LinkInfo>, mut joints: Vec<JointInfo>) -> Folded {
+    let mut merged = Vec::new();
+    let mut merged_links: Vec<MergedLink> = Vec::new();
+    while let Some(ji) = joints.iter().position(|j| j.kind == JointKind::Fixed) {
+        let j = joints.remove(ji);
+        let (parent, child) = (j.parent, j.child);
+        let t = iso(&j.origin);
+        let child_link = links[child].clone();
+        merge_mass(&mut links[parent], &child_link, &t);
+        for k in &mut joints {
+            if k.parent == child {
+                k.parent = parent;
+                k.origin = origin_of(&(t * iso(&k.origin)));
+            }
+        }
+        merged.push(format!(
+            "{} ({} into {})",
+            j.name, child_link.name, links[parent].name
+        ));
+        for m in &mut merged_links {
+            if m.into == child {
+                m.into = parent;
+                m.origin = origin_of(&(t * iso(&m.origin)));
+            }
+        }
+        merged_links.push(MergedLink {
+            name: child_link.name.clone(),
+            into: parent,
+            origin: j.origin,
+        });
+        // Drop the child link and renumber.
+        links.remove(child);
+        for k in &mut joints {
+            if k.parent > child {
+                k.parent -= 1;
+            }
+            if k.child > child {
+                k.child -= 1;
+            }
+        }
+        for m in &mut merged_links {
+            if m.into > child {
+                m.into -= 1;
+            }
+        }
+    }
+    Folded {
+        links,
+        joints,
+        merged,
+        merged_links,
+    }
+}
+
+/// Orders the simplified tree and sorts its joints into controlled and mimic.
+fn finish(
+    name: String,
+    f: Folded,
+    leaders: &Leaders,
+    locked: Vec<LockedJoint>,
+    ignored: Vec<IgnoredLink>,
+) -> Result<ArmModel, PlantError> {
+    let root = find_root(&f.links, &f.joints)?;
+    let topological = depth_first(&f.links, &f.joints, root)?;
+    let actuated: Vec<usize> = topological
+        .iter()
+        .copied()
+        .filter(|&ji| !leaders.contains_key(&f.joints[ji].name))
+        .collect();
+    if actuated.is_empty() {
+        return Err(PlantError::NoActuatedJoints);
+    }
+    let mut mimic = Vec::new();
+    for &ji in &topological {
+        let Some((leader, multiplier, offset)) = leaders.get(&f.joints[ji].name) else {
+            continue;
+        };
+        let leader = actuated
+            .iter()
+            .position(|&a| &f.joints[a].name == leader)
+            .ok_or_else(|| PlantError::Mimic {
+                joint: f.joints[ji].name.clone(),
+                reason: format!("it follows '{leader}', which is not a controlled joint"),
+            })?;
+        mimic.push(MimicJoint {
+            joint: ji,
+            leader,
+            multiplier: *multiplier,
+            offset: *offset,
+        });
+    }
+    Ok(ArmModel {
+        name,
+        links: f.links,
+        joints: f.joints,
+        root,
+        topological,
+        actuated,
+        mimic,
+        locked,
+        ignored,
+        notes: Vec::new(),
+        merged: f.merged,
+        merged_links: f.merged_links,
+    })
+}

@@ -1,0 +1,219 @@
+//! Per-joint gains for an arm's default scenario (SPEC §7, §11).
+//!
+//! K2_i sets how hard joint i's velocity error is pushed back. The discrete
+//! loop needs Δt·λ_max(K2^½ M⁻¹ K2^½) < 2; K2_i = ρ / (Δt · max_q M⁻¹_ii)
+//! with ρ = 1 (half the limit) equalises that product over the joints, and
+//! all K2_i are scaled down together if the coupled λ_max is larger.
+//! K1_i then sets the steady error: at steady tracking τ ≈ −K2 K1 Z1, so
+//! holding the joint's load τ*_i (gravity, inertia, URDF friction) within
+//! 40 % of the envelope needs K1_i ≥ τ*_i / (0.4 k_c,i K2_i). K1_i is kept
+//! at most 0.2/Δt so that the position loop stays well inside the velocity
+//! loop; where that is not enough the joint's envelope is widened, as far
+//! as its range allows. Only if some joint needs more is the rate raised.
+
+use plant_rapier::{ArmModel, PlantError};
+
+use crate::Scenario;
+use crate::probe::Probe;
+
+/// Target for Δt·λ_max(K2^½ M⁻¹ K2^½): half the stability limit.
+const RHO: f64 = 1.0;
+/// Steady error aimed for, as a fraction of the smallest k_c.
+const ERROR_FRACTION: f64 = 0.4;
+/// K1_i Δt at most.
+const K1_DT_MAX: f64 = 0.2;
+/// The paper's gain: the smallest K1_i chosen.
+const K1_MIN: f64 = 15.0;
+/// Fastest rate the default scenario will use.
+const MAX_RATE_HZ: f64 = 10_000.0;
+/// Postures probed along the reference.
+const POSTURES: usize = 12;
+
+/// One joint's gains and the numbers they come from.
+#[derive(Debug, Clone)]
+pub struct JointGain {
+    /// Joint name.
+    pub name: String,
+    /// K1_i, 1/s.
+    pub k1: f64,
+    /// K2_i, N m s/rad.
+    pub k2: f64,
+    /// The largest M⁻¹_ii over the postures probed.
+    pub minv_diag: f64,
+    /// τ*_i: the largest torque the reference needs, N m.
+    pub load: f64,
+    /// Its effort limit, if any.
+    pub effort: Option<f64>,
+    /// Why K1_i is what it is.
+    pub k1_reason: String,
+}
+
+/// The gains of every joint, the rate, and the margins behind them.
+#[derive(Debug, Clone)]
+pub struct GainChoice {
+    /// Control rate, Hz.
+    pub rate_hz: f64,
+    /// Why the rate is not the scenario's 1 kHz, if it is not.
+    pub rate_reason: Option<String>,
+    /// Per joint.
+    pub joints: Vec<JointGain>,
+    /// The largest Δt·λ_max(K2^½ M⁻¹ K2^½) over the postures (< 2 is stable).
+    pub stability_number: f64,
+    /// Envelope offset k_c per joint: the scenario's, or wider where the
+    /// load needs it and the joint's range allows it.
+    pub envelope: Vec<f64>,
+}
+
+impl GainChoice {
+    /// Joints whose K2_i is below the analysis's ½ (allowed, SPEC §7).
+    pub fn below_half(&self) -> Vec<&str> {
+        self.joints
+            .iter()
+            .filter(|j| j.k2 <= 0.5)
+            .map(|j| j.name.as_str())
+            .collect()
+    }
+}
+
+/// The postures probed: the reference at evenly spread times, and q(0).
+fn postures(s: &Scenario) -> Vec<Vec<f64>> {
+    let mut out: Vec<Vec<f64>> = (0..POSTURES)
+        .map(|k| {
+            let t = s.duration_s * k as f64 / POSTURES as f64;
+            s.reference.joints.iter().map(|r| r.eval(t)[0]).collect()
+        })
+        .collect();
+    out.push(s.initial.q.clone());
+    out
+}
+
+/// The gains for `model` running `s` (reference, envelope, plant settings);
+/// `kc_cap` is the widest envelope offset each joint may be given.
+pub fn choose_gains(
+    model: &ArmModel,
+    s: &Scenario,
+    kc_cap: &[f64],
+) -> Result<GainChoice, PlantError> {
+    let n = model.dof();
+    let armature = s.plant.armature.resolve("plant.armature", n)?;
+    let probes = postures(s)
+        .iter()
+        .map(|q| Probe::at(model, q, &armature))
+        .collect::<Result<Vec<_>, _>>()?;
+    let minv_diag: Vec<f64> = (0..n)
+        .map(|i| probes.iter().map(|p| p.minv[(i, i)]).fold(0.0, f64::max))
+        .collect();
+    let qdd_max: Vec<f64> = s
+        .reference
+        .joints
+        .iter()
+        .map(|r| r.amplitude() * r.omega * r.omega)
+        .collect();
+    let load: Vec<f64> = (0..n)
+        .map(|i| {
+            let j = &model.joints[model.actuated[i]];
+            let inertial = |p: &Probe| (0..n).map(|k| p.m[(i, k)].abs() * qdd_max[k]).sum::<f64>();
+            let worst = probes
+                .iter()
+                .map(|p| p.gravity[i].abs() + inertial(p))
+                .fold(0.0, f64::max);
+            let qd_max = s.reference.joints[i].amplitude() * s.reference.joints[i].omega;
+            let urdf = if s.plant.urdf_dynamics {
+                j.friction + j.damping * qd_max
+            } else {
+                0.0
+            };
+            worst + urdf
+        })
+        .collect();
+    let kc: Vec<f64> = s.envelope.joints.iter().map(|e| e.offset).collect();
+    // The envelope's smallest value over its offset (0.8 for the default's ±20 %).
+    let kc_low: Vec<f64> = s
+        .envelope
+        .joints
+        .iter()
+        .map(|e| e.min_value() / e.offset)
+        .collect();
+    let mut rate = s.rate_hz;
+    loop {
+        let dt = 1.0 / rate;
+        let mut k2: Vec<f64> = minv_diag.iter().map(|m| RHO / (dt * m)).collect();
+        let worst = probes
+            .iter()
+            .map(|p| p.stability_number(&k2, dt))
+            .fold(0.0, f64::max);
+        if worst > RHO {
+            k2.iter_mut().for_each(|k| *k *= RHO / worst);
+        }
+        let k1_max = K1_DT_MAX / dt;
+        let need: Vec<f64> = (0..n)
+            .map(|i| load[i] / (ERROR_FRACTION * kc_low[i] * kc[i] * k2[i]))
+            .collect();
+        // Where K1 is capped, the envelope may widen up to its cap instead.
+        let envelope: Vec<f64> = (0..n)
+            .map(|i| kc[i] * (need[i] / k1_max).max(1.0))
+            .collect();
+        let short = (0..n)
+            .map(|i| envelope[i] / kc_cap[i].max(kc[i]))
+            .fold(0.0, f64::max);
+        if short <= 1.0 || rate >= MAX_RATE_HZ {
+            let stability_number = probes
+                .iter()
+                .map(|p| p.stability_number(&k2, dt))
+                .fold(0.0, f64::max);
+            let rate_reason = (rate != s.rate_hz).then(|| {
+                format!(
+                    "at {} Hz no K1_i ≤ {:.0} holds joint {}'s load within 40 % of the widest envelope its range allows; K1 K2 grows with the rate squared",
+                    s.rate_hz,
+                    K1_DT_MAX * s.rate_hz,
+                    worst_joint(model, &need)
+                )
+            });
+            let joints = (0..n)
+                .map(|i| JointGain {
+                    name: model.joints[model.actuated[i]].name.clone(),
+                    k1: need[i].clamp(K1_MIN.min(k1_max), k1_max),
+                    k2: k2[i],
+                    minv_diag: minv_diag[i],
+                    load: load[i],
+                    effort: model.joints[model.actuated[i]].effort,
+                    k1_reason: k1_reason(need[i], k1_max),
+                })
+                .collect();
+            return Ok(GainChoice {
+                rate_hz: rate,
+                rate_reason,
+                joints,
+                stability_number,
+                envelope: (0..n)
+                    .map(|i| envelope[i].min(kc_cap[i].max(kc[i])))
+                    .collect(),
+            });
+        }
+        // K1_max K2 grows with rate²: the rate that closes the gap, in
+        // multiples of 100 Hz so the period stays a round number of ns.
+        rate = ((rate * short.sqrt() / 100.0).ceil() * 100.0).min(MAX_RATE_HZ);
+        if rate <= s.rate_hz {
+            rate = s.rate_hz + 100.0;
+        }
+    }
+}
+
+fn worst_joint(model: &ArmModel, need: &[f64]) -> String {
+    let i = (0..need.len())
+        .max_by(|&a, &b| need[a].total_cmp(&need[b]))
+        .unwrap_or(0);
+    format!("'{}'", model.joints[model.actuated[i]].name)
+}
+
+fn k1_reason(need: f64, k1_max: f64) -> String {
+    if need <= K1_MIN {
+        format!("the paper's {K1_MIN} already holds the load (needs {need:.2})")
+    } else if need <= k1_max {
+        "holds the load within 40 % of the envelope".into()
+    } else {
+        format!(
+            "capped at 0.2/Δt = {k1_max:.0} (the load needs {need:.0}): the envelope is widened"
+        )
+    }
+}
