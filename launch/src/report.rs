@@ -19,6 +19,16 @@ pub struct Report {
     pub robot: String,
     /// Run length, s.
     pub duration_s: f64,
+    /// K1_i per joint.
+    pub k1: Vec<f64>,
+    /// K2_i per joint.
+    pub k2: Vec<f64>,
+    /// Joints whose K2_i is at or below the analysis's ½ (SPEC §7 allows it).
+    pub k2_below_analysis: Vec<String>,
+    /// Joints held still by the scenario (and those that mimic them).
+    pub locked_joints: Vec<String>,
+    /// Joints coupled by `<mimic>`, not controlled.
+    pub mimic_joints: Vec<String>,
     /// The run's figures.
     #[serde(flatten)]
     pub summary: Summary,
@@ -53,15 +63,54 @@ pub struct Report {
     pub warning: Option<String>,
 }
 
+/// The gains and joint roles of a plan, for the report.
+struct Gains {
+    k1: Vec<f64>,
+    k2: Vec<f64>,
+    below: Vec<String>,
+    locked: Vec<String>,
+    mimic: Vec<String>,
+}
+
+fn gains(plan: &Plan) -> Gains {
+    let m = &plan.robot.model;
+    let n = m.dof();
+    let c = &plan.scenario.controller;
+    // The plan resolved both gains against the arm already.
+    let k1 = c.k1.resolve("controller.k1", n).unwrap_or_default();
+    let k2 = c.k2.resolve("controller.k2", n).unwrap_or_default();
+    let names = m.joint_names();
+    Gains {
+        below: (0..n)
+            .filter(|&i| k2.get(i).is_some_and(|k| *k <= 0.5))
+            .map(|i| names[i].clone())
+            .collect(),
+        k1,
+        k2,
+        locked: m.locked.iter().map(|l| l.name.clone()).collect(),
+        mimic: m
+            .mimic
+            .iter()
+            .map(|c| m.joints[c.joint].name.clone())
+            .collect(),
+    }
+}
+
 impl Report {
     /// For an in-process run.
     pub fn from_sim(plan: &Plan, summary: Summary, wall_time_s: f64) -> Self {
         let sim_s = summary.steps as f64 * summary.dt_s;
+        let g = gains(plan);
         Self {
             scenario: plan.scenario.name.clone(),
             scenario_source: plan.source.clone(),
             robot: plan.robot.label(),
             duration_s: sim_s,
+            k1: g.k1,
+            k2: g.k2,
+            k2_below_analysis: g.below,
+            locked_joints: g.locked,
+            mimic_joints: g.mimic,
             realtime_factor: sim_s / wall_time_s.max(1e-9),
             summary,
             wall_time_s,
@@ -82,7 +131,13 @@ impl Report {
         let dropped = a.contents.logger_dropped();
         let warning = a.warning();
         let sim_s = a.summary.steps as f64 * a.summary.dt_s;
+        let g = gains(&a.plan);
         Self {
+            k1: g.k1,
+            k2: g.k2,
+            k2_below_analysis: g.below,
+            locked_joints: g.locked,
+            mimic_joints: g.mimic,
             scenario: a.plan.scenario.name.clone(),
             scenario_source: meta("scenario_source"),
             robot: meta("robot"),
@@ -129,6 +184,29 @@ pub fn table(r: &Report) -> String {
         r.wall_time_s,
         r.realtime_factor
     );
+    let fmt = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:.4}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let _ = writeln!(out, "gains: K1 = [{}], K2 = [{}]", fmt(&r.k1), fmt(&r.k2));
+    if !r.k2_below_analysis.is_empty() {
+        let _ = writeln!(
+            out,
+            "K2 below the analysis's 1/2 (allowed, SPEC §7): {}",
+            r.k2_below_analysis.join(", ")
+        );
+    }
+    if !r.locked_joints.is_empty() || !r.mimic_joints.is_empty() {
+        let _ = writeln!(
+            out,
+            "locked joints: [{}]; mimic joints: [{}]",
+            r.locked_joints.join(", "),
+            r.mimic_joints.join(", ")
+        );
+    }
+    let _ = writeln!(out);
     let _ = writeln!(
         out,
         "{:<12} {:>12} {:>12} {:>12} {:>12} {:>12} {:>12} {:>10} {:>10}",

@@ -1,6 +1,6 @@
 //! The posture an arm's default reference swings about: the middle of each
-//! joint's range, unless gravity there asks more of a motor than it has;
-//! then, joint by joint, the offset that asks the least.
+//! joint's range, unless gravity there asks much of a motor or of a light
+//! joint's gain; then, joint by joint, the offset that asks the least.
 
 use plant_rapier::{ArmModel, PlantError};
 
@@ -18,14 +18,23 @@ const UNLIMITED: [f64; 4] = [
     std::f64::consts::PI,
 ];
 
-/// The largest |G_i(q)| / effort_i over the joints that have an effort limit.
+/// The gravity acceleration |G_i| M⁻¹_ii (rad/s²) that the largest gains at
+/// 1 kHz hold inside the widest envelope: (ρ/Δt)(K1 Δt/Δt)(0.4 · 0.8 · 0.6 rad).
+const HELD_ACCELERATION: f64 = 1000.0 * 200.0 * 0.32 * 0.6;
+
+/// How hard gravity at `q` is on the arm: the largest of |G_i| / effort_i
+/// and |G_i| M⁻¹_ii / [`HELD_ACCELERATION`] over the joints.
 fn effort_ratio(model: &ArmModel, q: &[f64]) -> Result<f64, PlantError> {
     let p = Probe::at(model, q, &vec![0.0; model.dof()])?;
     Ok(model
         .actuated
         .iter()
         .enumerate()
-        .filter_map(|(i, &ji)| model.joints[ji].effort.map(|e| p.gravity[i].abs() / e))
+        .map(|(i, &ji)| {
+            let g = p.gravity[i].abs();
+            let motor = model.joints[ji].effort.map_or(0.0, |e| g / e);
+            motor.max(g * p.minv[(i, i)] / HELD_ACCELERATION)
+        })
         .fold(0.0, f64::max))
 }
 

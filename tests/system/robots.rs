@@ -2,15 +2,20 @@
 
 use crate::util::{fails, json, ok, testbed};
 
-const ARMS: [&str; 3] = [
+const ARMS: [&str; 8] = [
     "robots/two_link.urdf",
     "robots/three_link_planar.urdf",
     "robots/ur5.urdf",
+    "robots/iiwa14.urdf",
+    "robots/panda.urdf",
+    "robots/xarm7.urdf",
+    "robots/so101.urdf",
+    "robots/z1.urdf",
 ];
 
-/// Each shipped arm runs its default scenario to the end, in process and in
-/// lockstep, with the same bits, finite signals and the envelope respected
-/// after T_c.
+/// Each shipped arm runs its default scenario to the end at 1 kHz, in
+/// process and in lockstep, with the same bits, finite signals, the
+/// envelope kept after T_c and no barrier breach.
 #[test]
 fn every_shipped_arm_runs_its_default_scenario() {
     let dir = tempfile::tempdir().unwrap();
@@ -35,6 +40,8 @@ fn every_shipped_arm_runs_its_default_scenario() {
         for s in [&sim, &run] {
             assert_eq!(s["finite"], true, "{arm}: {s}");
             assert_eq!(s["constraint_satisfied_after_tc"], true, "{arm}: {s}");
+            assert_eq!(s["barrier_breached_steps"], 0, "{arm}: {s}");
+            assert_eq!(s["dt_s"], 1e-3, "{arm}: {s}");
             assert!(
                 (s["duration_s"].as_f64().unwrap() - 10.0).abs() < 1e-3,
                 "{arm}: {s}"
@@ -65,34 +72,116 @@ fn robot_command_reports_joint_order_and_masses() {
     .collect();
     assert!(
         order.windows(2).all(|w| w[0] < w[1]),
-        "joints not in file order: {text}"
+        "joints not in tree order: {text}"
     );
     assert!(text.contains("merged fixed joint ee_fixed_joint"), "{text}");
     assert!(text.contains("moving mass 16.9939 kg"), "{text}");
 }
 
-/// The 7-joint KUKA iiwa 14: read, merged, and run. Its default scenario
-/// needs 5.2 kHz (the light wrist bounds the scalar gain K2 by Δt·K2·λ ≤ 1)
-/// and, with one K2 for every joint, does not hold the shoulder's gravity
-/// load inside a 0.25 rad envelope (README, Robots): this checks that it
-/// runs, not that it tracks.
+/// The 7-joint KUKA iiwa 14: read and merged; per-joint gains at 1 kHz.
 #[test]
-fn the_seven_joint_iiwa_loads_and_runs() {
+fn the_seven_joint_iiwa_loads_with_per_joint_gains() {
     let text =
         String::from_utf8(ok(testbed().args(["robot", "robots/iiwa14.urdf"])).stdout).unwrap();
     assert!(text.contains("7 actuated joints"), "{text}");
     assert!(text.contains("merged fixed joint iiwa_joint_ee"), "{text}");
     assert!(text.contains("moving mass 25.6100 kg"), "{text}");
-    let s = json(&ok(testbed().args([
-        "sim",
-        "--json",
-        "--robot",
-        "robots/iiwa14.urdf",
-        "--duration",
-        "0.5",
-    ])));
-    assert_eq!(s["finite"], true, "{s}");
-    assert_eq!(s["dof"], 7);
+    assert!(text.contains("10 s at 1000 Hz"), "{text}");
+    assert!(text.contains("why K1"), "{text}");
+}
+
+/// The Panda: its mimic finger is coupled, the default scenario locks the
+/// fingers, and the log records both.
+#[test]
+fn panda_fingers_are_mimic_and_locked_by_default() {
+    let text =
+        String::from_utf8(ok(testbed().args(["robot", "robots/panda.urdf"])).stdout).unwrap();
+    assert!(
+        text.contains("mimic joint panda_finger_joint2 (prismatic) = 1 × panda_finger_joint1"),
+        "{text}"
+    );
+    assert!(
+        text.contains("locked panda_finger_joint1 at 0.0200"),
+        "{text}"
+    );
+    assert!(text.contains("URDF <dynamics>"), "{text}");
+    let dir = tempfile::tempdir().unwrap();
+    let s = json(&ok(testbed()
+        .args(["run", "--mode", "lockstep", "--json", "--duration", "0.2"])
+        .args(["--robot", "robots/panda.urdf", "--runs-dir"])
+        .arg(dir.path())));
+    assert_eq!(s["dof"], 7, "{s}");
+    let log = s["log"].as_str().unwrap();
+    let bytes = std::fs::read(log).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let idx = summary
+        .metadata_indexes
+        .iter()
+        .find(|m| m.name == "testbed.run")
+        .unwrap();
+    let meta = mcap::read::metadata(&bytes, idx).unwrap();
+    assert_eq!(
+        meta.metadata["locked_joints"],
+        "panda_finger_joint1=0.02,panda_finger_joint2=0.02 (mimics panda_finger_joint1)"
+    );
+    assert!(meta.metadata["k2"].starts_with('['), "{:?}", meta.metadata);
+}
+
+/// The SO-ARM101 lists its joints from the gripper inwards; the testbed
+/// orders them from the root, and locks the gripper.
+#[test]
+fn joints_are_in_tree_order_and_the_gripper_is_locked() {
+    let text =
+        String::from_utf8(ok(testbed().args(["robot", "robots/so101.urdf"])).stdout).unwrap();
+    let pan = text.find("  0  shoulder_pan").unwrap();
+    let grip = text.find("gripper ").unwrap();
+    assert!(pan < grip, "{text}");
+    assert!(text.contains("locked gripper at"), "{text}");
+    assert!(text.contains("ignored link"), "{text}");
+}
+
+/// Per-joint gains from a scenario, in both barrier modes; wrong lengths
+/// and bad locks are errors naming the key.
+#[test]
+fn per_joint_gains_and_locks_from_a_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    let robots = crate::util::repo_root().join("robots");
+    for barrier in ["per-joint", "norm"] {
+        let f = dir.path().join(format!("{barrier}.toml"));
+        std::fs::write(
+            &f,
+            format!(
+                "robot = \"{}/two_link.urdf\"\nduration_s = 4.0\n[controller]\nk1 = [15.0, 20.0]\nk2 = [15.0, 10.0]\nbarrier = \"{barrier}\"\n",
+                robots.display()
+            ),
+        )
+        .unwrap();
+        let s = json(&ok(testbed().args(["sim", "--json", "--scenario"]).arg(&f)));
+        assert_eq!(s["constraint_satisfied_after_tc"], true, "{barrier}: {s}");
+        assert_eq!(s["k2"], serde_json::json!([15.0, 10.0]), "{s}");
+    }
+    let cases = [
+        (
+            "[controller]\nk2 = [15.0]\n",
+            "controller.k2 = 1 entries is invalid",
+        ),
+        ("[controller]\nk1 = [15.0, nan]\n", "controller.k1[1] = NaN"),
+        (
+            "[plant.lock]\nghost = 0.0\n",
+            "plant.lock.ghost = 0 is invalid",
+        ),
+        ("[plant.lock]\njoint1 = 9.0\n", "within the joint's limits"),
+        ("[plant]\narmature = [-1.0, 0.0]\n", "plant.armature[0]"),
+    ];
+    for (i, (body, needle)) in cases.iter().enumerate() {
+        let f = dir.path().join(format!("bad{i}.toml"));
+        std::fs::write(&f, body).unwrap();
+        let err = fails(testbed().args(["sim", "--scenario"]).arg(&f));
+        assert!(
+            err.contains(needle) && err.contains(&format!("bad{i}.toml")),
+            "{body}: {err}"
+        );
+    }
 }
 
 /// URDFs a user may bring that the plant cannot simulate: each is a clear
@@ -140,7 +229,7 @@ fn malformed_and_unsupported_urdfs_are_clear_errors() {
                 ),
                 joint("j", "revolute", "base", "a", "")
             )),
-            "link 'a': the inertia tensor is not positive definite",
+            "link 'a': the inertia tensor is not positive semi-definite",
         ),
         (
             "triangle",
@@ -180,7 +269,7 @@ fn malformed_and_unsupported_urdfs_are_clear_errors() {
                 "{a}{}",
                 joint("j", "revolute", "base", "a", r#"<mimic joint="k"/>"#)
             )),
-            "<mimic>",
+            "joint 'j' has <mimic>: it follows joint 'k', which does not exist",
         ),
         (
             "bad_number",
@@ -227,6 +316,26 @@ fn malformed_and_unsupported_urdfs_are_clear_errors() {
             "no mass",
         ),
         ("two_roots", robot(a.clone()), "several root links"),
+        (
+            "mimic_of_fixed",
+            robot(format!(
+                "{a}{}{}{}",
+                link("b", "1", good_i),
+                joint("f", "fixed", "base", "a", ""),
+                joint("j", "revolute", "a", "b", r#"<mimic joint="f"/>"#)
+            )),
+            "it follows joint 'f', which is fixed",
+        ),
+        (
+            "floating_inside",
+            robot(format!(
+                "{a}{}{}{}",
+                link("b", "1", good_i),
+                joint("j", "revolute", "base", "a", ""),
+                joint("free", "floating", "a", "b", "")
+            )),
+            "joint 'free' is floating",
+        ),
     ];
     assert!(cases.len() >= 10);
     let dir = tempfile::tempdir().unwrap();

@@ -41,6 +41,16 @@ pub struct RunMetadata {
     pub seed: u64,
     /// The plant effects the scenario turns on, by name.
     pub plant_effects: Vec<&'static str>,
+    /// K1_i and K2_i per joint, as `[a, b, …]`.
+    pub k1: String,
+    /// K2_i per joint.
+    pub k2: String,
+    /// Locked joints as `name=position`, with what they mimic.
+    pub locked_joints: String,
+    /// Mimic joints as `name=multiplier*leader+offset`.
+    pub mimic_joints: String,
+    /// Whether URDF damping and friction act.
+    pub urdf_dynamics: bool,
 }
 
 impl RunMetadata {
@@ -55,6 +65,11 @@ impl RunMetadata {
             ("joint_names".into(), self.joint_names.join(",")),
             ("seed".into(), self.seed.to_string()),
             ("plant_effects".into(), self.plant_effects.join(",")),
+            ("k1".into(), self.k1.clone()),
+            ("k2".into(), self.k2.clone()),
+            ("locked_joints".into(), self.locked_joints.clone()),
+            ("mimic_joints".into(), self.mimic_joints.clone()),
+            ("urdf_dynamics".into(), self.urdf_dynamics.to_string()),
             (
                 "start_time_unix_ns".into(),
                 self.start_time_unix_ns.to_string(),

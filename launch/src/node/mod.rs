@@ -240,8 +240,45 @@ fn logger_metadata(ctx: &NodeContext, out: &std::path::Path) -> crate::log::RunM
         joint_names: plan.robot.model.joint_names(),
         seed: plan.scenario.seed,
         plant_effects: plan.scenario.plant.configured_effects().names(),
+        k1: gain_list(&plan.scenario.controller.k1, plan.robot.model.dof()),
+        k2: gain_list(&plan.scenario.controller.k2, plan.robot.model.dof()),
+        locked_joints: joint_roles(plan).0,
+        mimic_joints: joint_roles(plan).1,
+        urdf_dynamics: plan.scenario.plant.urdf_dynamics,
         start_time_unix_ns: std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(0, |d| d.as_nanos() as u64),
     }
+}
+
+/// `[a, b, …]`: a gain resolved for the arm's joints.
+fn gain_list(g: &::controller::Gain, n: usize) -> String {
+    let v = g.resolve("gain", n).unwrap_or_default();
+    format!("{v:?}")
+}
+
+/// The locked and the mimic joints, as the log's metadata writes them.
+fn joint_roles(plan: &Plan) -> (String, String) {
+    let m = &plan.robot.model;
+    let locked = m
+        .locked
+        .iter()
+        .map(|l| match &l.follows {
+            Some(f) => format!("{}={} (mimics {f})", l.name, l.position),
+            None => format!("{}={}", l.name, l.position),
+        })
+        .collect::<Vec<_>>()
+        .join(",");
+    let mimic = m
+        .mimic
+        .iter()
+        .map(|c| {
+            format!(
+                "{}={}*{}+{}",
+                m.joints[c.joint].name, c.multiplier, m.joints[m.actuated[c.leader]].name, c.offset
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(",");
+    (locked, mimic)
 }
