@@ -19,13 +19,15 @@
 //! assert!(q[0] < 0.0); // a horizontal arm starts to fall
 //! ```
 //!
-//! Conventions: gravity points along -z (URDF is z-up); joint order is the
-//! order of the actuated joints in the URDF file; q = 0 is the URDF's zero
-//! pose. Joint damping, friction and armature are zero: whatever the plant
-//! should add on top is added explicitly.
+//! Conventions: gravity points along -z (URDF is z-up); joint order is tree
+//! order from the root (depth-first, siblings in file order); q = 0 is the
+//! URDF's zero pose. `<mimic>` joints are coupled to their leader and are
+//! not controlled; joints a scenario locks are fixed. Joint damping and dry
+//! friction are the URDF's `<dynamics>` (or zero with `urdf_dynamics =
+//! false`), armature is the scenario's: nothing of Rapier's defaults.
 //!
 //! Limitations: inertia only, no contact (links have no colliders);
-//! floating, planar and spherical joints and `<mimic>` are refused.
+//! floating, planar and spherical joints and closed loops are refused.
 
 mod config;
 pub mod effects;
