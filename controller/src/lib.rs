@@ -26,6 +26,8 @@
 
 mod gain;
 mod law;
+mod machine;
+pub mod node;
 mod params;
 mod rbf;
 mod shifting;
@@ -33,6 +35,7 @@ mod weight_update;
 
 pub use gain::Gain;
 pub use law::{Controller, ControllerInput, barrier_lyapunov};
+pub use machine::ControllerMachine;
 pub use params::{BarrierMode, ControllerParams, Integrator};
 pub use rbf::Rbf;
 pub use shifting::shifting;

@@ -11,11 +11,11 @@ use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
 
 use crate::assemble::RecordAssembler;
 use crate::csv_out;
-use crate::log::{LogContents, LogError, LogMessage, read_log};
 use crate::mode::Mode;
 use crate::run::timing::{TimingStats, TimingSummary};
 use crate::summary::{Summary, SummaryBuilder};
 use crate::verify::Verifier;
+use logger::{LogContents, LogError, LogMessage, read_log};
 
 /// Why a log could not be analysed.
 #[derive(Debug, thiserror::Error)]
@@ -208,7 +208,7 @@ pub fn analyse(path: &Path, mut opts: AnalyseOptions<'_>) -> Result<LogAnalysis,
     let mut series = opts.series.then(|| Series::new(n));
     let mut verifier = if opts.verify {
         Some(
-            Verifier::new(plan.scenario.controller.clone(), n, plan.dt())
+            Verifier::new(plan.scenario.controller.clone(), n, plan.period_ns)
                 .map_err(|e| meta_err(path, e.to_string()))?,
         )
     } else {

@@ -16,13 +16,13 @@ use std::time::Instant;
 use scenario::{Overrides, Plan};
 use serde::Serialize;
 
-use crate::clock;
-use crate::closed_loop::{self, StepCosts};
 use crate::mode::Mode;
 use crate::node::placement::{self, Placement};
 use crate::run::timing::{Percentiles, TimingStats};
 use crate::run::{self, RunError, RunOptions};
+use crate::sim::{self, StepCosts};
 use wire::NodeKind;
+use wire::clock;
 
 /// What to measure.
 #[derive(Debug, Clone)]
@@ -51,7 +51,7 @@ pub enum BenchError {
     Scenario(#[from] scenario::ScenarioError),
     /// The in-process loop failed.
     #[error(transparent)]
-    Loop(#[from] closed_loop::LoopError),
+    Loop(#[from] sim::LoopError),
     /// A multi-process run failed.
     #[error(transparent)]
     Run(#[from] RunError),
@@ -268,6 +268,7 @@ fn stack(plan: &Plan, mode: Mode, opts: &BenchOptions) -> Result<run::RunOutcome
         runs_dir: opts.runs_dir.clone(),
         progress: false,
         realtime_setup: opts.realtime_setup,
+        verbose: false,
     })?)
 }
 
@@ -287,7 +288,7 @@ fn bench_arm(
         ));
         let start = Instant::now();
         let keep = if i == 0 { Some(&mut costs) } else { None };
-        closed_loop::run_measured(plan, keep, |_| Ok(()))?;
+        sim::run_measured(plan, keep, |_| Ok(()))?;
         walls.push(start.elapsed().as_secs_f64());
     }
     let inprocess = median(walls);

@@ -2,7 +2,7 @@
 //! processes, the launcher, the run summary and CSV output.
 //!
 //! Where it sits: at the top. `testbed sim` loads a [`scenario::Plan`], runs
-//! [`closed_loop::run`] and feeds each [`record::StepRecord`] to a
+//! [`sim::run`] and feeds each [`record::StepRecord`] to a
 //! [`summary::SummaryBuilder`]. `testbed run` spawns the [`node`] processes
 //! (plant, trajectory, controller) that talk over iceoryx2 ([`wire`]), and
 //! [`run`] supervises them and assembles the same records from the topics.
@@ -10,14 +10,12 @@
 pub mod analysis;
 pub mod assemble;
 pub mod bench;
-pub mod clock;
-pub mod closed_loop;
 pub mod csv_out;
-pub mod log;
 pub mod mode;
 pub mod node;
 pub mod plots;
 pub mod record;
 pub mod run;
+pub mod sim;
 pub mod summary;
 pub mod verify;

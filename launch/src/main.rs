@@ -2,7 +2,6 @@
 
 mod cli;
 mod report;
-mod robot_info;
 
 use std::process::ExitCode;
 

@@ -23,3 +23,12 @@ impl Mode {
         }
     }
 }
+
+impl From<Mode> for wire::Mode {
+    fn from(m: Mode) -> Self {
+        match m {
+            Mode::Realtime => wire::Mode::Realtime,
+            Mode::Lockstep => wire::Mode::Lockstep,
+        }
+    }
+}

@@ -3,16 +3,13 @@
 
 use std::collections::BTreeMap;
 
-use controller::{Controller, ControllerError, ControllerInput, Diagnostics};
-use scenario::ns_to_s;
-use wire::{Command, ControllerDiagnostics, JointState};
+use controller::{ControllerError, ControllerMachine};
+use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample};
 
-/// Re-drives a fresh controller step by step.
+/// Re-drives a fresh controller machine step by step.
 pub struct Verifier {
-    law: Controller,
-    diag: Diagnostics,
+    machine: ControllerMachine,
     n: usize,
-    dt: f64,
     next: u64,
     states: BTreeMap<u64, JointState>,
     diags: BTreeMap<u64, ControllerDiagnostics>,
@@ -24,18 +21,15 @@ pub struct Verifier {
 }
 
 impl Verifier {
-    /// A controller with `params` for `n` joints at period `dt`.
+    /// A controller with `params` for `n` joints at a period of `period_ns`.
     pub fn new(
         params: controller::ControllerParams,
         n: usize,
-        dt: f64,
+        period_ns: u64,
     ) -> Result<Self, ControllerError> {
-        let law = Controller::new(params, n)?;
         Ok(Self {
-            diag: law.diagnostics(),
-            law,
+            machine: ControllerMachine::new(params, n, period_ns)?,
             n,
-            dt,
             next: 0,
             states: BTreeMap::new(),
             diags: BTreeMap::new(),
@@ -74,17 +68,20 @@ impl Verifier {
                 return;
             };
             let n = self.n;
-            let input = ControllerInput {
-                t: ns_to_s(s.header.t_ns),
-                q: &s.q_measured[..n],
-                qd: &s.qd_measured[..n],
-                q_d: &d.q_d[..n],
-                qd_d: &d.qd_d[..n],
-                kc: &d.kc_in[..n],
-                kc_dot: &d.kc_dot[..n],
+            // The reference the controller used, as its diagnostics record it.
+            let reference = ReferenceSample {
+                header: d.header,
+                dof: d.dof,
+                reserved: 0,
+                q_d: d.q_d,
+                qd_d: d.qd_d,
+                qdd_d: [0.0; wire::MAX_DOF],
+                kc: d.kc_in,
+                kc_dot: d.kc_dot,
             };
-            self.law.step(self.dt, &input, &mut self.diag);
-            for (a, b) in self.diag.tau.iter().zip(&c.tau[..n]) {
+            let used = (d.fault != controller::Fault::NoReference.code()).then_some(&reference);
+            let (replayed, _) = self.machine.step(s, used);
+            for (a, b) in replayed.tau[..n].iter().zip(&c.tau[..n]) {
                 let diff = if a.to_bits() == b.to_bits() {
                     0.0
                 } else {

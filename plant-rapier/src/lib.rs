@@ -31,7 +31,9 @@
 
 mod config;
 pub mod effects;
+mod machine;
 mod model;
+pub mod node;
 mod plant;
 mod rig;
 
@@ -40,6 +42,7 @@ pub use config::{
     SensorConfig,
 };
 pub use effects::Effects;
+pub use machine::PlantMachine;
 pub use model::{
     ArmModel, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks, MergedLink,
     MimicJoint, MimicSpec, Origin,

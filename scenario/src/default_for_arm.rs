@@ -56,8 +56,9 @@ fn default_locks(full: &ArmModel) -> Vec<(String, f64, String)> {
         locks.push((j.name.clone(), lock_position(j.limits), why.to_string()));
     }
     if locks.len() == full.dof() {
-        // Nothing would be left: lock only what cannot be simulated.
-        locks.retain(|(name, ..)| massless.contains(name));
+        // Nothing would be left to control: lock nothing, and let the plant
+        // say what it cannot simulate.
+        locks.clear();
     }
     locks
 }

@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod log_replay;
+mod replace_nodes;
 mod robots;
 mod run_cli;
 mod scenarios;

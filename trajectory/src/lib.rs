@@ -17,8 +17,11 @@
 //! assert_eq!(s.kc, vec![0.5, 0.55]);        // 0.5 + 0.1 sin 0, 0.45 + 0.1 cos 0
 //! ```
 
+mod machine;
+pub mod node;
 mod sinusoid;
 
+pub use machine::TrajectoryMachine;
 pub use sinusoid::Sinusoid;
 
 use serde::{Deserialize, Serialize};

@@ -18,14 +18,31 @@
 //! Services live under a per-run prefix ([`RunPrefix`]), so two runs, or two
 //! tests, never see each other.
 
+pub mod clock;
+mod config;
 mod domain;
 mod messages;
+mod node;
 mod topics;
 
+pub use config::{ConfigError, read_config, write_config};
 pub use domain::DomainNodes;
 pub use iceoryx2::prelude::ZeroCopySend;
 pub use messages::*;
+pub use node::{Mode, NodeError, NodeLink, ns_to_s};
 pub use topics::{
     Bus, Delivery, RunPrefix, SUBSCRIBER_BUFFER, Topic, TopicPublisher, TopicSubscriber, WireError,
     monotonic_ns,
 };
+
+/// iceoryx2's own messages on stderr: only its errors unless `verbose`
+/// (then its information too). `IOX2_LOG_LEVEL` in the environment still
+/// decides when set.
+pub fn set_ipc_log_level(verbose: bool) {
+    use iceoryx2::prelude::{LogLevel, set_log_level, set_log_level_from_env_or};
+    if verbose {
+        set_log_level(LogLevel::Info);
+    } else {
+        set_log_level_from_env_or(LogLevel::Error);
+    }
+}

@@ -60,6 +60,8 @@ pub struct RunOptions {
     /// Pin the nodes to CPUs and, in real time, run the loop under
     /// SCHED_FIFO with locked memory (see [`crate::node::placement`]).
     pub realtime_setup: bool,
+    /// Let the nodes print iceoryx2's own messages.
+    pub verbose: bool,
 }
 
 /// What a finished run produced.
@@ -146,27 +148,19 @@ fn run_id() -> String {
 
 /// The arguments of `testbed node <kind>` for this run.
 pub fn node_args(
-    kind: NodeKind,
     prefix: &RunPrefix,
-    scenario: &Path,
+    config: &Path,
     mode: Mode,
-    (log, source): (&Path, &str),
     parent: Option<u32>,
 ) -> Vec<String> {
     let mut args = vec![
         "--prefix".to_string(),
         prefix.as_str().to_string(),
-        "--scenario".to_string(),
-        scenario.display().to_string(),
+        "--config".to_string(),
+        config.display().to_string(),
         "--mode".to_string(),
         mode.as_str().to_string(),
     ];
-    if kind == NodeKind::Logger {
-        args.push("--out".into());
-        args.push(log.display().to_string());
-        args.push("--source".into());
-        args.push(source.to_string());
-    }
     if let Some(pid) = parent {
         args.push("--parent-pid".into());
         args.push(pid.to_string());
@@ -192,7 +186,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
             std::io::Error::other(e.to_string()),
         )
     })?;
-    std::fs::write(&scenario_file, toml)
+    std::fs::write(&scenario_file, &toml)
         .map_err(|e| RunError::Output(scenario_file.display().to_string(), e))?;
 
     let prefix = RunPrefix::unique();
@@ -205,6 +199,15 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let control = bus.publisher::<Control>(Topic::Control, Delivery::DropWhenFull)?;
     let log = std::path::absolute(run_dir.join("run.mcap"))
         .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?;
+    let configs = crate::node::configs::write_all(
+        &std::path::absolute(run_dir.join("nodes"))
+            .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?,
+        plan,
+        opts.mode,
+        &log,
+        &toml,
+    )
+    .map_err(|e| RunError::Output(run_dir.display().to_string(), std::io::Error::other(e)))?;
 
     let cpus = crate::node::placement::cpu_count();
     let _off_loop = opts
@@ -219,14 +222,13 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     for kind in NODES {
         let external = opts.external.contains(&kind);
         let parent = if external { None } else { me };
-        let mut args = node_args(
-            kind,
-            &prefix,
-            &scenario_file,
-            opts.mode,
-            (&log, &plan.source),
-            parent,
-        );
+        let Some((_, config)) = configs.iter().find(|(k, _)| *k == kind) else {
+            unreachable!("write_all writes a config for every node kind");
+        };
+        let mut args = node_args(&prefix, config, opts.mode, parent);
+        if opts.verbose {
+            args.push("--verbose".into());
+        }
         if opts.realtime_setup {
             args.extend(crate::node::placement::for_node(kind, opts.mode, cpus).to_args());
         }

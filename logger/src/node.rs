@@ -5,15 +5,45 @@
 //! gap in sequence numbers, counted per topic in `testbed.log_stats`.
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::PathBuf;
 use std::time::Duration;
 
+use serde::{Deserialize, Serialize};
 use wire::{
-    Command, ControllerDiagnostics, JointState, ReferenceSample, Timing, Topic, TopicSubscriber,
+    Command, ControllerDiagnostics, JointState, NodeError, NodeLink, ReferenceSample, Timing,
+    Topic, TopicSubscriber,
 };
 
-use super::{NodeContext, NodeError};
-use crate::log::{LogMessage, LogWriter, RunMetadata};
+use crate::{LogError, LogMessage, LogWriter, RunMetadata};
+
+/// What the launcher hands the logger node.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoggerNodeConfig {
+    /// The MCAP file to write.
+    pub out: PathBuf,
+    /// The `testbed.run` record (its start time is set when the logger starts).
+    pub metadata: RunMetadata,
+    /// The robot's URDF, attached to the log.
+    pub urdf: String,
+}
+
+/// Why the logger node stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum LoggerNodeError {
+    /// The node protocol or the bus.
+    #[error(transparent)]
+    Node(#[from] NodeError),
+    /// The log could not be written.
+    #[error(transparent)]
+    Log(#[from] LogError),
+}
+
+impl From<wire::WireError> for LoggerNodeError {
+    fn from(e: wire::WireError) -> Self {
+        Self::Node(e.into())
+    }
+}
 
 /// Counts for one topic.
 #[derive(Debug, Default, Clone, Copy)]
@@ -39,18 +69,17 @@ struct Sub<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> {
 }
 
 impl<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> Sub<M> {
-    fn new(ctx: &NodeContext, topic: Topic) -> Result<Self, NodeError> {
+    fn new(link: &NodeLink, topic: Topic) -> Result<Self, LoggerNodeError> {
         Ok(Self {
-            sub: ctx.bus.polling_subscriber(topic)?,
+            sub: link.bus.polling_subscriber(topic)?,
             count: TopicCount::default(),
         })
     }
 
-    fn drain(&mut self, log: &mut LogWriter) -> Result<(), NodeError> {
+    fn drain(&mut self, log: &mut LogWriter) -> Result<(), LoggerNodeError> {
         while let Some(m) = self.sub.receive()? {
             self.count.add(m.header().seq);
-            log.write(&m)
-                .map_err(|e| NodeError::Protocol(e.to_string()))?;
+            log.write(&m)?;
         }
         let _ = self.sub.drain_events();
         Ok(())
@@ -72,7 +101,7 @@ struct Subs {
 }
 
 impl Subs {
-    fn drain(&mut self, log: &mut LogWriter) -> Result<(), NodeError> {
+    fn drain(&mut self, log: &mut LogWriter) -> Result<(), LoggerNodeError> {
         self.state.drain(log)?;
         self.reference.drain(log)?;
         self.command.drain(log)?;
@@ -91,47 +120,49 @@ impl Subs {
     }
 }
 
-/// Runs the logger node, writing to `out`.
-pub fn run(ctx: &mut NodeContext, out: &Path, meta: RunMetadata) -> Result<(), NodeError> {
-    let log_err = |e: crate::log::LogError| NodeError::Protocol(e.to_string());
+/// Runs the logger node to the end of the run.
+pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerNodeError> {
     let mut subs = Subs {
-        state: Sub::new(ctx, Topic::JointState)?,
-        reference: Sub::new(ctx, Topic::Reference)?,
-        command: Sub::new(ctx, Topic::Command)?,
-        diag: Sub::new(ctx, Topic::Diagnostics)?,
-        timing: Sub::new(ctx, Topic::Timing)?,
+        state: Sub::new(link, Topic::JointState)?,
+        reference: Sub::new(link, Topic::Reference)?,
+        command: Sub::new(link, Topic::Command)?,
+        diag: Sub::new(link, Topic::Diagnostics)?,
+        timing: Sub::new(link, Topic::Timing)?,
     };
-    let mut log = LogWriter::create(out, &meta, &ctx.plan.robot.urdf).map_err(log_err)?;
+    let mut meta = config.metadata.clone();
+    meta.start_time_unix_ns = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos() as u64);
+    let mut log = LogWriter::create(&config.out, &meta, &config.urdf)?;
     // Every channel exists from the start, even if a topic stays silent.
-    log.add_channel::<JointState>().map_err(log_err)?;
-    log.add_channel::<ReferenceSample>().map_err(log_err)?;
-    log.add_channel::<Command>().map_err(log_err)?;
-    log.add_channel::<ControllerDiagnostics>()
-        .map_err(log_err)?;
-    log.add_channel::<Timing>().map_err(log_err)?;
-    log.flush().map_err(log_err)?;
+    log.add_channel::<JointState>()?;
+    log.add_channel::<ReferenceSample>()?;
+    log.add_channel::<Command>()?;
+    log.add_channel::<ControllerDiagnostics>()?;
+    log.add_channel::<Timing>()?;
+    log.flush()?;
 
-    let started = ctx.ready_and_wait_for_start();
-    let result = match started {
+    let started = link.ready_and_wait_for_start();
+    let result: Result<(), LoggerNodeError> = match started {
         Ok(_) => loop {
             subs.drain(&mut log)?;
-            log.flush_if_due().map_err(log_err)?;
-            if let Err(e) = ctx.check() {
-                break Err(e);
+            log.flush_if_due()?;
+            if let Err(e) = link.check() {
+                break Err(e.into());
             }
-            if let Err(e) = ctx.bus.wait(Duration::from_millis(10)) {
+            if let Err(e) = link.bus.wait(Duration::from_millis(10)) {
                 break Err(e.into());
             }
         },
-        Err(e) => Err(e),
+        Err(e) => Err(e.into()),
     };
     // STOP, a signal or a vanished launcher: in every case take what is
     // still buffered and finish the file properly.
     subs.drain(&mut log)?;
     let stats = subs.stats();
-    log.finish(stats).map_err(log_err)?;
+    log.finish(stats)?;
     match result {
-        Err(NodeError::Stopped) => Ok(()),
+        Err(LoggerNodeError::Node(NodeError::Stopped)) => Ok(()),
         other => other,
     }
 }

@@ -7,7 +7,7 @@
 use nix::sys::time::TimeSpec;
 use nix::time::{ClockId, ClockNanosleepFlags, clock_nanosleep};
 
-pub use wire::monotonic_ns;
+pub use crate::monotonic_ns;
 
 /// Asks the kernel not to coalesce this thread's timers (default slack is
 /// 50 µs). Failure only costs precision, so it is ignored.

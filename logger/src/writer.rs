@@ -19,7 +19,8 @@ const FLUSH_EVERY: Duration = Duration::from_millis(500);
 const CHUNK_BYTES: u64 = 1 << 20;
 
 /// What the `testbed.run` metadata record says.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RunMetadata {
     /// Run id (the run folder's name).
     pub run_id: String,
@@ -40,7 +41,7 @@ pub struct RunMetadata {
     /// The seed of every random effect.
     pub seed: u64,
     /// The plant effects the scenario turns on, by name.
-    pub plant_effects: Vec<&'static str>,
+    pub plant_effects: Vec<String>,
     /// K1_i and K2_i per joint, as `[a, b, …]`.
     pub k1: String,
     /// K2_i per joint.
@@ -144,7 +145,11 @@ impl LogWriter {
         if let Some((id, _)) = self.channels.get(M::TOPIC) {
             return Ok(*id);
         }
-        let schema = serde_json::to_vec(&M::schema()).unwrap_or_default();
+        let schema = serde_json::to_vec(&M::schema()).map_err(|cause| LogError::Encode {
+            path: self.path.display().to_string(),
+            topic: M::TOPIC,
+            cause,
+        })?;
         let schema_id = self
             .writer
             .add_schema(M::SCHEMA, "jsonschema", &schema)
@@ -171,7 +176,11 @@ impl LogWriter {
             *s
         });
         let h = msg.header();
-        let data = serde_json::to_vec(&msg.to_json()).unwrap_or_default();
+        let data = serde_json::to_vec(&msg.to_json()).map_err(|cause| LogError::Encode {
+            path: self.path.display().to_string(),
+            topic: M::TOPIC,
+            cause,
+        })?;
         let header = MessageHeader {
             channel_id: id,
             sequence: seq,

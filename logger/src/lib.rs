@@ -1,4 +1,10 @@
-//! The run log: one MCAP file per run that explains itself.
+//! The run log: one MCAP file per run that explains itself, and the
+//! logger process that writes it.
+//!
+//! Where it sits: at the end of the data flow. The logger node
+//! ([`node::run`]) subscribes to every data topic and writes what it
+//! receives; `testbed replay` and the launcher's summary read the file
+//! back ([`read_log`]). Nothing here steps the loop.
 //!
 //! Channels carry JSON messages with `jsonschema` schemas (so Foxglove can
 //! plot every field), in zstd-compressed chunks; each message's log time is
@@ -9,6 +15,7 @@
 //! and what it could not take.
 
 mod json;
+pub mod node;
 mod reader;
 mod writer;
 
@@ -41,6 +48,26 @@ pub enum LogError {
         path: String,
         /// The cause.
         cause: mcap::McapError,
+    },
+    /// A message could not be encoded.
+    #[error("{path}: cannot encode a {topic} message: {cause}")]
+    Encode {
+        /// The file.
+        path: String,
+        /// The message's topic.
+        topic: &'static str,
+        /// The cause.
+        cause: serde_json::Error,
+    },
+    /// A message's handler failed.
+    #[error("{path}: {topic} message: {reason}")]
+    Message {
+        /// The file.
+        path: String,
+        /// The message's topic.
+        topic: String,
+        /// What went wrong.
+        reason: String,
     },
     /// The file is readable MCAP but not a testbed log.
     #[error("{path}: {reason}")]

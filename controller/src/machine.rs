@@ -1,0 +1,121 @@
+//! The controller's step machine: joint state + reference → command +
+//! diagnostics, in wire messages. The controller node, `testbed sim` and
+//! `replay --verify` all drive this one machine.
+
+use wire::{Command, ControllerDiagnostics, Header, JointState, ReferenceSample, joints};
+
+use crate::{Controller, ControllerError, ControllerInput, ControllerParams, Diagnostics, Fault};
+
+/// The law behind wire messages.
+#[derive(Debug, Clone)]
+pub struct ControllerMachine {
+    law: Controller,
+    diag: Diagnostics,
+    n: usize,
+    dt: f64,
+}
+
+impl ControllerMachine {
+    /// The law with `params` for `dof` joints at a period of `period_ns`.
+    pub fn new(
+        params: ControllerParams,
+        dof: usize,
+        period_ns: u64,
+    ) -> Result<Self, ControllerError> {
+        let law = Controller::new(params, dof)?;
+        Ok(Self {
+            diag: law.diagnostics(),
+            law,
+            n: dof,
+            dt: wire::ns_to_s(period_ns),
+        })
+    }
+
+    /// Number of joints.
+    pub fn dof(&self) -> usize {
+        self.n
+    }
+
+    /// The diagnostics of the last step.
+    pub fn diagnostics(&self) -> &Diagnostics {
+        &self.diag
+    }
+
+    /// One step on the measured `state` with `reference` (None: no sample
+    /// is available, which publishes zero torque with a fault). The
+    /// messages carry the state's seq and sim time; their wall stamps and
+    /// compute time are the caller's to set.
+    pub fn step(
+        &mut self,
+        state: &JointState,
+        reference: Option<&ReferenceSample>,
+    ) -> (Command, ControllerDiagnostics) {
+        let n = self.n;
+        let zero = ReferenceSample::default();
+        match reference {
+            Some(r) => {
+                let input = ControllerInput {
+                    t: wire::ns_to_s(state.header.t_ns),
+                    q: &state.q_measured[..n],
+                    qd: &state.qd_measured[..n],
+                    q_d: &r.q_d[..n],
+                    qd_d: &r.qd_d[..n],
+                    kc: &r.kc[..n],
+                    kc_dot: &r.kc_dot[..n],
+                };
+                self.law.step(self.dt, &input, &mut self.diag);
+            }
+            None => {
+                self.diag.fault = Some(Fault::NoReference);
+                self.diag.tau.iter_mut().for_each(|x| *x = 0.0);
+            }
+        }
+        let header = Header {
+            seq: state.header.seq,
+            t_ns: state.header.t_ns,
+            wall_ns: 0,
+        };
+        let d = &self.diag;
+        let command = Command {
+            header,
+            dof: n as u32,
+            fault: d.fault.map_or(0, |f| f.code()),
+            tau: joints(&d.tau),
+            state_wall_ns: state.header.wall_ns,
+            compute_ns: 0,
+        };
+        (command, diag_msg(header, d, reference.unwrap_or(&zero)))
+    }
+}
+
+fn diag_msg(header: Header, d: &Diagnostics, r: &ReferenceSample) -> ControllerDiagnostics {
+    ControllerDiagnostics {
+        header,
+        dof: d.tau.len() as u32,
+        fault: d.fault.map_or(0, |f| f.code()),
+        barrier_breached: u32::from(d.barrier_breached),
+        reserved: 0,
+        compute_ns: 0,
+        gamma: d.gamma,
+        gamma_dot: d.gamma_dot,
+        j_hat: d.j_hat,
+        delta: d.delta,
+        r: d.r,
+        wc_norm: d.wc_norm,
+        q_d: r.q_d,
+        qd_d: r.qd_d,
+        kc_in: r.kc,
+        kc_dot: r.kc_dot,
+        z1: joints(&d.z1),
+        z1g: joints(&d.z1g),
+        z2: joints(&d.z2),
+        alpha: joints(&d.alpha),
+        kc: joints(&d.kc),
+        d: joints(&d.d),
+        tau: joints(&d.tau),
+        tau_actor: joints(&d.tau_actor),
+        tau_feedback: joints(&d.tau_feedback),
+        tau_barrier: joints(&d.tau_barrier),
+        wa_norm: joints(&d.wa_norm),
+    }
+}

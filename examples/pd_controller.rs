@@ -1,0 +1,127 @@
+//! Replace the controller node: a PD law on the same topics.
+//!
+//! `testbed run --external controller` prints the command it waits for;
+//! start this binary with the same arguments instead:
+//!
+//! ```sh
+//! testbed run --mode lockstep --external controller &
+//! example-pd-controller --prefix … --config runs/<id>/nodes/controller.json --mode lockstep
+//! ```
+//!
+//! It reads the controller's config (joints, period), follows the node
+//! protocol (`wire::NodeLink`), and for every joint state publishes a
+//! command τ = −Kp (q − q_d) − Kd (q̇ − q̇_d) and the diagnostics the log
+//! and the summary are made from. Other arguments the launcher adds (CPU
+//! placement) are ignored.
+
+use std::process::ExitCode;
+use std::time::Duration;
+
+use controller::node::ControllerNodeConfig;
+use wire::{
+    Command, ControllerDiagnostics, JointState, Mode, NodeKind, NodeLink, ReferenceSample,
+    RunPrefix, STATE_FINAL, Topic, monotonic_ns, read_config,
+};
+
+const KP: f64 = 400.0;
+const KD: f64 = 40.0;
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("example-pd-controller: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `--prefix`, `--config` and `--mode` from the command line.
+fn args() -> Result<(RunPrefix, std::path::PathBuf, Mode), String> {
+    let argv: Vec<String> = std::env::args().collect();
+    let value = |flag: &str| {
+        argv.iter()
+            .position(|a| a == flag)
+            .and_then(|i| argv.get(i + 1))
+            .cloned()
+            .ok_or(format!("missing {flag}"))
+    };
+    let prefix = RunPrefix::parse(&value("--prefix")?).map_err(|e| e.to_string())?;
+    Ok((prefix, value("--config")?.into(), value("--mode")?.parse()?))
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let (prefix, config, mode) = args()?;
+    let config: ControllerNodeConfig = read_config(&config)?;
+    let n = config.dof;
+    let mut link = NodeLink::connect(NodeKind::Controller, &prefix, None)?;
+    let states = link.bus.subscriber::<JointState>(Topic::JointState)?;
+    let references = link.bus.subscriber::<ReferenceSample>(Topic::Reference)?;
+    let commands = link
+        .bus
+        .publisher::<Command>(Topic::Command, mode.delivery())?;
+    let diagnostics = link
+        .bus
+        .publisher::<ControllerDiagnostics>(Topic::Diagnostics, mode.delivery())?;
+    link.ready_and_wait_for_start()?;
+    let mut recent: Vec<ReferenceSample> = Vec::new();
+    let mut handled = 0;
+    'run: loop {
+        while let Some(s) = states.receive()? {
+            if s.flags & STATE_FINAL != 0 {
+                break 'run;
+            }
+            // The newest reference at or before the state; in lockstep wait
+            // until one at or after it has come, so the choice is final.
+            let r = loop {
+                while let Some(r) = references.receive()? {
+                    recent.push(r);
+                }
+                let settled = recent.iter().any(|r| r.header.t_ns >= s.header.t_ns);
+                if settled || mode == Mode::Realtime {
+                    break recent
+                        .iter()
+                        .rev()
+                        .find(|r| r.header.t_ns <= s.header.t_ns)
+                        .copied();
+                }
+                link.bus.wait(Duration::from_millis(1))?;
+            };
+            let r = r.unwrap_or_default();
+            let mut d = ControllerDiagnostics {
+                header: s.header,
+                dof: n as u32,
+                q_d: r.q_d,
+                qd_d: r.qd_d,
+                kc_in: r.kc,
+                kc_dot: r.kc_dot,
+                kc: r.kc,
+                ..ControllerDiagnostics::default()
+            };
+            for i in 0..n {
+                d.z1[i] = s.q_measured[i] - r.q_d[i];
+                d.z1g[i] = d.z1[i];
+                d.z2[i] = s.qd_measured[i] - r.qd_d[i];
+                d.tau[i] = -KP * d.z1[i] - KD * d.z2[i];
+                d.tau_feedback[i] = d.tau[i];
+            }
+            d.header.wall_ns = monotonic_ns();
+            commands.send(Command {
+                header: d.header,
+                dof: n as u32,
+                fault: 0,
+                tau: d.tau,
+                state_wall_ns: s.header.wall_ns,
+                compute_ns: 0,
+            })?;
+            diagnostics.send(d)?;
+            handled += 1;
+        }
+        if !states.wait_event(Duration::from_millis(100))? {
+            link.check()?;
+        }
+        states.drain_events()?;
+    }
+    link.done_and_wait_for_stop(handled)?;
+    Ok(())
+}

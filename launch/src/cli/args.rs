@@ -1,0 +1,104 @@
+//! The arguments of the subcommands.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::NodeName;
+use launch::mode::Mode;
+
+#[derive(Debug, Args)]
+pub(crate) struct ScenarioArgs {
+    /// Scenario file (TOML), or the name of a shipped one (`testbed
+    /// scenarios` lists them) [default: the paper's, scenarios/paper.toml].
+    #[arg(long, value_name = "FILE|NAME")]
+    pub(crate) scenario: Option<PathBuf>,
+    /// Run this arm (URDF) instead of the scenario's; with no --scenario,
+    /// the default scenario for the arm (see `testbed robot`).
+    #[arg(long, value_name = "URDF")]
+    pub(crate) robot: Option<PathBuf>,
+    /// Run for this many seconds instead of the scenario's duration_s.
+    #[arg(long, value_name = "S")]
+    pub(crate) duration: Option<f64>,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Write one row per control step to this CSV file.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) csv: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct SimArgs {
+    #[command(flatten)]
+    pub(crate) common: ScenarioArgs,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct RunArgs {
+    #[command(flatten)]
+    pub(crate) common: ScenarioArgs,
+    /// Timing mode.
+    #[arg(long, value_enum, default_value = "realtime")]
+    pub(crate) mode: Mode,
+    /// Control rate in Hz instead of the scenario's rate_hz.
+    #[arg(long, value_name = "HZ")]
+    pub(crate) rate: Option<f64>,
+    /// Do not start this node; wait for one started by hand (repeatable).
+    #[arg(long, value_enum, value_name = "NODE")]
+    pub(crate) external: Vec<NodeName>,
+    /// Folder for run folders.
+    #[arg(long, value_name = "DIR", default_value = "runs")]
+    pub(crate) runs_dir: PathBuf,
+    /// Leave the nodes where the OS puts them: no CPU pinning, and in real
+    /// time no SCHED_FIFO and no locked memory.
+    #[arg(long)]
+    pub(crate) no_realtime_setup: bool,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct BenchArgs {
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Length of each real-time part and of the timer floor, s.
+    #[arg(long, value_name = "S", default_value_t = 60.0)]
+    pub(crate) realtime_s: f64,
+    /// Repeats of the in-process and lockstep parts (medians are reported).
+    #[arg(long, value_name = "N", default_value_t = 3)]
+    pub(crate) repeats: usize,
+    /// Shorten every scenario to this many seconds (quick check).
+    #[arg(long, value_name = "S")]
+    pub(crate) duration: Option<f64>,
+    /// The large arm to measure besides the paper's: the largest shipped
+    /// arm whose default scenario runs at 1 kHz (robots/iiwa14.urdf has 7
+    /// joints, but its default scenario runs at 5.2 kHz).
+    #[arg(long, value_name = "URDF", default_value = "robots/ur5.urdf")]
+    pub(crate) large_arm: PathBuf,
+    /// Folder for run folders.
+    #[arg(long, value_name = "DIR", default_value = "runs")]
+    pub(crate) runs_dir: PathBuf,
+    /// Measure without pinning, SCHED_FIFO or locked memory.
+    #[arg(long)]
+    pub(crate) no_realtime_setup: bool,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct ReplayArgs {
+    /// The run's MCAP log (runs/<id>/run.mcap).
+    #[arg(value_name = "FILE.mcap")]
+    pub(crate) log: PathBuf,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Write one row per control step to this CSV file.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) csv: Option<PathBuf>,
+    /// Write the paper's figures (PNG and SVG) and a timing figure here.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) plots: Option<PathBuf>,
+    /// Re-drive the controller from the logged states and references and
+    /// report the largest difference from the logged torques.
+    #[arg(long)]
+    pub(crate) verify: bool,
+}

@@ -1,0 +1,149 @@
+//! Command-line parsing and dispatch: one module per subcommand.
+
+mod args;
+mod bench;
+mod replay;
+mod robot;
+mod run;
+mod scenarios;
+mod sim;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+
+use launch::node::{self, NodeArgs};
+use scenario::Overrides;
+use wire::NodeKind;
+
+use crate::report::{self, Report};
+use args::{BenchArgs, ReplayArgs, RunArgs, ScenarioArgs, SimArgs};
+
+/// Run the paper's RL neuroadaptive controller under deferred constraints on
+/// a simulated arm.
+#[derive(Debug, Parser)]
+#[command(name = "testbed", version, about)]
+struct Cli {
+    /// Show iceoryx2's own messages (by default only its errors).
+    #[arg(long, global = true)]
+    verbose: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run the closed loop in one process, as fast as the machine allows.
+    Sim(SimArgs),
+    /// Run the stack as separate processes over iceoryx2 shared memory.
+    Run(RunArgs),
+    /// Describe an arm: joints in order, limits, masses, and the default
+    /// scenario `--robot` would run on it; or why it cannot be used.
+    Robot {
+        /// The URDF file.
+        #[arg(value_name = "URDF")]
+        path: PathBuf,
+    },
+    /// Measure speed and timing on this machine: in process, lockstep, real
+    /// time, and the machine's own timer floor.
+    Bench(BenchArgs),
+    /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
+    Replay(ReplayArgs),
+    /// List the shipped scenarios and what each one demonstrates.
+    Scenarios,
+    /// Run one node of a stack (the launcher starts these; start one by hand
+    /// with `testbed run --external <node>` to debug or replace it).
+    Node {
+        /// Which node.
+        #[arg(value_enum)]
+        name: NodeName,
+        #[command(flatten)]
+        args: NodeArgs,
+    },
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum NodeName {
+    Plant,
+    Trajectory,
+    Controller,
+    Logger,
+}
+
+impl NodeName {
+    pub(crate) fn kind(self) -> NodeKind {
+        match self {
+            NodeName::Plant => NodeKind::Plant,
+            NodeName::Trajectory => NodeKind::Trajectory,
+            NodeName::Controller => NodeKind::Controller,
+            NodeName::Logger => NodeKind::Logger,
+        }
+    }
+}
+
+/// Exit status of a run stopped by Ctrl-C (128 + SIGINT).
+pub(crate) const EXIT_INTERRUPTED: u8 = 130;
+
+/// Parses the command line and runs it.
+pub fn run() -> Result<ExitCode> {
+    let cli = Cli::parse();
+    wire::set_ipc_log_level(cli.verbose);
+    match cli.command {
+        Command::Sim(args) => sim::sim(args),
+        Command::Run(args) => run::run_stack(args, cli.verbose),
+        Command::Replay(args) => replay::replay(args),
+        Command::Bench(args) => bench::bench(args),
+        Command::Scenarios => {
+            print!("{}", scenarios::scenario_list());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Robot { path } => {
+            print!("{}", robot::describe(&path)?);
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Node { name, args } => {
+            node::run(name.kind(), &args)
+                .with_context(|| format!("{} node", name.kind().name()))?;
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+pub(crate) fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario::Plan> {
+    let overrides = Overrides {
+        duration_s: common.duration,
+        rate_hz: rate,
+        robot: common.robot.clone(),
+    };
+    let path = common.scenario.as_deref().map(resolve_scenario);
+    Ok(scenario::load(path.as_deref(), &overrides)?)
+}
+
+/// A scenario argument that is not a file but names a shipped scenario
+/// becomes that scenario's file.
+fn resolve_scenario(arg: &std::path::Path) -> PathBuf {
+    if arg.exists() || arg.components().count() > 1 {
+        return arg.to_path_buf();
+    }
+    match arg.to_str().and_then(scenario::find_shipped) {
+        Some(s) => s.path(),
+        None => arg.to_path_buf(),
+    }
+}
+
+pub(crate) fn print_report(report: &Report, json: bool) -> Result<()> {
+    if json {
+        println!("{}", serde_json::to_string_pretty(report)?);
+    } else {
+        print!("{}", report::table(report));
+    }
+    if !report.summary.finite {
+        eprintln!("testbed: warning: the run produced non-finite values or controller faults");
+    }
+    if let Some(w) = &report.warning {
+        eprintln!("testbed: warning: {w}");
+    }
+    Ok(())
+}

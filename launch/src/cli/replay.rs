@@ -1,0 +1,44 @@
+//! `testbed replay`: everything from a run's log.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+
+use super::args::ReplayArgs;
+use super::print_report;
+use crate::report::Report;
+
+pub(crate) fn replay(args: ReplayArgs) -> Result<ExitCode> {
+    let mut csv = match &args.csv {
+        Some(path) => {
+            Some(BufWriter::new(File::create(path).with_context(|| {
+                format!("cannot create CSV file {}", path.display())
+            })?))
+        }
+        None => None,
+    };
+    let csv_name = args
+        .csv
+        .as_ref()
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    let analysis = launch::analysis::analyse(
+        &args.log,
+        launch::analysis::AnalyseOptions {
+            csv: csv
+                .as_mut()
+                .map(|w| (csv_name.as_str(), w as &mut dyn Write)),
+            verify: args.verify,
+            series: args.plots.is_some(),
+        },
+    )?;
+    if let (Some(dir), Some(series)) = (&args.plots, &analysis.series) {
+        let written = launch::plots::write_all(dir, series, &analysis.plan)
+            .with_context(|| format!("writing figures to {}", dir.display()))?;
+        eprintln!("testbed: wrote {} figures to {}", written, dir.display());
+    }
+    print_report(&Report::from_log(analysis), args.json)?;
+    Ok(ExitCode::SUCCESS)
+}

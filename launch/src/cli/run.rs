@@ -1,0 +1,38 @@
+//! `testbed run`: the stack as separate processes.
+
+use std::io::IsTerminal;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use launch::run::{self, RunError, RunOptions};
+
+use super::args::RunArgs;
+use super::{EXIT_INTERRUPTED, load, print_report};
+use crate::report::Report;
+
+pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
+    let plan = load(&args.common, args.rate)?;
+    let source = plan.source.clone();
+    let opts = RunOptions {
+        plan: plan.clone(),
+        mode: args.mode,
+        csv: args.common.csv.clone(),
+        external: args.external.iter().map(|n| n.kind()).collect(),
+        runs_dir: args.runs_dir.clone(),
+        progress: std::io::stderr().is_terminal(),
+        realtime_setup: !args.no_realtime_setup,
+        verbose,
+    };
+    let outcome = match run::run(opts) {
+        Ok(o) => o,
+        Err(RunError::Interrupted) => {
+            eprintln!("testbed: interrupted; all nodes stopped");
+            return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        }
+        Err(e) => return Err(e).with_context(|| format!("running {source}")),
+    };
+    let mut report = Report::from_log(outcome.analysis);
+    report.run_dir = Some(outcome.run_dir.display().to_string());
+    print_report(&report, args.common.json)?;
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,51 @@
+//! `testbed sim`: the run in one process.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use launch::{csv_out, sim as in_process, summary::SummaryBuilder};
+
+use super::args::SimArgs;
+use super::{load, print_report};
+use crate::report::Report;
+
+pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
+    let args = args.common;
+    let plan = load(&args, None)?;
+    let mut csv = match &args.csv {
+        Some(path) => {
+            let file = File::create(path)
+                .with_context(|| format!("cannot create CSV file {}", path.display()))?;
+            let mut w = BufWriter::new(file);
+            writeln!(w, "{}", csv_out::header(plan.robot.model.dof()))
+                .with_context(|| format!("writing {}", path.display()))?;
+            Some(w)
+        }
+        None => None,
+    };
+    let mut summary = SummaryBuilder::new(
+        plan.robot.model.joint_names(),
+        plan.dt(),
+        plan.scenario.controller.tc,
+    );
+    let start = Instant::now();
+    let result = in_process::run(&plan, |r| {
+        summary.add(r);
+        match csv.as_mut() {
+            Some(w) => csv_out::write_row(w, r),
+            None => Ok(()),
+        }
+    });
+    let wall = start.elapsed().as_secs_f64();
+    // Keep what was written even if the loop failed part-way.
+    if let (Some(mut w), Some(path)) = (csv, &args.csv) {
+        w.flush()
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    result.with_context(|| format!("running {}", plan.source))?;
+    print_report(&Report::from_sim(&plan, summary.finish(), wall), args.json)?;
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,150 @@
+//! The launcher's validated plan, cut into what each node needs: the one
+//! typed path from `testbed run` to its processes (written as JSON by
+//! [`wire::write_config`], read back by the node with the same type).
+
+use std::path::{Path, PathBuf};
+
+use controller::node::ControllerNodeConfig;
+use logger::RunMetadata;
+use logger::node::LoggerNodeConfig;
+use plant_rapier::node::PlantNodeConfig;
+use scenario::Plan;
+use trajectory::node::TrajectoryNodeConfig;
+use wire::{ConfigError, NodeKind, write_config};
+
+use crate::mode::Mode;
+
+/// The plant's part of `plan`.
+pub fn plant(plan: &Plan) -> PlantNodeConfig {
+    let s = &plan.scenario;
+    PlantNodeConfig {
+        robot: plan.robot.label(),
+        urdf: plan.robot.urdf.clone(),
+        plant: s.plant.clone(),
+        seed: s.seed,
+        period_ns: plan.period_ns,
+        steps: plan.steps,
+        initial_q: s.initial.q.clone(),
+        initial_qd: s.initial.qd.clone(),
+    }
+}
+
+/// The controller's part: gains and sizes only, never the model.
+pub fn controller(plan: &Plan) -> ControllerNodeConfig {
+    ControllerNodeConfig {
+        params: plan.scenario.controller.clone(),
+        dof: plan.robot.model.dof(),
+        period_ns: plan.period_ns,
+    }
+}
+
+/// The trajectory's part.
+pub fn trajectory(plan: &Plan) -> TrajectoryNodeConfig {
+    let m = &plan.robot.model;
+    TrajectoryNodeConfig {
+        reference: plan.scenario.reference.clone(),
+        envelope: plan.scenario.envelope.clone(),
+        limits: m.actuated.iter().map(|&j| m.joints[j].limits).collect(),
+        joint_names: m.joint_names(),
+        period_ns: plan.period_ns,
+        reference_period_ns: plan.reference_period_ns,
+        steps: plan.steps,
+    }
+}
+
+/// The logger's part: where to write and what the log says about the run.
+pub fn logger(plan: &Plan, mode: Mode, out: &Path, toml: &str) -> LoggerNodeConfig {
+    LoggerNodeConfig {
+        out: out.to_path_buf(),
+        metadata: metadata(plan, mode, out, toml),
+        urdf: plan.robot.urdf.clone(),
+    }
+}
+
+/// The `testbed.run` record of a run of `plan` logged to `out`.
+pub fn metadata(plan: &Plan, mode: Mode, out: &Path, toml: &str) -> RunMetadata {
+    let m = &plan.robot.model;
+    let n = m.dof();
+    let gains = |g: &controller::Gain| format!("{:?}", g.resolve("gain", n).unwrap_or_default());
+    let (locked, mimic) = joint_roles(plan);
+    RunMetadata {
+        run_id: out
+            .parent()
+            .and_then(|p| p.file_name())
+            .map_or_else(String::new, |n| n.to_string_lossy().to_string()),
+        mode: mode.as_str().to_string(),
+        rate_hz: plan.scenario.rate_hz,
+        scenario_toml: toml.to_string(),
+        scenario_source: plan.source.clone(),
+        robot: plan.robot.label(),
+        joint_names: m.joint_names(),
+        seed: plan.scenario.seed,
+        plant_effects: plan
+            .scenario
+            .plant
+            .configured_effects()
+            .names()
+            .into_iter()
+            .map(String::from)
+            .collect(),
+        k1: gains(&plan.scenario.controller.k1),
+        k2: gains(&plan.scenario.controller.k2),
+        locked_joints: locked,
+        mimic_joints: mimic,
+        urdf_dynamics: plan.scenario.plant.urdf_dynamics,
+        start_time_unix_ns: 0,
+    }
+}
+
+/// The locked and the mimic joints, as the log's metadata writes them.
+fn joint_roles(plan: &Plan) -> (String, String) {
+    let m = &plan.robot.model;
+    let locked = m
+        .locked
+        .iter()
+        .map(|l| match &l.follows {
+            Some(f) => format!("{}={} (mimics {f})", l.name, l.position),
+            None => format!("{}={}", l.name, l.position),
+        })
+        .collect::<Vec<_>>()
+        .join(",");
+    let mimic = m
+        .mimic
+        .iter()
+        .map(|c| {
+            format!(
+                "{}={}*{}+{}",
+                m.joints[c.joint].name, c.multiplier, m.joints[m.actuated[c.leader]].name, c.offset
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(",");
+    (locked, mimic)
+}
+
+/// Writes every node's config under `dir` (`<dir>/<node>.json`) and
+/// returns the paths, in [`NodeKind::ALL`] order.
+pub fn write_all(
+    dir: &Path,
+    plan: &Plan,
+    mode: Mode,
+    log: &Path,
+    toml: &str,
+) -> Result<Vec<(NodeKind, PathBuf)>, ConfigError> {
+    std::fs::create_dir_all(dir).map_err(|cause| ConfigError::Io {
+        path: dir.display().to_string(),
+        cause,
+    })?;
+    let mut out = Vec::new();
+    for kind in NodeKind::ALL {
+        let path = dir.join(format!("{}.json", kind.name()));
+        match kind {
+            NodeKind::Plant => write_config(&path, &plant(plan))?,
+            NodeKind::Controller => write_config(&path, &controller(plan))?,
+            NodeKind::Trajectory => write_config(&path, &trajectory(plan))?,
+            NodeKind::Logger => write_config(&path, &logger(plan, mode, log, toml))?,
+        }
+        out.push((kind, path));
+    }
+    Ok(out)
+}

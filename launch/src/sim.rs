@@ -1,0 +1,93 @@
+//! `testbed sim`: the run in one process. The plant, trajectory and
+//! controller step machines are called in order with the same messages the
+//! nodes exchange, and the step records come from the same assembler that
+//! reads a multi-process run's log: so lockstep reproduces this bit for bit.
+
+use controller::{ControllerError, ControllerMachine};
+use plant_rapier::PlantError;
+use scenario::Plan;
+use trajectory::TrajectoryMachine;
+
+use crate::assemble::RecordAssembler;
+use crate::record::StepRecord;
+
+/// Why the loop stopped early.
+#[derive(Debug, thiserror::Error)]
+pub enum LoopError {
+    /// The plant could not be built or stepped.
+    #[error("plant ({robot}): {cause}")]
+    Plant {
+        /// The robot's label.
+        robot: String,
+        /// The cause.
+        cause: PlantError,
+    },
+    /// The controller could not be built.
+    #[error("controller: {0}")]
+    Controller(#[from] ControllerError),
+    /// The step consumer failed (e.g. the CSV file could not be written).
+    #[error("writing step {step}: {cause}")]
+    Sink {
+        /// The step being written.
+        step: u64,
+        /// The cause.
+        cause: std::io::Error,
+    },
+}
+
+/// Wall time of each plant and controller step, ns (for benchmarks).
+#[derive(Debug, Default, Clone)]
+pub struct StepCosts {
+    /// One entry per plant step.
+    pub plant_ns: Vec<u64>,
+    /// One entry per controller step.
+    pub controller_ns: Vec<u64>,
+}
+
+/// Runs `plan` to the end, handing every step to `on_step`.
+pub fn run(
+    plan: &Plan,
+    on_step: impl FnMut(&StepRecord<'_>) -> std::io::Result<()>,
+) -> Result<(), LoopError> {
+    run_measured(plan, None, on_step)
+}
+
+/// [`run`], also timing every plant and controller step into `costs`.
+pub fn run_measured(
+    plan: &Plan,
+    mut costs: Option<&mut StepCosts>,
+    mut on_step: impl FnMut(&StepRecord<'_>) -> std::io::Result<()>,
+) -> Result<(), LoopError> {
+    let plant_err = |cause| LoopError::Plant {
+        robot: plan.robot.label(),
+        cause,
+    };
+    let mut plant = crate::node::configs::plant(plan)
+        .machine()
+        .map_err(plant_err)?;
+    let n = plant.dof();
+    let mut controller =
+        ControllerMachine::new(plan.scenario.controller.clone(), n, plan.period_ns)?;
+    let mut reference = TrajectoryMachine::new(plan.reference.clone(), plan.reference_period_ns);
+    let mut records = RecordAssembler::new(n, plan.dt(), plan.steps);
+    let mut state = plant.state(0, 0);
+    for k in 0..plan.steps {
+        let r = reference.sample(reference.index_at(state.header.t_ns), 0);
+        let t0 = std::time::Instant::now();
+        let (command, diagnostics) = controller.step(&state, Some(&r));
+        let t1 = std::time::Instant::now();
+        plant.step(Some(&command)).map_err(plant_err)?;
+        if let Some(c) = costs.as_mut() {
+            c.controller_ns.push((t1 - t0).as_nanos() as u64);
+            c.plant_ns.push(t1.elapsed().as_nanos() as u64);
+        }
+        records.push_state(state);
+        records.push_diag(diagnostics);
+        state = plant.state(k + 1, 0);
+        records.push_state(state);
+        records
+            .emit(&mut on_step)
+            .map_err(|cause| LoopError::Sink { step: k, cause })?;
+    }
+    Ok(())
+}

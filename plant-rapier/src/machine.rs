@@ -1,0 +1,116 @@
+//! The plant's step machine: command → state, in wire messages. The plant
+//! node, `testbed sim` and the benchmarks all drive this one machine, so a
+//! lockstep run and an in-process one compute the same bits.
+
+use wire::{Command, Header, JointState, MAX_DOF, STATE_FINAL, joints};
+
+use crate::{ArmModel, PlantConfig, PlantError, Rig};
+
+/// The rig stepped a period at a time, its states as [`JointState`]s.
+#[derive(Debug)]
+pub struct PlantMachine {
+    rig: Rig,
+    n: usize,
+    period_ns: u64,
+    steps: u64,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    q_meas: Vec<f64>,
+    qd_meas: Vec<f64>,
+    /// Deadline misses so far (the real-time node counts them).
+    pub misses: u64,
+}
+
+impl PlantMachine {
+    /// The rig for `model` at `q0`, `qd0`, stepping periods of `period_ns`
+    /// for `steps` steps.
+    pub fn new(
+        model: &ArmModel,
+        config: &PlantConfig,
+        seed: u64,
+        period_ns: u64,
+        steps: u64,
+        (q0, qd0): (&[f64], &[f64]),
+    ) -> Result<Self, PlantError> {
+        let mut rig = Rig::new(model, config, seed, period_ns)?;
+        rig.set_state(q0, qd0)?;
+        let n = rig.dof();
+        Ok(Self {
+            rig,
+            n,
+            period_ns,
+            steps,
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            q_meas: vec![0.0; n],
+            qd_meas: vec![0.0; n],
+            misses: 0,
+        })
+    }
+
+    /// Number of controlled joints.
+    pub fn dof(&self) -> usize {
+        self.n
+    }
+
+    /// Control period, ns.
+    pub fn period_ns(&self) -> u64 {
+        self.period_ns
+    }
+
+    /// Steps in the run.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// State k as published, stamped `wall_ns`: the true state, the sensors'
+    /// reading (drawn here, once per state) and the effects of the period
+    /// that led to it. State `steps` is flagged final.
+    pub fn state(&mut self, k: u64, wall_ns: u64) -> JointState {
+        self.rig.true_state_into(&mut self.q, &mut self.qd);
+        self.rig.measure_into(&mut self.q_meas, &mut self.qd_meas);
+        let first = k == 0;
+        JointState {
+            header: Header {
+                seq: k,
+                t_ns: k * self.period_ns,
+                wall_ns,
+            },
+            dof: self.n as u32,
+            flags: if k == self.steps { STATE_FINAL } else { 0 },
+            q: joints(&self.q),
+            qd: joints(&self.qd),
+            q_measured: joints(&self.q_meas),
+            qd_measured: joints(&self.qd_meas),
+            // What the plant really applied: the command after delay, loss
+            // and saturation.
+            tau_applied: if first {
+                [0.0; MAX_DOF]
+            } else {
+                joints(self.rig.applied_torque())
+            },
+            disturbance: if first {
+                [0.0; MAX_DOF]
+            } else {
+                joints(self.rig.disturbance())
+            },
+            effects: self.rig.effects().0,
+            reserved: 0,
+            deadline_misses: self.misses,
+        }
+    }
+
+    /// Steps one period with `cmd` (None: no new command, the last is held).
+    pub fn step(&mut self, cmd: Option<&Command>) -> Result<(), PlantError> {
+        if let Some(c) = cmd
+            && c.dof as usize != self.n
+        {
+            return Err(PlantError::WrongLength {
+                field: "command tau",
+                expected: self.n,
+                got: c.dof as usize,
+            });
+        }
+        self.rig.step(cmd.map(|c| &c.tau[..self.n]))
+    }
+}

@@ -1,0 +1,155 @@
+//! Replacing a node: a controller written outside the testbed
+//! (`examples/pd_controller.rs`) and a trajectory that publishes another
+//! reference, started by hand where `--external` says.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use crate::util::{testbed, wait_bounded};
+
+/// Starts `testbed run … --external NODE`, waits for the command it prints,
+/// and returns the child and that command's arguments (the caller waits
+/// for the child; a panic here fails the test, and the run's node exits
+/// when its launcher does).
+#[allow(clippy::zombie_processes)]
+fn start_with_external(args: &[&str], node: &str) -> (std::process::Child, Vec<String>) {
+    let mut child = testbed()
+        .args(args)
+        .args(["--external", node])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stderr = child.stderr.take().unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    // A watchdog, not a timing assertion: the line comes within seconds.
+    let deadline = std::time::Instant::now() + Duration::from_secs(120);
+    loop {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        let line = rx
+            .recv_timeout(left)
+            .expect("the launcher printed no command");
+        let prefix = format!("testbed node {node} ");
+        if let Some(rest) = line.trim().strip_prefix(&prefix) {
+            let argv = rest.split_whitespace().map(String::from).collect();
+            std::thread::spawn(move || for _ in rx {});
+            return (child, argv);
+        }
+    }
+}
+
+fn value<'a>(argv: &'a [String], flag: &str) -> &'a str {
+    let i = argv.iter().position(|a| a == flag).unwrap();
+    &argv[i + 1]
+}
+
+fn finish(mut child: std::process::Child) -> serde_json::Value {
+    let status = wait_bounded(&mut child, 240);
+    let mut out = String::new();
+    std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut out).unwrap();
+    assert!(status.success(), "testbed run failed: {out}");
+    serde_json::from_str(&out).unwrap()
+}
+
+/// The example PD controller drives a lockstep run in place of the paper's.
+#[test]
+fn an_example_controller_replaces_the_controller_node() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run, argv) = start_with_external(
+        &[
+            "run",
+            "--mode",
+            "lockstep",
+            "--json",
+            "--duration",
+            "2",
+            "--runs-dir",
+        ]
+        .map(String::from)
+        .iter()
+        .map(String::as_str)
+        .chain([dir.path().to_str().unwrap()])
+        .collect::<Vec<_>>(),
+        "controller",
+    );
+    let mut pd = Command::new(env!("CARGO_BIN_EXE_example-pd-controller"))
+        .args(&argv)
+        .spawn()
+        .unwrap();
+    let s = finish(run);
+    assert!(wait_bounded(&mut pd, 60).success());
+    assert_eq!(s["steps"], 2000, "{s}");
+    assert_eq!(s["finite"], true, "{s}");
+    assert_eq!(s["fault_steps"], 0, "{s}");
+    // The paper's law kicks joint 1 with −107 N m at t = 0; PD gives
+    // −400·0.6 − 40·(0 − 2) = −160 N m.
+    let tau = s["joints"][0]["max_abs_torque"].as_f64().unwrap();
+    assert!(tau > 150.0, "{s}");
+}
+
+/// A trajectory node publishing another reference (the paper's shifted by
+/// 0.2 rad on joint 1) in lockstep and in real time: the run follows it.
+#[test]
+fn a_replacement_trajectory_is_followed_in_lockstep_and_real_time() {
+    for mode in ["lockstep", "realtime"] {
+        let dir = tempfile::tempdir().unwrap();
+        let runs = dir.path().to_str().unwrap().to_string();
+        let (run, argv) = start_with_external(
+            &[
+                "run",
+                "--mode",
+                mode,
+                "--json",
+                "--duration",
+                "3",
+                "--runs-dir",
+                &runs,
+            ],
+            "trajectory",
+        );
+        let config = value(&argv, "--config").to_string();
+        let mut c: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&config).unwrap()).unwrap();
+        let offset = c["reference"]["joints"][0]["offset"].as_f64().unwrap();
+        c["reference"]["joints"][0]["offset"] = (offset + 0.2).into();
+        let other = dir.path().join("other-trajectory.json");
+        std::fs::write(&other, c.to_string()).unwrap();
+        let mut args = argv.clone();
+        let i = args.iter().position(|a| a == "--config").unwrap();
+        args[i + 1] = other.display().to_string();
+        let mut traj = testbed()
+            .arg("node")
+            .arg("trajectory")
+            .args(&args)
+            .spawn()
+            .unwrap();
+        let s = finish(run);
+        assert!(wait_bounded(&mut traj, 60).success());
+        assert_eq!(s["constraint_satisfied_after_tc"], true, "{mode}: {s}");
+        // The log's diagnostics hold the reference the controller used.
+        let log = s["log"].as_str().unwrap();
+        let csv = dir.path().join("r.csv");
+        crate::util::ok(testbed().args(["replay", log, "--csv"]).arg(&csv));
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let mut rows = text.lines();
+        let header: Vec<&str> = rows.next().unwrap().split(',').collect();
+        let col = header.iter().position(|h| *h == "qref0").unwrap();
+        let first: Vec<&str> = rows.next().unwrap().split(',').collect();
+        let qref0: f64 = first[col].parse().unwrap();
+        assert!((qref0 - 0.2).abs() < 1e-12, "{mode}: q_d1(0) = {qref0}");
+        let q_col = header.iter().position(|h| *h == "q0").unwrap();
+        let last: Vec<&str> = text.lines().last().unwrap().split(',').collect();
+        let (q, qr): (f64, f64) = (last[q_col].parse().unwrap(), last[col].parse().unwrap());
+        assert!(
+            (q - qr).abs() < 0.1,
+            "{mode}: q {q} does not follow q_d {qr}"
+        );
+    }
+}

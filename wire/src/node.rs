@@ -1,0 +1,196 @@
+//! The node protocol every process of a run follows, whatever its role:
+//! create its ports, report READY on the status topic, wait for START
+//! (which carries the wall-clock epoch of step 0), run, report DONE, and
+//! exit when the launcher sends STOP. A node also stops by itself when its
+//! launcher disappears or a SIGINT/SIGTERM arrives.
+
+use std::time::Duration;
+
+use crate::{
+    Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, NODE_DONE, NODE_READY,
+    NODE_RUNNING, NodeKind, NodeStatus, RunPrefix, Topic, TopicPublisher, TopicSubscriber,
+    WireError, monotonic_ns,
+};
+
+/// Timing mode of a multi-process run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// The plant steps on an absolute-deadline grid at the scenario rate,
+    /// holding the latest command; a late command is a deadline miss.
+    Realtime,
+    /// The plant is the clock: it publishes state k and steps only when
+    /// command k has arrived. Deterministic, as fast as the machine allows.
+    Lockstep,
+}
+
+impl Mode {
+    /// The command-line spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Mode::Realtime => "realtime",
+            Mode::Lockstep => "lockstep",
+        }
+    }
+
+    /// What a publisher of this mode does with a full reader: wait
+    /// (lockstep: nothing is lost) or skip it (real time: never wait).
+    pub fn delivery(self) -> Delivery {
+        match self {
+            Mode::Lockstep => Delivery::Lossless,
+            Mode::Realtime => Delivery::DropWhenFull,
+        }
+    }
+}
+
+impl std::str::FromStr for Mode {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "realtime" => Ok(Mode::Realtime),
+            "lockstep" => Ok(Mode::Lockstep),
+            other => Err(format!("'{other}' is not a mode: realtime or lockstep")),
+        }
+    }
+}
+
+/// Why a node stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum NodeError {
+    /// The bus failed.
+    #[error(transparent)]
+    Wire(#[from] WireError),
+    /// The launcher is gone.
+    #[error("the launcher (pid {0}) is gone")]
+    ParentGone(u32),
+    /// The launcher sent STOP before the node finished.
+    #[error("stopped by the launcher")]
+    Stopped,
+    /// Something arrived that the protocol does not allow.
+    #[error("{0}")]
+    Protocol(String),
+}
+
+/// One node's link to its run: the bus, and the status and control ports.
+pub struct NodeLink {
+    /// The node's connection to the run's shared memory.
+    pub bus: Bus,
+    kind: NodeKind,
+    status: TopicPublisher<NodeStatus>,
+    control: TopicSubscriber<Control>,
+    parent_pid: Option<u32>,
+    status_seq: u64,
+    stop_seen: bool,
+}
+
+impl NodeLink {
+    /// Connects node `kind` to the run under `prefix`; with `parent_pid`
+    /// the node stops once that process (its launcher) is gone.
+    pub fn connect(
+        kind: NodeKind,
+        prefix: &RunPrefix,
+        parent_pid: Option<u32>,
+    ) -> Result<Self, WireError> {
+        let bus = Bus::new(prefix, kind.name())?;
+        let status = bus.publisher(Topic::Status, Delivery::DropWhenFull)?;
+        let control = bus.subscriber(Topic::Control)?;
+        Ok(Self {
+            bus,
+            kind,
+            status,
+            control,
+            parent_pid,
+            status_seq: 0,
+            stop_seen: false,
+        })
+    }
+
+    /// Publishes this node's state.
+    pub fn report(&mut self, state: u32, step: u64) -> Result<(), NodeError> {
+        let msg = NodeStatus {
+            header: Header {
+                seq: self.status_seq,
+                t_ns: 0,
+                wall_ns: monotonic_ns(),
+            },
+            node: self.kind as u32,
+            state,
+            pid: std::process::id(),
+            reserved: 0,
+            step,
+        };
+        self.status_seq += 1;
+        self.status.send(msg)?;
+        Ok(())
+    }
+
+    /// Errors if the launcher is gone, a termination signal arrived, or
+    /// STOP was received.
+    pub fn check(&mut self) -> Result<(), NodeError> {
+        self.bus.wait(Duration::ZERO)?;
+        if let Some(pid) = self.parent_pid
+            && std::os::unix::process::parent_id() != pid
+        {
+            return Err(NodeError::ParentGone(pid));
+        }
+        while let Some(c) = self.control.receive()? {
+            if c.command == CONTROL_STOP {
+                self.stop_seen = true;
+            }
+        }
+        if self.stop_seen {
+            return Err(NodeError::Stopped);
+        }
+        Ok(())
+    }
+
+    /// Reports READY and blocks until START; returns the epoch of step 0.
+    pub fn ready_and_wait_for_start(&mut self) -> Result<u64, NodeError> {
+        self.report(NODE_READY, 0)?;
+        let mut last_report = monotonic_ns();
+        loop {
+            self.control.wait_event(Duration::from_millis(50))?;
+            self.control.drain_events()?;
+            if let Some(c) = self.control.receive()? {
+                match c.command {
+                    CONTROL_START => {
+                        self.report(NODE_RUNNING, 0)?;
+                        return Ok(c.epoch_wall_ns);
+                    }
+                    CONTROL_STOP => return Err(NodeError::Stopped),
+                    other => {
+                        return Err(NodeError::Protocol(format!(
+                            "unknown control command {other}"
+                        )));
+                    }
+                }
+            }
+            self.check()?;
+            // READY again now and then, in case the launcher connected late.
+            if monotonic_ns() - last_report > 500_000_000 {
+                self.report(NODE_READY, 0)?;
+                last_report = monotonic_ns();
+            }
+        }
+    }
+
+    /// Reports DONE and waits for STOP (or the launcher's disappearance).
+    pub fn done_and_wait_for_stop(&mut self, steps: u64) -> Result<(), NodeError> {
+        self.report(NODE_DONE, steps)?;
+        loop {
+            match self.check() {
+                Err(NodeError::Stopped) => return Ok(()),
+                Err(e) => return Err(e),
+                Ok(()) => {}
+            }
+            self.control.wait_event(Duration::from_millis(50))?;
+            self.control.drain_events()?;
+        }
+    }
+}
+
+/// Seconds from integer nanoseconds: the one conversion every process
+/// uses, so in-process and multi-process runs compute the same bits.
+pub fn ns_to_s(ns: u64) -> f64 {
+    ns as f64 / 1e9
+}
