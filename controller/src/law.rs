@@ -122,7 +122,24 @@ impl Controller {
             self.publish_fault(out, fault);
             return;
         }
+        self.errors_and_barrier(input, out);
+        self.torque(input, out);
+        self.critic_signals(input, out);
+        let finite_out = out.tau.iter().all(|x| x.is_finite())
+            && out.r.is_finite()
+            && out.delta.is_finite()
+            && self.lambda.iter().all(|x| x.is_finite());
+        if !finite_out {
+            self.publish_fault(out, Fault::NonFiniteOutput);
+            return;
+        }
 
+        self.advance_weights(dt, out);
+    }
+
+    /// γ, Z1, Z1γ, the barrier's D, α, Z2 and the barrier torque (SPEC §4–§7).
+    fn errors_and_barrier(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
+        let n = self.n;
         let p = &self.p;
         let (gamma, gamma_dot) = shifting(input.t, p.tc);
         out.gamma = gamma;
@@ -177,7 +194,11 @@ impl Controller {
             out.z2[i] = input.qd[i] - out.alpha[i];
             out.tau_barrier[i] = -gamma * out.z1g[i] / (p.beta * d);
         }
+    }
 
+    /// The networks' features and τ = actor − K2 Z2 + barrier (SPEC §7, §8).
+    fn torque(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
+        let n = self.n;
         // Actor input Z_a = [q; q̇; Z1; Z2], critic input Z_c = [Z1; Z2].
         self.za[..n].copy_from_slice(input.q);
         self.za[n..2 * n].copy_from_slice(input.qd);
@@ -198,8 +219,11 @@ impl Controller {
         }
         out.wc_norm = dot(&self.wc, &self.wc).sqrt();
         out.j_hat = dot(&self.wc, &self.sc);
+    }
 
-        // Critic signals: r, Ż_c, Λ, δ (SPEC §8).
+    /// r, Ż_c, Λ and δ of the critic (SPEC §8).
+    fn critic_signals(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
+        let p = &self.p;
         out.r = p.q_weight * dot(&self.zc, &self.zc) + p.r_weight * dot(&out.tau, &out.tau);
         match self.prev_t {
             Some(t0) if input.t > t0 => {
@@ -216,17 +240,13 @@ impl Controller {
             *l -= s / p.psi;
         }
         out.delta = out.r + dot(&self.wc, &self.lambda);
+    }
 
-        let finite_out = out.tau.iter().all(|x| x.is_finite())
-            && out.r.is_finite()
-            && out.delta.is_finite()
-            && self.lambda.iter().all(|x| x.is_finite());
-        if !finite_out {
-            self.publish_fault(out, Fault::NonFiniteOutput);
-            return;
-        }
-
-        // Advance both weight sets over dt with this step's signals held.
+    /// Both weight sets over `dt` with this step's signals held (SPEC §9).
+    fn advance_weights(&mut self, dt: f64, out: &Diagnostics) {
+        let n = self.n;
+        let p = &self.p;
+        let nn = self.sa.len();
         let advance: fn(&mut [f64], &[f64], f64, f64, f64, f64) = match p.integrator {
             Integrator::Exact => advance_exact,
             Integrator::Euler => advance_euler,
@@ -238,7 +258,7 @@ impl Controller {
             advance(col, &self.sa, c, p.sigma_a, p.eta_a, dt);
         }
         self.prev_zc.copy_from_slice(&self.zc);
-        self.prev_t = Some(input.t);
+        self.prev_t = Some(out.t);
     }
 
     fn publish_fault(&self, out: &mut Diagnostics, fault: Fault) {

@@ -15,7 +15,7 @@ use crate::mode::Mode;
 use crate::run::timing::{TimingStats, TimingSummary};
 use crate::summary::{Summary, SummaryBuilder};
 use crate::verify::Verifier;
-use logger::{LogContents, LogError, LogMessage, read_log};
+use logger::{DecodeError, LogContents, LogError, LogMessage, MessageError, read_log};
 
 /// Why a log could not be analysed.
 #[derive(Debug, thiserror::Error)]
@@ -193,20 +193,88 @@ fn plan_from(contents: &LogContents) -> Result<(Plan, Mode), AnalysisError> {
     Ok((plan, mode))
 }
 
+/// What is computed from a log's messages while it is read.
+struct Analyser<'a, 'o> {
+    plan: &'a Plan,
+    n: usize,
+    assembler: RecordAssembler,
+    summary: SummaryBuilder,
+    timing: TimingStats,
+    series: Option<Series>,
+    verifier: Option<Verifier>,
+    csv: Option<&'o mut dyn Write>,
+    wall: (u64, u64),
+}
+
+impl Analyser<'_, '_> {
+    fn on_message(&mut self, topic: &str, v: &serde_json::Value) -> Result<(), MessageError> {
+        match topic {
+            t if t == JointState::TOPIC => {
+                let s = JointState::parse(v)?;
+                check_dof(s.dof, self.n)?;
+                self.wall = (
+                    self.wall.0.min(s.header.wall_ns),
+                    self.wall.1.max(s.header.wall_ns),
+                );
+                if let Some(ver) = self.verifier.as_mut() {
+                    ver.push_state(s);
+                }
+                self.assembler.push_state(s);
+            }
+            t if t == ControllerDiagnostics::TOPIC => {
+                let d = ControllerDiagnostics::parse(v)?;
+                check_dof(d.dof, self.n)?;
+                if let Some(ver) = self.verifier.as_mut() {
+                    ver.push_diag(d);
+                }
+                self.assembler.push_diag(d);
+            }
+            t if t == Command::TOPIC => {
+                let c = Command::parse(v)?;
+                if let Some(ver) = self.verifier.as_mut() {
+                    ver.push_command(c);
+                }
+            }
+            t if t == Timing::TOPIC => self.on_timing(&Timing::parse(v)?),
+            t if t == ReferenceSample::TOPIC => {
+                ReferenceSample::parse(v)?;
+            }
+            _ => {}
+        }
+        let (summary, series, csv) = (&mut self.summary, &mut self.series, &mut self.csv);
+        self.assembler.emit(|r| {
+            summary.add(r);
+            if let Some(s) = series.as_mut() {
+                s.add(r);
+            }
+            match csv.as_mut() {
+                Some(w) => csv_out::write_row(w, r),
+                None => Ok(()),
+            }
+        })?;
+        Ok(())
+    }
+
+    fn on_timing(&mut self, t: &Timing) {
+        self.timing.add(t);
+        if let Some(s) = self.series.as_mut() {
+            if t.period_ns > 0 {
+                s.jitter_us
+                    .push((t.period_ns - self.plan.period_ns as i64).unsigned_abs() as f64 / 1e3);
+            }
+            if t.round_trip_ns >= 0 {
+                s.round_trip_us.push(t.round_trip_ns as f64 / 1e3);
+            }
+        }
+    }
+}
+
 /// Reads the log at `path` and computes everything from it.
-pub fn analyse(path: &Path, mut opts: AnalyseOptions<'_>) -> Result<LogAnalysis, AnalysisError> {
+pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, AnalysisError> {
     let head = read_log(path, None)?;
     let (plan, mode) = plan_from(&head)?;
     let n = plan.robot.model.dof();
-    let mut assembler = RecordAssembler::new(n, plan.dt(), plan.steps);
-    let mut summary = SummaryBuilder::new(
-        plan.robot.model.joint_names(),
-        plan.dt(),
-        plan.scenario.controller.tc,
-    );
-    let mut timing = TimingStats::new(plan.period_ns);
-    let mut series = opts.series.then(|| Series::new(n));
-    let mut verifier = if opts.verify {
+    let verifier = if opts.verify {
         Some(
             Verifier::new(plan.scenario.controller.clone(), n, plan.period_ns)
                 .map_err(|e| meta_err(path, e.to_string()))?,
@@ -214,108 +282,61 @@ pub fn analyse(path: &Path, mut opts: AnalyseOptions<'_>) -> Result<LogAnalysis,
     } else {
         None
     };
-    if let Some((p, w)) = opts.csv.as_mut() {
-        writeln!(w, "{}", csv_out::header(n)).map_err(|cause| AnalysisError::Output {
-            path: p.to_string(),
-            cause,
-        })?;
-    }
-    let mut csv_error: Option<std::io::Error> = None;
-    let mut wall = (u64::MAX, 0u64);
-    let mut on_message = |topic: &str, v: &serde_json::Value| -> Result<(), String> {
-        match topic {
-            t if t == JointState::TOPIC => {
-                let s = JointState::parse(v)?;
-                check_dof(s.dof, n)?;
-                wall = (wall.0.min(s.header.wall_ns), wall.1.max(s.header.wall_ns));
-                if let Some(ver) = verifier.as_mut() {
-                    ver.push_state(s);
-                }
-                assembler.push_state(s);
-            }
-            t if t == ControllerDiagnostics::TOPIC => {
-                let d = ControllerDiagnostics::parse(v)?;
-                check_dof(d.dof, n)?;
-                if let Some(ver) = verifier.as_mut() {
-                    ver.push_diag(d);
-                }
-                assembler.push_diag(d);
-            }
-            t if t == Command::TOPIC => {
-                let c = Command::parse(v)?;
-                if let Some(ver) = verifier.as_mut() {
-                    ver.push_command(c);
-                }
-            }
-            t if t == Timing::TOPIC => {
-                let t = Timing::parse(v)?;
-                timing.add(&t);
-                if let Some(s) = series.as_mut() {
-                    if t.period_ns > 0 {
-                        s.jitter_us.push(
-                            (t.period_ns - plan.period_ns as i64).unsigned_abs() as f64 / 1e3,
-                        );
-                    }
-                    if t.round_trip_ns >= 0 {
-                        s.round_trip_us.push(t.round_trip_ns as f64 / 1e3);
-                    }
-                }
-            }
-            t if t == ReferenceSample::TOPIC => {
-                ReferenceSample::parse(v)?;
-            }
-            _ => {}
-        }
-        let emitted = assembler.emit(|r| {
-            summary.add(r);
-            if let Some(s) = series.as_mut() {
-                s.add(r);
-            }
-            match opts.csv.as_mut() {
-                Some((_, w)) => csv_out::write_row(w, r),
-                None => Ok(()),
-            }
-        });
-        if let Err(e) = emitted {
-            csv_error = Some(e);
-            return Err("cannot write the CSV".into());
-        }
-        Ok(())
+    let (csv_path, mut csv) = match opts.csv {
+        Some((p, w)) => (p.to_string(), Some(w)),
+        None => (String::new(), None),
     };
-    let contents = read_log(path, Some(&mut on_message))?;
-    if let (Some(cause), Some((p, _))) = (csv_error, opts.csv.as_ref()) {
-        return Err(AnalysisError::Output {
-            path: p.to_string(),
-            cause,
-        });
+    let out_err = |cause| AnalysisError::Output {
+        path: csv_path.clone(),
+        cause,
+    };
+    if let Some(w) = csv.as_mut() {
+        writeln!(w, "{}", csv_out::header(n)).map_err(out_err)?;
     }
-    if let Some((p, w)) = opts.csv.as_mut() {
-        w.flush().map_err(|cause| AnalysisError::Output {
-            path: p.to_string(),
-            cause,
-        })?;
+    let mut a = Analyser {
+        plan: &plan,
+        n,
+        assembler: RecordAssembler::new(n, plan.dt(), plan.steps),
+        summary: SummaryBuilder::new(
+            plan.robot.model.joint_names(),
+            plan.dt(),
+            plan.scenario.controller.tc,
+        ),
+        timing: TimingStats::new(plan.period_ns),
+        series: opts.series.then(|| Series::new(n)),
+        verifier,
+        csv,
+        wall: (u64::MAX, 0),
+    };
+    let contents = match read_log(path, Some(&mut |t, v| a.on_message(t, v))) {
+        Err(LogError::Sink { cause, .. }) => return Err(out_err(cause)),
+        other => other?,
+    };
+    if let Some(w) = a.csv.as_mut() {
+        w.flush().map_err(out_err)?;
     }
-    let rate_hz = plan.scenario.rate_hz;
-    let wall_span_s = wall.1.saturating_sub(wall.0) as f64 / 1e9;
+    let wall = a.wall;
     Ok(LogAnalysis {
-        wall_span_s,
+        wall_span_s: wall.1.saturating_sub(wall.0) as f64 / 1e9,
         wall_window_ns: wall,
         expected_rows: plan.steps,
-        missing_rows: assembler.missing(),
-        summary: summary.finish(),
-        timing: timing.finish(mode, rate_hz),
-        verify: verifier.map(|v| (v.max_abs_torque_diff, v.steps)),
-        series,
+        missing_rows: a.assembler.missing(),
+        summary: a.summary.finish(),
+        timing: a.timing.finish(mode, plan.scenario.rate_hz),
+        verify: a.verifier.map(|v| (v.max_abs_torque_diff, v.steps)),
+        series: a.series,
         contents,
         plan,
         mode,
     })
 }
 
-fn check_dof(dof: u32, n: usize) -> Result<(), String> {
+fn check_dof(dof: u32, n: usize) -> Result<(), DecodeError> {
     if dof as usize == n {
         Ok(())
     } else {
-        Err(format!("dof {dof} but the logged robot has {n} joints"))
+        Err(DecodeError(format!(
+            "dof {dof} but the logged robot has {n} joints"
+        )))
     }
 }

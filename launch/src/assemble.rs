@@ -70,11 +70,6 @@ impl RecordAssembler {
         }
     }
 
-    /// The next row to be emitted (= rows emitted so far, plus those given up).
-    pub fn next_step(&self) -> u64 {
-        self.next
-    }
-
     /// Rows given up because their data never came.
     pub fn missing(&self) -> u64 {
         self.missing

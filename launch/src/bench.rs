@@ -278,20 +278,7 @@ fn bench_arm(
     progress: &mut impl FnMut(&str),
 ) -> Result<ArmBench, BenchError> {
     let sim_s = plan.steps as f64 * plan.dt();
-    let mut walls = Vec::new();
-    let mut costs = StepCosts::default();
-    for i in 0..opts.repeats {
-        progress(&format!(
-            "{}: in process, run {}",
-            plan.scenario.name,
-            i + 1
-        ));
-        let start = Instant::now();
-        let keep = if i == 0 { Some(&mut costs) } else { None };
-        sim::run_measured(plan, keep, |_| Ok(()))?;
-        walls.push(start.elapsed().as_secs_f64());
-    }
-    let inprocess = median(walls);
+    let (inprocess, costs) = in_process(plan, opts, progress)?;
     let mut lock_walls = Vec::new();
     let mut rss = vec![(
         "in-process loop".to_string(),
@@ -317,19 +304,7 @@ fn bench_arm(
     let mut rt_plan = plan.clone();
     rt_plan.steps = (opts.realtime_s * plan.scenario.rate_hz).round() as u64;
     rt_plan.scenario.duration_s = opts.realtime_s;
-    // The loop's CPU, one priority level above the controller: the loop
-    // never delays the floor's wake-ups (the floor may delay the loop by
-    // the microsecond a wake-up takes, which counts against the testbed).
-    let placement = if opts.realtime_setup {
-        let cpus = placement::cpu_count();
-        let controller = placement::for_node(NodeKind::Controller, Mode::Realtime, cpus);
-        Placement {
-            fifo: controller.fifo.map(|p| p + 1),
-            ..controller
-        }
-    } else {
-        Placement::default()
-    };
+    let placement = floor_placement(opts);
     // Start-up and shut-down take a few seconds at most; the probe keeps
     // running until the run is over, and only the run's window counts.
     let probe = FloorProbe::start(plan.scenario.rate_hz, opts.realtime_s + 60.0, &placement);
@@ -362,6 +337,45 @@ fn bench_arm(
         timer_floor: floor,
         peak_rss_kb: rss,
     })
+}
+
+/// Where the timer floor runs: the loop's CPU, one priority level above the
+/// controller, so the loop never delays the floor's wake-ups (the floor may
+/// delay the loop by the microsecond a wake-up takes, which counts against
+/// the testbed).
+fn floor_placement(opts: &BenchOptions) -> Placement {
+    if opts.realtime_setup {
+        let cpus = placement::cpu_count();
+        let controller = placement::for_node(NodeKind::Controller, Mode::Realtime, cpus);
+        Placement {
+            fifo: controller.fifo.map(|p| p + 1),
+            ..controller
+        }
+    } else {
+        Placement::default()
+    }
+}
+
+/// Median wall time of the in-process loop and the step costs of its first run.
+fn in_process(
+    plan: &Plan,
+    opts: &BenchOptions,
+    progress: &mut impl FnMut(&str),
+) -> Result<(f64, StepCosts), BenchError> {
+    let mut walls = Vec::new();
+    let mut costs = StepCosts::default();
+    for i in 0..opts.repeats {
+        progress(&format!(
+            "{}: in process, run {}",
+            plan.scenario.name,
+            i + 1
+        ));
+        let start = Instant::now();
+        let keep = if i == 0 { Some(&mut costs) } else { None };
+        sim::run_measured(plan, keep, |_| Ok(()))?;
+        walls.push(start.elapsed().as_secs_f64());
+    }
+    Ok((median(walls), costs))
 }
 
 /// Runs the whole bench; `progress` hears what is being measured.

@@ -182,15 +182,29 @@ fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
     let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
     let names = plan.robot.model.joint_names();
     let tc = plan.scenario.controller.tc;
-    let n = names.len();
-    let line = |label: String, y, i: usize, dashed| Line {
+    positions(dir, s, &names, tc)?;
+    velocities(dir, s, &names, tc)?;
+    errors(dir, s, &names, tc)?;
+    weights_and_torques(dir, s, &names, tc)?;
+    timing_figure(dir, s)?;
+    Ok(6)
+}
+
+/// One line of a panel in the `i`-th colour.
+fn line(label: String, y: &[f64], i: usize, dashed: bool) -> Line<'_> {
+    Line {
         label,
         y,
         color: COLORS[i % COLORS.len()],
         dashed,
-    };
-    let red = RGBColor(214, 39, 40);
+    }
+}
 
+const RED: RGBColor = RGBColor(214, 39, 40);
+
+/// Fig. 1: q with q_d ± k_c.
+fn positions(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), String> {
+    let n = names.len();
     let mut upper = Vec::new();
     let mut lower = Vec::new();
     for i in 0..n {
@@ -207,13 +221,13 @@ fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
                 Line {
                     label: "q_d ± k_c".into(),
                     y: &upper[i],
-                    color: red,
+                    color: RED,
                     dashed: true,
                 },
                 Line {
                     label: String::new(),
                     y: &lower[i],
-                    color: red,
+                    color: RED,
                     dashed: true,
                 },
             ],
@@ -228,6 +242,12 @@ fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
         Some(tc),
     )?;
 
+    Ok(())
+}
+
+/// Fig. 2: q̇ and q̇_d.
+fn velocities(dir: &Path, s: &Series, names: &[String], _tc: f64) -> Result<(), String> {
+    let n = names.len();
     let velocities: Vec<Panel<'_>> = (0..n)
         .map(|i| Panel {
             title: format!("{}: velocity", names[i]),
@@ -246,7 +266,12 @@ fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
         &velocities,
         None,
     )?;
+    Ok(())
+}
 
+/// Fig. 3: Z1 with ± k_c.
+fn errors(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), String> {
+    let n = names.len();
     let neg_kc: Vec<Vec<f64>> =
         s.kc.iter()
             .map(|k| k.iter().map(|x| -x).collect())
@@ -260,13 +285,13 @@ fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
                 Line {
                     label: "± k_c".into(),
                     y: &s.kc[i],
-                    color: red,
+                    color: RED,
                     dashed: true,
                 },
                 Line {
                     label: String::new(),
                     y: &neg_kc[i],
-                    color: red,
+                    color: RED,
                     dashed: true,
                 },
             ],
@@ -280,7 +305,12 @@ fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
         &errors,
         Some(tc),
     )?;
+    Ok(())
+}
 
+/// Figs. 4 and 5: the actor's weight norms and the torques.
+fn weights_and_torques(dir: &Path, s: &Series, names: &[String], _tc: f64) -> Result<(), String> {
+    let n = names.len();
     let weights = vec![Panel {
         title: "actor weight norms".into(),
         y_label: "‖Ŵa‖",
@@ -305,9 +335,7 @@ fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
             .collect(),
     }];
     save(dir, "fig5_torques", "Input torques", &s.t, &torques, None)?;
-
-    timing_figure(dir, s)?;
-    Ok(6)
+    Ok(())
 }
 
 /// Histograms of period jitter and round trip.

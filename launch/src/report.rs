@@ -167,8 +167,20 @@ fn percentiles(p: &Percentiles) -> String {
 
 /// A readable summary.
 pub fn table(r: &Report) -> String {
-    let s = &r.summary;
     let mut out = String::new();
+    heading(&mut out, r);
+    joint_table(&mut out, &r.summary);
+    verdicts(&mut out, &r.summary);
+    if let Some(t) = &r.timing {
+        timing_lines(&mut out, t);
+    }
+    run_notes(&mut out, r);
+    out
+}
+
+/// The run, its length, and the gains and joint roles.
+fn heading(out: &mut String, r: &Report) {
+    let s = &r.summary;
     let _ = writeln!(
         out,
         "scenario {} ({}), robot {}, {} joints",
@@ -207,6 +219,9 @@ pub fn table(r: &Report) -> String {
         );
     }
     let _ = writeln!(out);
+}
+
+fn joint_table(out: &mut String, s: &Summary) {
     let _ = writeln!(
         out,
         "{:<12} {:>12} {:>12} {:>12} {:>12} {:>12} {:>12} {:>10} {:>10}",
@@ -235,6 +250,9 @@ pub fn table(r: &Report) -> String {
             j.max_actor_weight_norm
         );
     }
+}
+
+fn verdicts(out: &mut String, s: &Summary) {
     let ends_before_tc = s.joints.iter().all(|j| j.min_margin_after_tc.is_none());
     let verdict = if ends_before_tc {
         "not judged (the run ends before T_c)"
@@ -262,29 +280,33 @@ pub fn table(r: &Report) -> String {
         "plant effects: {active}; saturated {} steps, commands lost {}, held {}",
         e.saturated_steps, e.dropped_commands, e.held_commands
     );
-    if let Some(t) = &r.timing {
-        let _ = writeln!(
-            out,
-            "\ntiming ({} at {} Hz): {} cycles, {} deadline misses, {} wake-ups late by a period",
-            t.mode.as_str(),
-            t.rate_hz,
-            t.cycles,
-            t.deadline_misses,
-            t.late_wakeups
-        );
-        let _ = writeln!(
-            out,
-            "  period jitter us  {}",
-            percentiles(&t.period_jitter_us)
-        );
-        let _ = writeln!(out, "  wake late us      {}", percentiles(&t.wake_late_us));
-        let _ = writeln!(out, "  round trip us     {}", percentiles(&t.round_trip_us));
-        let _ = writeln!(
-            out,
-            "  controller us     {}",
-            percentiles(&t.controller_compute_us)
-        );
-    }
+}
+
+fn timing_lines(out: &mut String, t: &TimingSummary) {
+    let _ = writeln!(
+        out,
+        "\ntiming ({} at {} Hz): {} cycles, {} deadline misses, {} wake-ups late by a period",
+        t.mode.as_str(),
+        t.rate_hz,
+        t.cycles,
+        t.deadline_misses,
+        t.late_wakeups
+    );
+    let _ = writeln!(
+        out,
+        "  period jitter us  {}",
+        percentiles(&t.period_jitter_us)
+    );
+    let _ = writeln!(out, "  wake late us      {}", percentiles(&t.wake_late_us));
+    let _ = writeln!(out, "  round trip us     {}", percentiles(&t.round_trip_us));
+    let _ = writeln!(
+        out,
+        "  controller us     {}",
+        percentiles(&t.controller_compute_us)
+    );
+}
+
+fn run_notes(out: &mut String, r: &Report) {
     if let Some(m) = r.missing_rows.filter(|m| *m > 0) {
         let _ = writeln!(out, "rows lost to dropped samples: {m}");
     }
@@ -300,7 +322,6 @@ pub fn table(r: &Report) -> String {
     if let Some(l) = &r.log {
         let _ = writeln!(out, "log: {l}");
     }
-    out
 }
 
 /// A readable bench report.

@@ -19,8 +19,8 @@ pub mod node;
 mod reader;
 mod writer;
 
-pub use json::{Field, Fields, LogMessage};
-pub use reader::{LogContents, OnMessage, read_log};
+pub use json::{DecodeError, Fields, LogMessage};
+pub use reader::{LogContents, MessageError, OnMessage, read_log};
 pub use writer::{LogWriter, RunMetadata};
 
 /// Name of the metadata record that describes the run.
@@ -59,15 +59,15 @@ pub enum LogError {
         /// The cause.
         cause: serde_json::Error,
     },
-    /// A message's handler failed.
-    #[error("{path}: {topic} message: {reason}")]
-    Message {
+    /// The handler of a message failed while reading.
+    #[error("reading {path} ({topic}): {cause}")]
+    Sink {
         /// The file.
         path: String,
         /// The message's topic.
         topic: String,
-        /// What went wrong.
-        reason: String,
+        /// The cause.
+        cause: std::io::Error,
     },
     /// The file is readable MCAP but not a testbed log.
     #[error("{path}: {reason}")]

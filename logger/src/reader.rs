@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use mcap::read::{ChunkFlattener, Options};
 use mcap::records::Record;
 
-use super::{LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
+use super::{DecodeError, LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
 
 /// What a log holds besides its messages.
 #[derive(Debug, Clone, Default)]
@@ -41,8 +41,21 @@ impl LogContents {
     }
 }
 
+/// Why a message handler stopped reading a log.
+#[derive(Debug, thiserror::Error)]
+pub enum MessageError {
+    /// The message does not decode, or does not fit the run: the log is
+    /// read up to it, and `cut_short` says why.
+    #[error(transparent)]
+    Malformed(#[from] DecodeError),
+    /// The handler itself failed (writing a CSV, say): reading stops with
+    /// this error.
+    #[error(transparent)]
+    Sink(#[from] std::io::Error),
+}
+
 /// Called for every message of a log, in file order.
-pub type OnMessage<'a> = &'a mut dyn FnMut(&str, &serde_json::Value) -> Result<(), String>;
+pub type OnMessage<'a> = &'a mut dyn FnMut(&str, &serde_json::Value) -> Result<(), MessageError>;
 
 /// Reads `path` record by record, calling `on_message(topic, json)` (if
 /// given) for every message in file order. A truncated or unfinished file is
@@ -86,21 +99,11 @@ pub fn read_log(
                 topics.insert(c.id, c.topic);
             }
             Record::Message { header, data } => {
-                let (Some(topic), Some(on_message)) =
-                    (topics.get(&header.channel_id), on_message.as_mut())
-                else {
-                    out.messages += 1;
-                    continue;
-                };
-                let value: serde_json::Value = match serde_json::from_slice(&data) {
-                    Ok(v) => v,
-                    Err(e) => {
-                        out.cut_short = Some(format!("a {topic} message is not JSON ({e})"));
-                        break;
-                    }
-                };
-                if let Err(e) = on_message(topic, &value) {
-                    out.cut_short = Some(format!("a {topic} message is malformed: {e}"));
+                let topic = topics.get(&header.channel_id);
+                if let (Some(topic), Some(handler)) = (topic, on_message.as_mut())
+                    && let Some(why) = deliver(handler, topic, &data, &p)?
+                {
+                    out.cut_short = Some(why);
                     break;
                 }
                 out.messages += 1;
@@ -124,4 +127,27 @@ pub fn read_log(
         out.cut_short = Some("the logger never finished the file (no footer)".into());
     }
     Ok(out)
+}
+
+/// Hands one message to the handler: None when it took it, Some(why) when
+/// the log is to be read no further, an error when the handler failed.
+fn deliver(
+    handler: &mut OnMessage<'_>,
+    topic: &str,
+    data: &[u8],
+    path: &str,
+) -> Result<Option<String>, LogError> {
+    let value: serde_json::Value = match serde_json::from_slice(data) {
+        Ok(v) => v,
+        Err(e) => return Ok(Some(format!("a {topic} message is not JSON ({e})"))),
+    };
+    match handler(topic, &value) {
+        Ok(()) => Ok(None),
+        Err(MessageError::Malformed(e)) => Ok(Some(format!("a {topic} message is malformed: {e}"))),
+        Err(MessageError::Sink(cause)) => Err(LogError::Sink {
+            path: path.to_string(),
+            topic: topic.to_string(),
+            cause,
+        }),
+    }
 }

@@ -306,46 +306,14 @@ impl PlantConfig {
             ));
         }
         if let Some(p) = &self.payload {
-            if p.link.is_empty() {
-                return Err(invalid(
-                    "plant.payload.link",
-                    "\"\"",
-                    "the name of a link of the robot",
-                ));
-            }
-            if !(p.mass.is_finite() && p.mass > 0.0) {
-                return Err(invalid("plant.payload.mass", p.mass, "a finite mass > 0"));
-            }
-            check_finite("plant.payload.offset", &p.offset)?;
-            if !(p.attach_at_s.is_finite() && p.attach_at_s >= 0.0) {
-                return Err(invalid(
-                    "plant.payload.attach_at_s",
-                    p.attach_at_s,
-                    "a finite time ≥ 0",
-                ));
-            }
+            p.validate()?;
         }
-        let d = &self.disturbance;
-        d.constant.check_signed("plant.disturbance.constant")?;
-        d.step.check_signed("plant.disturbance.step")?;
-        d.sin_amplitude
-            .check_signed("plant.disturbance.sin_amplitude")?;
-        for (key, v) in [
-            ("plant.disturbance.step_at_s", d.step_at_s),
-            ("plant.disturbance.sin_omega", d.sin_omega),
-        ] {
-            if !v.is_finite() {
-                return Err(invalid(key, v, "a finite number"));
-            }
-        }
-        d.noise_std.check("plant.disturbance.noise_std")?;
-        if !(d.noise_bandwidth_hz.is_finite() && d.noise_bandwidth_hz > 0.0) {
-            return Err(invalid(
-                "plant.disturbance.noise_bandwidth_hz",
-                d.noise_bandwidth_hz,
-                "a finite frequency > 0",
-            ));
-        }
+        self.disturbance.validate()?;
+        self.validate_sensor_and_actuation()?;
+        Ok(())
+    }
+
+    fn validate_sensor_and_actuation(&self) -> Result<(), PlantError> {
         let s = &self.sensor;
         s.q_noise_std.check("plant.sensor.q_noise_std")?;
         s.qd_noise_std.check("plant.sensor.qd_noise_std")?;
@@ -431,6 +399,58 @@ impl PlantConfig {
                 "plant.payload.link",
                 format!("\"{}\"", p.link),
                 format!("one of the robot's links ({})", link_names.join(", ")),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl PayloadConfig {
+    fn validate(&self) -> Result<(), PlantError> {
+        let p = self;
+        if p.link.is_empty() {
+            return Err(invalid(
+                "plant.payload.link",
+                "\"\"",
+                "the name of a link of the robot",
+            ));
+        }
+        if !(p.mass.is_finite() && p.mass > 0.0) {
+            return Err(invalid("plant.payload.mass", p.mass, "a finite mass > 0"));
+        }
+        check_finite("plant.payload.offset", &p.offset)?;
+        if !(p.attach_at_s.is_finite() && p.attach_at_s >= 0.0) {
+            return Err(invalid(
+                "plant.payload.attach_at_s",
+                p.attach_at_s,
+                "a finite time ≥ 0",
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl DisturbanceConfig {
+    fn validate(&self) -> Result<(), PlantError> {
+        let d = self;
+        d.constant.check_signed("plant.disturbance.constant")?;
+        d.step.check_signed("plant.disturbance.step")?;
+        d.sin_amplitude
+            .check_signed("plant.disturbance.sin_amplitude")?;
+        for (key, v) in [
+            ("plant.disturbance.step_at_s", d.step_at_s),
+            ("plant.disturbance.sin_omega", d.sin_omega),
+        ] {
+            if !v.is_finite() {
+                return Err(invalid(key, v, "a finite number"));
+            }
+        }
+        d.noise_std.check("plant.disturbance.noise_std")?;
+        if !(d.noise_bandwidth_hz.is_finite() && d.noise_bandwidth_hz > 0.0) {
+            return Err(invalid(
+                "plant.disturbance.noise_bandwidth_hz",
+                d.noise_bandwidth_hz,
+                "a finite frequency > 0",
             ));
         }
         Ok(())

@@ -87,13 +87,15 @@ fn postures(s: &Scenario) -> Vec<Vec<f64>> {
     out
 }
 
-/// The gains for `model` running `s` (reference, envelope, plant settings);
-/// `kc_cap` is the widest envelope offset each joint may be given.
-pub fn choose_gains(
-    model: &ArmModel,
-    s: &Scenario,
-    kc_cap: &[f64],
-) -> Result<GainChoice, PlantError> {
+/// What the plant reports about the arm along the reference.
+struct Measured {
+    probes: Vec<Probe>,
+    minv_diag: Vec<f64>,
+    load: Vec<f64>,
+}
+
+/// Probes the arm at the reference's postures; the load τ*_i of each joint.
+fn measure(model: &ArmModel, s: &Scenario) -> Result<Measured, PlantError> {
     let n = model.dof();
     let armature = s.plant.armature.resolve("plant.armature", n)?;
     let probes = postures(s)
@@ -103,9 +105,8 @@ pub fn choose_gains(
     let minv_diag: Vec<f64> = (0..n)
         .map(|i| probes.iter().map(|p| p.minv[(i, i)]).fold(0.0, f64::max))
         .collect();
-    let qdd_max: Vec<f64> = s
-        .reference
-        .joints
+    let r = &s.reference.joints;
+    let qdd_max: Vec<f64> = r
         .iter()
         .map(|r| r.amplitude() * r.omega * r.omega)
         .collect();
@@ -117,7 +118,7 @@ pub fn choose_gains(
                 .iter()
                 .map(|p| p.gravity[i].abs() + inertial(p))
                 .fold(0.0, f64::max);
-            let qd_max = s.reference.joints[i].amplitude() * s.reference.joints[i].omega;
+            let qd_max = r[i].amplitude() * r[i].omega;
             let urdf = if s.plant.urdf_dynamics {
                 j.friction + j.damping * qd_max
             } else {
@@ -126,6 +127,36 @@ pub fn choose_gains(
             worst + urdf
         })
         .collect();
+    Ok(Measured {
+        probes,
+        minv_diag,
+        load,
+    })
+}
+
+/// K2 at period `dt`: ρ/(Δt M⁻¹_ii), scaled down together to the coupled bound.
+fn k2_at(m: &Measured, dt: f64) -> Vec<f64> {
+    let mut k2: Vec<f64> = m.minv_diag.iter().map(|x| RHO / (dt * x)).collect();
+    let worst = m
+        .probes
+        .iter()
+        .map(|p| p.stability_number(&k2, dt))
+        .fold(0.0, f64::max);
+    if worst > RHO {
+        k2.iter_mut().for_each(|k| *k *= RHO / worst);
+    }
+    k2
+}
+
+/// The gains for `model` running `s` (reference, envelope, plant settings);
+/// `kc_cap` is the widest envelope offset each joint may be given.
+pub fn choose_gains(
+    model: &ArmModel,
+    s: &Scenario,
+    kc_cap: &[f64],
+) -> Result<GainChoice, PlantError> {
+    let n = model.dof();
+    let m = measure(model, s)?;
     let kc: Vec<f64> = s.envelope.joints.iter().map(|e| e.offset).collect();
     // The envelope's smallest value over its offset (0.8 for the default's ±20 %).
     let kc_low: Vec<f64> = s
@@ -137,30 +168,19 @@ pub fn choose_gains(
     let mut rate = s.rate_hz;
     loop {
         let dt = 1.0 / rate;
-        let mut k2: Vec<f64> = minv_diag.iter().map(|m| RHO / (dt * m)).collect();
-        let worst = probes
-            .iter()
-            .map(|p| p.stability_number(&k2, dt))
-            .fold(0.0, f64::max);
-        if worst > RHO {
-            k2.iter_mut().for_each(|k| *k *= RHO / worst);
-        }
+        let k2 = k2_at(&m, dt);
         let k1_max = K1_DT_MAX / dt;
         let need: Vec<f64> = (0..n)
-            .map(|i| load[i] / (ERROR_FRACTION * kc_low[i] * kc[i] * k2[i]))
+            .map(|i| m.load[i] / (ERROR_FRACTION * kc_low[i] * kc[i] * k2[i]))
             .collect();
         // Where K1 is capped, the envelope may widen up to its cap instead.
         let envelope: Vec<f64> = (0..n)
-            .map(|i| kc[i] * (need[i] / k1_max).max(1.0))
+            .map(|i| (kc[i] * (need[i] / k1_max).max(1.0)).min(kc_cap[i].max(kc[i])))
             .collect();
         let short = (0..n)
-            .map(|i| envelope[i] / kc_cap[i].max(kc[i]))
+            .map(|i| kc[i] * (need[i] / k1_max).max(1.0) / kc_cap[i].max(kc[i]))
             .fold(0.0, f64::max);
         if short <= 1.0 || rate >= MAX_RATE_HZ {
-            let stability_number = probes
-                .iter()
-                .map(|p| p.stability_number(&k2, dt))
-                .fold(0.0, f64::max);
             let rate_reason = (rate != s.rate_hz).then(|| {
                 format!(
                     "at {} Hz no K1_i ≤ {:.0} holds joint {}'s load within 40 % of the widest envelope its range allows; K1 K2 grows with the rate squared",
@@ -169,34 +189,44 @@ pub fn choose_gains(
                     worst_joint(model, &need)
                 )
             });
-            let joints = (0..n)
-                .map(|i| JointGain {
-                    name: model.joints[model.actuated[i]].name.clone(),
-                    k1: need[i].clamp(K1_MIN.min(k1_max), k1_max),
-                    k2: k2[i],
-                    minv_diag: minv_diag[i],
-                    load: load[i],
-                    effort: model.joints[model.actuated[i]].effort,
-                    k1_reason: k1_reason(need[i], k1_max),
-                })
-                .collect();
             return Ok(GainChoice {
                 rate_hz: rate,
                 rate_reason,
-                joints,
-                stability_number,
-                envelope: (0..n)
-                    .map(|i| envelope[i].min(kc_cap[i].max(kc[i])))
-                    .collect(),
+                joints: joint_gains(model, &m, &k2, &need, k1_max),
+                stability_number: m
+                    .probes
+                    .iter()
+                    .map(|p| p.stability_number(&k2, dt))
+                    .fold(0.0, f64::max),
+                envelope,
             });
         }
         // K1_max K2 grows with rate²: the rate that closes the gap, in
         // multiples of 100 Hz so the period stays a round number of ns.
-        rate = ((rate * short.sqrt() / 100.0).ceil() * 100.0).min(MAX_RATE_HZ);
-        if rate <= s.rate_hz {
-            rate = s.rate_hz + 100.0;
-        }
+        rate = ((rate * short.sqrt() / 100.0).ceil() * 100.0)
+            .min(MAX_RATE_HZ)
+            .max(rate + 100.0);
     }
+}
+
+fn joint_gains(
+    model: &ArmModel,
+    m: &Measured,
+    k2: &[f64],
+    need: &[f64],
+    k1_max: f64,
+) -> Vec<JointGain> {
+    (0..k2.len())
+        .map(|i| JointGain {
+            name: model.joints[model.actuated[i]].name.clone(),
+            k1: need[i].clamp(K1_MIN.min(k1_max), k1_max),
+            k2: k2[i],
+            minv_diag: m.minv_diag[i],
+            load: m.load[i],
+            effort: model.joints[model.actuated[i]].effort,
+            k1_reason: k1_reason(need[i], k1_max),
+        })
+        .collect()
 }
 
 fn worst_joint(model: &ArmModel, need: &[f64]) -> String {

@@ -21,12 +21,14 @@
 pub mod clock;
 mod config;
 mod domain;
+mod fields;
 mod messages;
 mod node;
 mod topics;
 
 pub use config::{ConfigError, read_config, write_config};
 pub use domain::DomainNodes;
+pub use fields::{FieldRef, FieldSource, MessageFields};
 pub use iceoryx2::prelude::ZeroCopySend;
 pub use messages::*;
 pub use node::{Mode, NodeError, NodeLink, ns_to_s};

@@ -34,163 +34,163 @@ pub struct Header {
 /// `JointState::flags`: the last state of the run; no command is expected for it.
 pub const STATE_FINAL: u32 = 1;
 
-/// The plant's state at step `header.seq` (t_k = k Δt).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("testbed.JointState.v2")]
-pub struct JointState {
-    /// seq = k, t_ns = t_k.
-    pub header: Header,
-    /// Joints in use.
-    pub dof: u32,
-    /// [`STATE_FINAL`].
-    pub flags: u32,
-    /// The true joint positions q(t_k) (for analysis; the controller gets
-    /// `q_measured`).
-    pub q: Joints,
-    /// The true joint velocities q̇(t_k).
-    pub qd: Joints,
-    /// What the position sensors report (noise, quantisation).
-    pub q_measured: Joints,
-    /// What the velocity sensors report.
-    pub qd_measured: Joints,
-    /// The motor torque the plant applied over [t_{k−1}, t_k] (zero for k = 0).
-    pub tau_applied: Joints,
-    /// The disturbance d applied over [t_{k−1}, t_k].
-    pub disturbance: Joints,
-    /// Which plant effects acted on this state: the bits of
-    /// `plant_rapier::Effects` (friction, payload, saturated, …).
-    pub effects: u32,
-    /// Padding (keeps the layout explicit).
-    pub reserved: u32,
-    /// Deadline misses so far (real-time mode).
-    pub deadline_misses: u64,
+crate::data_message! {
+    /// The plant's state at step `header.seq` (t_k = k Δt).
+    #[type_name("testbed.JointState.v2")]
+    pub struct JointState {
+        /// seq = k, t_ns = t_k.
+        header: Header,
+        /// Joints in use.
+        dof: u32 => U32,
+        /// [`STATE_FINAL`].
+        flags: u32 => U32,
+        /// The true joint positions q(t_k) (for analysis; the controller gets
+        /// `q_measured`).
+        q: Joints => J,
+        /// The true joint velocities q̇(t_k).
+        qd: Joints => J,
+        /// What the position sensors report (noise, quantisation).
+        q_measured: Joints => J,
+        /// What the velocity sensors report.
+        qd_measured: Joints => J,
+        /// The motor torque the plant applied over [t_{k−1}, t_k] (zero for k = 0).
+        tau_applied: Joints => J,
+        /// The disturbance d applied over [t_{k−1}, t_k].
+        disturbance: Joints => J,
+        /// Which plant effects acted on this state: the bits of
+        /// `plant_rapier::Effects` (friction, payload, saturated, …).
+        effects: u32 => U32,
+        /// Padding (keeps the layout explicit).
+        reserved: u32 => Pad,
+        /// Deadline misses so far (real-time mode).
+        deadline_misses: u64 => U64,
+    }
 }
 
-/// The reference and envelope at `header.t_ns`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("testbed.Reference.v1")]
-pub struct ReferenceSample {
-    /// seq counts samples, t_ns is the time they describe.
-    pub header: Header,
-    /// Joints in use.
-    pub dof: u32,
-    /// Padding (keeps the layout explicit).
-    pub reserved: u32,
-    /// q_d.
-    pub q_d: Joints,
-    /// q̇_d.
-    pub qd_d: Joints,
-    /// q̈_d.
-    pub qdd_d: Joints,
-    /// k_c.
-    pub kc: Joints,
-    /// k̇_c.
-    pub kc_dot: Joints,
+crate::data_message! {
+    /// The reference and envelope at `header.t_ns`.
+    #[type_name("testbed.Reference.v1")]
+    pub struct ReferenceSample {
+        /// seq counts samples, t_ns is the time they describe.
+        header: Header,
+        /// Joints in use.
+        dof: u32 => U32,
+        /// Padding (keeps the layout explicit).
+        reserved: u32 => Pad,
+        /// q_d.
+        q_d: Joints => J,
+        /// q̇_d.
+        qd_d: Joints => J,
+        /// q̈_d.
+        qdd_d: Joints => J,
+        /// k_c.
+        kc: Joints => J,
+        /// k̇_c.
+        kc_dot: Joints => J,
+    }
 }
 
-/// The controller's torque for the state with the same `header.seq`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("testbed.Command.v1")]
-pub struct Command {
-    /// seq and t_ns of the state this answers; wall_ns when it was sent.
-    pub header: Header,
-    /// Joints in use.
-    pub dof: u32,
-    /// Non-zero: the controller published zero torque because of a fault.
-    pub fault: u32,
-    /// Joint torques (forces for prismatic joints).
-    pub tau: Joints,
-    /// wall_ns of the state this answers (for the round trip).
-    pub state_wall_ns: u64,
-    /// Controller compute time for this step, ns.
-    pub compute_ns: u64,
+crate::data_message! {
+    /// The controller's torque for the state with the same `header.seq`.
+    #[type_name("testbed.Command.v1")]
+    pub struct Command {
+        /// seq and t_ns of the state this answers; wall_ns when it was sent.
+        header: Header,
+        /// Joints in use.
+        dof: u32 => U32,
+        /// Non-zero: the controller published zero torque because of a fault.
+        fault: u32 => U32,
+        /// Joint torques (forces for prismatic joints).
+        tau: Joints => J,
+        /// wall_ns of the state this answers (for the round trip).
+        state_wall_ns: u64 => U64,
+        /// Controller compute time for this step, ns.
+        compute_ns: u64 => U64,
+    }
 }
 
-/// Everything the controller computed at one step (SPEC §12).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("testbed.ControllerDiagnostics.v1")]
-pub struct ControllerDiagnostics {
-    /// seq and t_ns of the state acted on.
-    pub header: Header,
-    /// Joints in use.
-    pub dof: u32,
-    /// Fault code (0 = none).
-    pub fault: u32,
-    /// 1 if the guard clamped D this step.
-    pub barrier_breached: u32,
-    /// Padding.
-    pub reserved: u32,
-    /// Controller compute time, ns.
-    pub compute_ns: u64,
-    /// γ(t).
-    pub gamma: f64,
-    /// γ̇(t).
-    pub gamma_dot: f64,
-    /// Ĵ.
-    pub j_hat: f64,
-    /// δ.
-    pub delta: f64,
-    /// r.
-    pub r: f64,
-    /// ‖Ŵ_c‖ before the update.
-    pub wc_norm: f64,
-    /// The reference used: q_d.
-    pub q_d: Joints,
-    /// The reference used: q̇_d.
-    pub qd_d: Joints,
-    /// The envelope used, per joint as given: k_c,i.
-    pub kc_in: Joints,
-    /// The envelope rate used: k̇_c,i.
-    pub kc_dot: Joints,
-    /// Z1.
-    pub z1: Joints,
-    /// Z1γ.
-    pub z1g: Joints,
-    /// Z2.
-    pub z2: Joints,
-    /// α.
-    pub alpha: Joints,
-    /// The bound each barrier used (min k_c in norm mode).
-    pub kc: Joints,
-    /// D before the guard.
-    pub d: Joints,
-    /// τ.
-    pub tau: Joints,
-    /// Actor term of τ.
-    pub tau_actor: Joints,
-    /// −K2 Z2 term of τ.
-    pub tau_feedback: Joints,
-    /// Barrier term of τ.
-    pub tau_barrier: Joints,
-    /// ‖Ŵ_a‖ per joint before the update.
-    pub wa_norm: Joints,
+crate::data_message! {
+    /// Everything the controller computed at one step (SPEC §12).
+    #[type_name("testbed.ControllerDiagnostics.v1")]
+    pub struct ControllerDiagnostics {
+        /// seq and t_ns of the state acted on.
+        header: Header,
+        /// Joints in use.
+        dof: u32 => U32,
+        /// Fault code (0 = none).
+        fault: u32 => U32,
+        /// 1 if the guard clamped D this step.
+        barrier_breached: u32 => U32,
+        /// Padding.
+        reserved: u32 => Pad,
+        /// Controller compute time, ns.
+        compute_ns: u64 => U64,
+        /// γ(t).
+        gamma: f64 => F64,
+        /// γ̇(t).
+        gamma_dot: f64 => F64,
+        /// Ĵ.
+        j_hat: f64 => F64,
+        /// δ.
+        delta: f64 => F64,
+        /// r.
+        r: f64 => F64,
+        /// ‖Ŵ_c‖ before the update.
+        wc_norm: f64 => F64,
+        /// The reference used: q_d.
+        q_d: Joints => J,
+        /// The reference used: q̇_d.
+        qd_d: Joints => J,
+        /// The envelope used, per joint as given: k_c,i.
+        kc_in: Joints => J,
+        /// The envelope rate used: k̇_c,i.
+        kc_dot: Joints => J,
+        /// Z1.
+        z1: Joints => J,
+        /// Z1γ.
+        z1g: Joints => J,
+        /// Z2.
+        z2: Joints => J,
+        /// α.
+        alpha: Joints => J,
+        /// The bound each barrier used (min k_c in norm mode).
+        kc: Joints => J,
+        /// D before the guard.
+        d: Joints => J,
+        /// τ.
+        tau: Joints => J,
+        /// Actor term of τ.
+        tau_actor: Joints => J,
+        /// −K2 Z2 term of τ.
+        tau_feedback: Joints => J,
+        /// Barrier term of τ.
+        tau_barrier: Joints => J,
+        /// ‖Ŵ_a‖ per joint before the update.
+        wa_norm: Joints => J,
+    }
 }
 
-/// Timing of one plant cycle (published by the plant, which is the clock).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("testbed.Timing.v1")]
-pub struct Timing {
-    /// seq = cycle k, t_ns = t_k.
-    pub header: Header,
-    /// How late the plant woke after its deadline, ns (real time; 0 in lockstep).
-    pub wake_late_ns: i64,
-    /// Wall time since the previous cycle's wake-up, ns (0 at k = 0).
-    pub period_ns: i64,
-    /// State k−1 published → its command sent, ns; −1 if it never came.
-    pub round_trip_ns: i64,
-    /// Controller compute time for step k−1, ns; −1 if unknown.
-    pub controller_compute_ns: i64,
-    /// 1 if the command for step k−1 had not arrived at this cycle's deadline.
-    pub deadline_missed: u32,
-    /// Padding.
-    pub reserved: u32,
-    /// Deadline misses so far.
-    pub deadline_misses: u64,
+crate::data_message! {
+    /// Timing of one plant cycle (published by the plant, which is the clock).
+    #[type_name("testbed.Timing.v1")]
+    pub struct Timing {
+        /// seq = cycle k, t_ns = t_k.
+        header: Header,
+        /// How late the plant woke after its deadline, ns (real time; 0 in lockstep).
+        wake_late_ns: i64 => I64,
+        /// Wall time since the previous cycle's wake-up, ns (0 at k = 0).
+        period_ns: i64 => I64,
+        /// State k−1 published → its command sent, ns; −1 if it never came.
+        round_trip_ns: i64 => I64,
+        /// Controller compute time for step k−1, ns; −1 if unknown.
+        controller_compute_ns: i64 => I64,
+        /// 1 if the command for step k−1 had not arrived at this cycle's deadline.
+        deadline_missed: u32 => U32,
+        /// Padding.
+        reserved: u32 => Pad,
+        /// Deadline misses so far.
+        deadline_misses: u64 => U64,
+    }
 }
 
 /// [`Control::command`]: start the run at `epoch_wall_ns`.

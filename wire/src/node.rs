@@ -194,3 +194,30 @@ impl NodeLink {
 pub fn ns_to_s(ns: u64) -> f64 {
     ns as f64 / 1e9
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn modes_parse_from_their_spelling_only() {
+        for m in [Mode::Realtime, Mode::Lockstep] {
+            assert_eq!(m.as_str().parse::<Mode>().unwrap(), m);
+        }
+        assert!(
+            "real-time"
+                .parse::<Mode>()
+                .unwrap_err()
+                .contains("realtime or lockstep")
+        );
+        assert_eq!(Mode::Lockstep.delivery(), Delivery::Lossless);
+        assert_eq!(Mode::Realtime.delivery(), Delivery::DropWhenFull);
+    }
+
+    #[test]
+    fn seconds_from_nanoseconds_are_exact_on_the_grid() {
+        assert_eq!(ns_to_s(1_000_000), 1e-3);
+        assert_eq!(ns_to_s(20_000_000_000), 20.0);
+    }
+}

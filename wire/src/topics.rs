@@ -31,17 +31,6 @@ pub enum Topic {
 }
 
 impl Topic {
-    /// Every topic.
-    pub const ALL: [Topic; 7] = [
-        Topic::JointState,
-        Topic::Reference,
-        Topic::Command,
-        Topic::Diagnostics,
-        Topic::Timing,
-        Topic::Control,
-        Topic::Status,
-    ];
-
     /// Service name (under the run prefix).
     pub fn name(self) -> &'static str {
         match self {
@@ -223,24 +212,9 @@ impl Bus {
         })
     }
 
-    /// The iceoryx2 node.
-    pub fn node(&self) -> &Node<ipc::Service> {
-        &self.node
-    }
-
-    /// The run prefix.
-    pub fn prefix(&self) -> &RunPrefix {
-        &self.prefix
-    }
-
     /// Sleeps up to `timeout`; `Err(Terminated)` once SIGINT or SIGTERM arrived.
     pub fn wait(&self, timeout: Duration) -> Result<(), WireError> {
         self.node.wait(timeout).map_err(|_| WireError::Terminated)
-    }
-
-    /// Removes what crashed processes of this run left in shared memory.
-    pub fn cleanup_dead_nodes(&self) -> u64 {
-        self.node.try_cleanup_dead_nodes().cleanups
     }
 
     fn service<T: Debug + ZeroCopySend + Copy + 'static>(

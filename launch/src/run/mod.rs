@@ -170,25 +170,11 @@ pub fn node_args(
 
 /// Runs the stack to the end.
 pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
-    let plan = &opts.plan;
-    let dof = plan.robot.model.dof();
+    let dof = opts.plan.robot.model.dof();
     if dof > MAX_DOF {
         return Err(RunError::TooManyJoints { dof });
     }
-    let run_dir = opts.runs_dir.join(run_id());
-    std::fs::create_dir_all(&run_dir)
-        .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?;
-    let scenario_file = std::path::absolute(run_dir.join("scenario.toml"))
-        .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?;
-    let toml = plan.effective_toml().map_err(|e| {
-        RunError::Output(
-            scenario_file.display().to_string(),
-            std::io::Error::other(e.to_string()),
-        )
-    })?;
-    std::fs::write(&scenario_file, &toml)
-        .map_err(|e| RunError::Output(scenario_file.display().to_string(), e))?;
-
+    let files = RunFiles::write(&opts)?;
     let prefix = RunPrefix::unique();
     // Domains that killed launchers left behind.
     for stale in RunPrefix::stale_domains(&prefix) {
@@ -197,22 +183,88 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let bus = Bus::new(&prefix, "launcher")?;
     let status = bus.subscriber::<NodeStatus>(Topic::Status)?;
     let control = bus.publisher::<Control>(Topic::Control, Delivery::DropWhenFull)?;
-    let log = std::path::absolute(run_dir.join("run.mcap"))
-        .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?;
-    let configs = crate::node::configs::write_all(
-        &std::path::absolute(run_dir.join("nodes"))
-            .map_err(|e| RunError::Output(run_dir.display().to_string(), e))?,
-        plan,
-        opts.mode,
-        &log,
-        &toml,
-    )
-    .map_err(|e| RunError::Output(run_dir.display().to_string(), std::io::Error::other(e)))?;
-
     let cpus = crate::node::placement::cpu_count();
     let _off_loop = opts
         .realtime_setup
         .then(|| crate::node::placement::OffLoopCpu::enter(cpus));
+    let mut children = spawn_nodes(&opts, &prefix, &files.configs, cpus)?;
+
+    let result = supervise(&opts, &bus, &status, &control, &mut children);
+    let peak_rss_kb = children.peak_rss_kb();
+    // Whatever happened: STOP (the logger then finishes the file), grace,
+    // SIGTERM, SIGKILL, reap.
+    let _ = control.send(control_msg(CONTROL_STOP, 0));
+    children.stop(STOP_GRACE);
+    let logger_exit = children.exit_of(NodeKind::Logger);
+    // Close every port of this process, then remove what is left of the
+    // run's domain (including what a killed node left behind).
+    drop((status, control, bus));
+    let _ = prefix.remove_domain_if_unused();
+    let wall_time_s = result?;
+    if let Some((status, stderr)) = logger_exit.filter(|(s, _)| !s.success()) {
+        return Err(RunError::NodeFailed {
+            node: NodeKind::Logger.name(),
+            how: describe(status),
+            stderr,
+        });
+    }
+    // One analysis path: the summary comes from the log just written.
+    let analysis = analyse_log(&files.log, opts.csv.as_deref())?;
+    Ok(RunOutcome {
+        analysis,
+        run_dir: files.run_dir,
+        log: files.log,
+        wall_time_s,
+        peak_rss_kb,
+    })
+}
+
+/// The run's folder: the scenario it runs, each node's config, the log's path.
+struct RunFiles {
+    run_dir: PathBuf,
+    log: PathBuf,
+    configs: Vec<(NodeKind, PathBuf)>,
+}
+
+impl RunFiles {
+    fn write(opts: &RunOptions) -> Result<Self, RunError> {
+        let plan = &opts.plan;
+        let out = |p: &Path| {
+            let p = p.display().to_string();
+            move |e| RunError::Output(p.clone(), e)
+        };
+        let run_dir =
+            std::path::absolute(opts.runs_dir.join(run_id())).map_err(out(&opts.runs_dir))?;
+        std::fs::create_dir_all(&run_dir).map_err(out(&run_dir))?;
+        let scenario_file = run_dir.join("scenario.toml");
+        let toml = plan.effective_toml().map_err(|e| {
+            RunError::Output(
+                scenario_file.display().to_string(),
+                std::io::Error::other(e),
+            )
+        })?;
+        std::fs::write(&scenario_file, &toml).map_err(out(&scenario_file))?;
+        let log = run_dir.join("run.mcap");
+        let configs =
+            crate::node::configs::write_all(&run_dir.join("nodes"), plan, opts.mode, &log, &toml)
+                .map_err(|e| {
+                RunError::Output(run_dir.display().to_string(), std::io::Error::other(e))
+            })?;
+        Ok(Self {
+            run_dir,
+            log,
+            configs,
+        })
+    }
+}
+
+/// Starts every node the launcher owns; says how to start the external ones.
+fn spawn_nodes(
+    opts: &RunOptions,
+    prefix: &RunPrefix,
+    configs: &[(NodeKind, PathBuf)],
+    cpus: usize,
+) -> Result<Children, RunError> {
     let exe = std::env::current_exe().map_err(|cause| RunError::Spawn {
         node: "plant",
         cause,
@@ -225,7 +277,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         let Some((_, config)) = configs.iter().find(|(k, _)| *k == kind) else {
             unreachable!("write_all writes a config for every node kind");
         };
-        let mut args = node_args(&prefix, config, opts.mode, parent);
+        let mut args = node_args(prefix, config, opts.mode, parent);
         if opts.verbose {
             args.push("--verbose".into());
         }
@@ -247,29 +299,12 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         })?;
         children.push(child);
     }
+    Ok(children)
+}
 
-    let result = supervise(&opts, &bus, &status, &control, &mut children);
-    let peak_rss_kb = children.peak_rss_kb();
-    // Whatever happened: STOP (the logger then finishes the file), grace,
-    // SIGTERM, SIGKILL, reap.
-    let _ = control.send(control_msg(CONTROL_STOP, 0));
-    children.stop(STOP_GRACE);
-    let logger_exit = children.exit_of(NodeKind::Logger);
-    // Close every port of this process, then remove what is left of the
-    // run's domain (including what a killed node left behind).
-    drop((status, control, bus));
-    let _ = prefix.remove_domain_if_unused();
-    let wall_time_s = result?;
-    if let Some((status, stderr)) = logger_exit.filter(|(s, _)| !s.success()) {
-        return Err(RunError::NodeFailed {
-            node: NodeKind::Logger.name(),
-            how: describe(status),
-            stderr,
-        });
-    }
-
-    // One analysis path: the summary comes from the log just written.
-    let mut csv_file = match &opts.csv {
+/// The run's figures from its log, with one CSV row per step if asked.
+fn analyse_log(log: &Path, csv: Option<&Path>) -> Result<LogAnalysis, RunError> {
+    let mut csv_file = match csv {
         Some(path) => {
             Some(BufWriter::new(File::create(path).map_err(|e| {
                 RunError::Output(path.display().to_string(), e)
@@ -277,27 +312,16 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         }
         None => None,
     };
-    let csv_name = opts
-        .csv
-        .as_ref()
-        .map(|p| p.display().to_string())
-        .unwrap_or_default();
-    let analysis = analyse(
-        &log,
+    let csv_name = csv.map(|p| p.display().to_string()).unwrap_or_default();
+    Ok(analyse(
+        log,
         AnalyseOptions {
             csv: csv_file
                 .as_mut()
                 .map(|w| (csv_name.as_str(), w as &mut dyn std::io::Write)),
             ..AnalyseOptions::default()
         },
-    )?;
-    Ok(RunOutcome {
-        analysis,
-        run_dir,
-        log,
-        wall_time_s,
-        peak_rss_kb,
-    })
+    )?)
 }
 
 fn control_msg(command: u32, epoch_wall_ns: u64) -> Control {

@@ -112,38 +112,9 @@ pub(super) fn joint_info(
         }
         axis.iter_mut().for_each(|a| *a /= norm);
     }
-    let lower = finite(format!("{field} limit lower"), j.limit.lower)?;
-    let upper = finite(format!("{field} limit upper"), j.limit.upper)?;
+    let limits = limits(j, kind, &field)?;
     let effort = finite(format!("{field} limit effort"), j.limit.effort)?;
-    // A revolute or prismatic joint without a usable <limit> (lower = upper,
-    // as urdf-rs fills a missing one) moves freely rather than being locked.
-    let limits = match kind {
-        JointKind::Revolute | JointKind::Prismatic if lower < upper => Some((lower, upper)),
-        JointKind::Revolute | JointKind::Prismatic if lower > upper => {
-            return Err(PlantError::BadLimits {
-                joint: j.name.clone(),
-                lower,
-                upper,
-            });
-        }
-        _ => None,
-    };
-    let (damping, friction) = match &j.dynamics {
-        Some(d) => (
-            finite(format!("{field} dynamics damping"), d.damping)?,
-            finite(format!("{field} dynamics friction"), d.friction)?,
-        ),
-        None => (0.0, 0.0),
-    };
-    for (what, v) in [("damping", damping), ("friction", friction)] {
-        if v < 0.0 {
-            return Err(PlantError::InvalidConfig {
-                key: format!("{field} dynamics {what}"),
-                value: v.to_string(),
-                need: "≥ 0".into(),
-            });
-        }
-    }
+    let (damping, friction) = dynamics(j, &field)?;
     Ok(JointInfo {
         name: j.name.clone(),
         kind,
@@ -161,4 +132,48 @@ pub(super) fn joint_info(
             None
         },
     })
+}
+
+/// Position limits of a revolute or prismatic joint.
+fn limits(
+    j: &urdf_rs::Joint,
+    kind: JointKind,
+    field: &str,
+) -> Result<Option<(f64, f64)>, PlantError> {
+    let lower = finite(format!("{field} limit lower"), j.limit.lower)?;
+    let upper = finite(format!("{field} limit upper"), j.limit.upper)?;
+    // A revolute or prismatic joint without a usable <limit> (lower = upper,
+    // as urdf-rs fills a missing one) moves freely rather than being locked.
+    Ok(match kind {
+        JointKind::Revolute | JointKind::Prismatic if lower < upper => Some((lower, upper)),
+        JointKind::Revolute | JointKind::Prismatic if lower > upper => {
+            return Err(PlantError::BadLimits {
+                joint: j.name.clone(),
+                lower,
+                upper,
+            });
+        }
+        _ => None,
+    })
+}
+
+/// `<dynamics damping friction>`, both ≥ 0 (zero when absent).
+fn dynamics(j: &urdf_rs::Joint, field: &str) -> Result<(f64, f64), PlantError> {
+    let (damping, friction) = match &j.dynamics {
+        Some(d) => (
+            finite(format!("{field} dynamics damping"), d.damping)?,
+            finite(format!("{field} dynamics friction"), d.friction)?,
+        ),
+        None => (0.0, 0.0),
+    };
+    for (what, v) in [("damping", damping), ("friction", friction)] {
+        if v < 0.0 {
+            return Err(PlantError::InvalidConfig {
+                key: format!("{field} dynamics {what}"),
+                value: v.to_string(),
+                need: "≥ 0".into(),
+            });
+        }
+    }
+    Ok((damping, friction))
 }

@@ -3,7 +3,7 @@
 
 use rapier3d_f64::prelude::*;
 
-use super::{Coupled, Dof};
+use super::{Coupled, Dof, pose};
 use crate::model::{ArmModel, JointKind};
 use crate::{PlantConfig, PlantError};
 
@@ -162,4 +162,128 @@ pub(super) fn mass_properties(link: &crate::LinkInfo) -> MassProperties {
         ),
         Rotation::from_xyzw(q.i, q.j, q.k, q.w),
     )
+}
+
+/// Every link as a rigid body at its q = 0 pose (the root fixed), with its
+/// own mass properties; the handles and those properties, in link order.
+pub(super) fn insert_bodies(
+    world: &mut PhysicsWorld,
+    model: &ArmModel,
+) -> (Vec<RigidBodyHandle>, Vec<MassProperties>) {
+    // World pose of every link at q = 0, parents first.
+    let mut link_pose = vec![Pose::IDENTITY; model.links.len()];
+    for &ji in &model.topological {
+        let j = &model.joints[ji];
+        link_pose[j.child] = link_pose[j.parent] * pose(&j.origin);
+    }
+    let mut handles = Vec::with_capacity(model.links.len());
+    let mut link_mprops = Vec::with_capacity(model.links.len());
+    for (i, link) in model.links.iter().enumerate() {
+        let builder = if i == model.root {
+            RigidBodyBuilder::fixed()
+        } else {
+            RigidBodyBuilder::dynamic()
+        };
+        let mprops = mass_properties(link);
+        link_mprops.push(mprops);
+        let body = builder
+            .pose(link_pose[i])
+            .additional_mass_properties(mprops)
+            .can_sleep(false)
+            .build();
+        handles.push(world.bodies.insert(body));
+    }
+    (handles, link_mprops)
+}
+
+/// Every joint into one multibody; its handle.
+pub(super) fn insert_joints(
+    world: &mut PhysicsWorld,
+    model: &ArmModel,
+    handles: &[RigidBodyHandle],
+) -> Result<MultibodyJointHandle, PlantError> {
+    let mut multibody = None;
+    for &ji in &model.topological {
+        let j = &model.joints[ji];
+        let axis = Vector::new(j.axis[0], j.axis[1], j.axis[2]);
+        let locked = match j.kind {
+            JointKind::Revolute | JointKind::Continuous => JointAxesMask::LOCKED_REVOLUTE_AXES,
+            JointKind::Prismatic => JointAxesMask::LOCKED_PRISMATIC_AXES,
+            JointKind::Fixed => JointAxesMask::LOCKED_FIXED_AXES,
+        };
+        // One frame built from the axis, on both sides, so that the joint's
+        // local X is the URDF axis and q = 0 is the URDF zero pose.
+        let basis = if j.kind == JointKind::Fixed {
+            Pose::IDENTITY
+        } else {
+            Pose::from_rotation(GenericJoint::complete_ang_frame(axis))
+        };
+        let mut builder = GenericJointBuilder::new(locked)
+            .local_frame1(pose(&j.origin) * basis)
+            .local_frame2(basis)
+            .contacts_enabled(false);
+        if let Some((lo, hi)) = j.limits {
+            let axis_id = if j.kind == JointKind::Prismatic {
+                JointAxis::LinX
+            } else {
+                JointAxis::AngX
+            };
+            builder = builder.limits(axis_id, [lo, hi]);
+        }
+        let handle = world
+            .multibody_joints
+            .insert(handles[j.parent], handles[j.child], builder.build(), true)
+            .ok_or_else(|| PlantError::Engine(format!("Rapier refused joint '{}'", j.name)))?;
+        multibody.get_or_insert(handle);
+    }
+    multibody.ok_or(PlantError::NoActuatedJoints)
+}
+
+/// Settles the new multibody: drops the free root, no self-contacts, and
+/// none of Rapier's default per-DoF damping, friction or armature.
+pub(super) fn settle(
+    bodies: &mut RigidBodySet,
+    joints: &mut MultibodyJointSet,
+    multibody: MultibodyJointHandle,
+) -> Result<(), PlantError> {
+    let (mb, _) = joints
+        .get_mut(multibody)
+        .ok_or_else(|| PlantError::Engine("multibody vanished after insertion".into()))?;
+    // The root is fixed: this drops the free root DOFs Rapier counts at first.
+    mb.forward_kinematics(bodies, true);
+    mb.update_rigid_bodies(bodies, true);
+    mb.set_self_contacts_enabled(false);
+    // Rapier gives every DOF a default joint damping of 0.1: the arm has none.
+    mb.damping_mut().fill(0.0);
+    mb.frictions_mut().fill(0.0);
+    mb.armature_mut().fill(0.0);
+    Ok(())
+}
+
+/// Effort limit per joint: the scenario's or the URDF's; infinite where
+/// there is none or saturation is off.
+pub(super) fn effort_limits(
+    model: &ArmModel,
+    config: &PlantConfig,
+) -> Result<Vec<f64>, PlantError> {
+    let n = model.dof();
+    let scenario_effort = match &config.effort_limit {
+        Some(e) => Some(e.resolve("plant.effort_limit", n)?),
+        None => None,
+    };
+    Ok(model
+        .actuated
+        .iter()
+        .enumerate()
+        .map(|(i, &ji)| {
+            let limit = match &scenario_effort {
+                Some(e) => Some(e[i]),
+                None => model.joints[ji].effort,
+            };
+            match limit {
+                Some(e) if config.saturate => e,
+                _ => f64::INFINITY,
+            }
+        })
+        .collect())
 }

@@ -3,12 +3,14 @@
 use rapier3d_f64::glamx::EulerRot;
 use rapier3d_f64::prelude::*;
 
-use crate::model::{ArmModel, JointKind, Origin};
+use crate::model::{ArmModel, Origin};
 use crate::{PlantConfig, PlantError};
 
 mod build;
 
-use build::{couple_mimics, dof_of, joint_dynamics, mass_properties};
+use build::{
+    couple_mimics, dof_of, effort_limits, insert_bodies, insert_joints, joint_dynamics, settle,
+};
 
 /// Where one actuated joint lives inside the Rapier multibody.
 #[derive(Debug, Clone)]
@@ -90,83 +92,14 @@ impl Plant {
         // times per period with the torque re-applied about the current axes.
         world.integration_parameters.num_solver_iterations = 1;
 
-        // World pose of every link at q = 0, parents first.
-        let mut link_pose = vec![Pose::IDENTITY; model.links.len()];
-        for &ji in &model.topological {
-            let j = &model.joints[ji];
-            link_pose[j.child] = link_pose[j.parent] * pose(&j.origin);
-        }
-        let mut handles = Vec::with_capacity(model.links.len());
-        let mut link_mprops = Vec::with_capacity(model.links.len());
-        for (i, link) in model.links.iter().enumerate() {
-            let builder = if i == model.root {
-                RigidBodyBuilder::fixed()
-            } else {
-                RigidBodyBuilder::dynamic()
-            };
-            let mprops = mass_properties(link);
-            link_mprops.push(mprops);
-            let body = builder
-                .pose(link_pose[i])
-                .additional_mass_properties(mprops)
-                .can_sleep(false)
-                .build();
-            handles.push(world.bodies.insert(body));
-        }
-
-        let mut multibody = None;
-        for &ji in &model.topological {
-            let j = &model.joints[ji];
-            let axis = Vector::new(j.axis[0], j.axis[1], j.axis[2]);
-            let locked = match j.kind {
-                JointKind::Revolute | JointKind::Continuous => JointAxesMask::LOCKED_REVOLUTE_AXES,
-                JointKind::Prismatic => JointAxesMask::LOCKED_PRISMATIC_AXES,
-                JointKind::Fixed => JointAxesMask::LOCKED_FIXED_AXES,
-            };
-            // One frame built from the axis, on both sides, so that the joint's
-            // local X is the URDF axis and q = 0 is the URDF zero pose.
-            let basis = if j.kind == JointKind::Fixed {
-                Pose::IDENTITY
-            } else {
-                Pose::from_rotation(GenericJoint::complete_ang_frame(axis))
-            };
-            let mut builder = GenericJointBuilder::new(locked)
-                .local_frame1(pose(&j.origin) * basis)
-                .local_frame2(basis)
-                .contacts_enabled(false);
-            if let Some((lo, hi)) = j.limits {
-                let axis_id = if j.kind == JointKind::Prismatic {
-                    JointAxis::LinX
-                } else {
-                    JointAxis::AngX
-                };
-                builder = builder.limits(axis_id, [lo, hi]);
-            }
-            let handle = world
-                .multibody_joints
-                .insert(handles[j.parent], handles[j.child], builder.build(), true)
-                .ok_or_else(|| PlantError::Engine(format!("Rapier refused joint '{}'", j.name)))?;
-            multibody.get_or_insert(handle);
-        }
-        let multibody = multibody.ok_or(PlantError::NoActuatedJoints)?;
-
+        let (handles, link_mprops) = insert_bodies(&mut world, model);
+        let multibody = insert_joints(&mut world, model, &handles)?;
         let PhysicsWorld {
             bodies,
             multibody_joints,
             ..
         } = &mut world;
-        let (mb, _) = multibody_joints
-            .get_mut(multibody)
-            .ok_or_else(|| PlantError::Engine("multibody vanished after insertion".into()))?;
-        // The root is fixed: this drops the free root DOFs Rapier counts at first.
-        mb.forward_kinematics(bodies, true);
-        mb.update_rigid_bodies(bodies, true);
-        mb.set_self_contacts_enabled(false);
-        // Rapier gives every DOF a default joint damping of 0.1: the arm has none.
-        mb.damping_mut().fill(0.0);
-        mb.frictions_mut().fill(0.0);
-        mb.armature_mut().fill(0.0);
-
+        settle(bodies, multibody_joints, multibody)?;
         let dofs = model
             .actuated
             .iter()
@@ -184,25 +117,7 @@ impl Plant {
             )));
         }
         joint_dynamics(model, config, &dofs, &coupled, multibody_joints, multibody)?;
-        let scenario_effort = match &config.effort_limit {
-            Some(e) => Some(e.resolve("plant.effort_limit", n)?),
-            None => None,
-        };
-        let effort = model
-            .actuated
-            .iter()
-            .enumerate()
-            .map(|(i, &ji)| {
-                let limit = match &scenario_effort {
-                    Some(e) => Some(e[i]),
-                    None => model.joints[ji].effort,
-                };
-                match limit {
-                    Some(e) if config.saturate => e,
-                    _ => f64::INFINITY,
-                }
-            })
-            .collect();
+        let effort = effort_limits(model, config)?;
         let f = &config.friction;
         Ok(Self {
             world,

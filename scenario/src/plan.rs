@@ -1,0 +1,217 @@
+//! A scenario checked against its robot, with its time grid fixed; and
+//! loading one from a file with the command line's overrides.
+
+use std::path::{Path, PathBuf};
+
+use plant_rapier::Locks;
+use trajectory::Reference;
+
+use crate::{PAPER_TOML, RobotSource, Scenario, ScenarioError};
+
+/// A scenario checked against its robot: everything a run needs.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The scenario as loaded.
+    pub scenario: Scenario,
+    /// Where the scenario came from ("built-in paper scenario" or a path).
+    pub source: String,
+    /// The scenario's TOML text as written by its author, for logs.
+    pub toml: String,
+    /// The robot.
+    pub robot: RobotSource,
+    /// The checked reference and envelope.
+    pub reference: Reference,
+    /// Control period in integer nanoseconds.
+    pub period_ns: u64,
+    /// Period of the reference samples in integer nanoseconds.
+    pub reference_period_ns: u64,
+    /// Number of control steps.
+    pub steps: u64,
+}
+
+impl Plan {
+    /// The scenario as it will run (overrides applied, robot path made
+    /// absolute), as TOML: what the node processes of a run load.
+    pub fn effective_toml(&self) -> Result<String, ScenarioError> {
+        let mut s = self.scenario.clone();
+        s.robot = self.robot.path.as_ref().map(|p| {
+            std::path::absolute(p)
+                .unwrap_or_else(|_| p.clone())
+                .display()
+                .to_string()
+        });
+        toml::to_string(&s).map_err(|e| ScenarioError::Toml {
+            file: self.source.clone(),
+            message: format!("cannot write the effective scenario: {e}"),
+        })
+    }
+
+    /// Control period in seconds (exactly `period_ns` / 1e9).
+    pub fn dt(&self) -> f64 {
+        self.period_ns as f64 / 1e9
+    }
+
+    /// Sim time of step `k` in nanoseconds.
+    pub fn t_ns(&self, k: u64) -> u64 {
+        k * self.period_ns
+    }
+
+    /// Time of the newest reference sample at or before `t_ns`: the one a
+    /// controller at `t_ns` uses.
+    pub fn reference_t_ns(&self, t_ns: u64) -> u64 {
+        t_ns / self.reference_period_ns * self.reference_period_ns
+    }
+}
+
+/// Command-line values that replace the scenario's own.
+#[derive(Debug, Clone, Default)]
+pub struct Overrides {
+    /// Replaces `duration_s`.
+    pub duration_s: Option<f64>,
+    /// Replaces `rate_hz`.
+    pub rate_hz: Option<f64>,
+    /// Replaces the robot; with no scenario file, the default scenario for
+    /// that arm is used.
+    pub robot: Option<PathBuf>,
+}
+
+/// Loads a scenario file (or the built-in paper scenario when `path` is
+/// None), applies `overrides`, loads its robot, and checks that they fit.
+pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, ScenarioError> {
+    let (toml_text, source, base) = match path {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|cause| ScenarioError::Io {
+                file: p.display().to_string(),
+                cause,
+            })?;
+            let base = p.parent().map(Path::to_path_buf).unwrap_or_default();
+            (text, p.display().to_string(), Some(base))
+        }
+        None => (
+            PAPER_TOML.to_string(),
+            "built-in paper scenario".to_string(),
+            None,
+        ),
+    };
+    let arm = match &overrides.robot {
+        Some(path) => Some(RobotSource::from_file(path, &Locks::new())?),
+        None => None,
+    };
+    let (mut scenario, toml_text, source) = match (&arm, path) {
+        (Some(arm), None) => {
+            let s = Scenario::for_arm(&arm.urdf).map_err(|cause| ScenarioError::Plant {
+                file: arm.label(),
+                cause,
+            })?;
+            let text = toml::to_string(&s).map_err(|e| ScenarioError::Toml {
+                file: arm.label(),
+                message: format!("cannot write the default scenario: {e}"),
+            })?;
+            (s, text, format!("default scenario for {}", arm.label()))
+        }
+        _ => (
+            Scenario::from_toml_str(&toml_text, &source)?,
+            toml_text,
+            source,
+        ),
+    };
+    if let Some(d) = overrides.duration_s {
+        scenario.duration_s = d;
+        scenario.validate(&format!("{source} with --duration {d}"))?;
+    }
+    if let Some(r) = overrides.rate_hz {
+        scenario.rate_hz = r;
+        scenario.validate(&format!("{source} with --rate {r}"))?;
+    }
+    let locks = &scenario.plant.lock;
+    let robot = match (arm, &scenario.robot, &base) {
+        (Some(arm), _, _) => arm.relocked(locks),
+        (None, rel, base) => match (rel, base) {
+            (Some(rel), Some(base)) => RobotSource::from_file(&base.join(rel), locks),
+            (Some(rel), None) => RobotSource::from_file(Path::new(rel), locks),
+            (None, _) => RobotSource::builtin().relocked(locks),
+        },
+    }
+    .map_err(|cause| ScenarioError::Robot {
+        file: source.clone(),
+        cause: Box::new(cause),
+    })?;
+    plan(scenario, source, toml_text, robot)
+}
+
+/// Checks a parsed scenario against a robot and fixes the time grid.
+pub fn plan(
+    scenario: Scenario,
+    source: String,
+    toml: String,
+    robot: RobotSource,
+) -> Result<Plan, ScenarioError> {
+    let dof = robot.model.dof();
+    let mismatch = |key: &str, got: usize| ScenarioError::Invalid {
+        file: source.clone(),
+        key: key.to_string(),
+        value: format!("{got} entries"),
+        need: format!(
+            "one entry per actuated joint of {} ({dof}: {})",
+            robot.label(),
+            robot.model.joint_names().join(", ")
+        ),
+    };
+    for (key, len) in [
+        ("initial.q", scenario.initial.q.len()),
+        ("initial.qd", scenario.initial.qd.len()),
+        ("reference.joints", scenario.reference.joints.len()),
+        ("envelope.joints", scenario.envelope.joints.len()),
+    ] {
+        if len != dof && !(key == "envelope.joints" && scenario.envelope.from_limits) {
+            return Err(mismatch(key, len));
+        }
+    }
+    let c = &scenario.controller;
+    for (key, gain) in [("controller.k1", &c.k1), ("controller.k2", &c.k2)] {
+        gain.resolve(key, dof)
+            .map_err(|cause| ScenarioError::Controller {
+                file: source.clone(),
+                cause,
+            })?;
+    }
+    let model = &robot.model;
+    let limits: Vec<Option<(f64, f64)>> = model
+        .actuated
+        .iter()
+        .map(|&j| model.joints[j].limits)
+        .collect();
+    let reference = Reference::with_limits(
+        &scenario.reference,
+        &scenario.envelope,
+        &limits,
+        &model.joint_names(),
+    )
+    .map_err(|cause| ScenarioError::Trajectory {
+        file: source.clone(),
+        cause,
+    })?;
+    scenario
+        .plant
+        .check_for(dof, &model.link_names())
+        .map_err(|cause| ScenarioError::Plant {
+            file: source.clone(),
+            cause,
+        })?;
+    let period_ns = (1e9 / scenario.rate_hz).round() as u64;
+    let reference_period_ns = match scenario.reference.rate_hz {
+        Some(r) => (1e9 / r).round() as u64,
+        None => period_ns,
+    };
+    let steps = (scenario.duration_s * 1e9 / period_ns as f64).round() as u64;
+    Ok(Plan {
+        scenario,
+        source,
+        toml,
+        robot,
+        reference,
+        period_ns,
+        reference_period_ns,
+        steps,
+    })
+}
