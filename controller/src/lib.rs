@@ -1,11 +1,13 @@
 //! The paper's reinforcement-learning neuroadaptive controller under deferred
 //! constraints, as pure math (SPEC §3–§12).
 //!
-//! Where it sits: the `controller` process (or `testbed sim`'s in-process
-//! loop) reads a joint state and the reference at the state's sim time, calls
-//! [`Controller::step`] with the control period, and publishes `tau` and the
-//! [`Diagnostics`]. No clock, no I/O, no IPC: the same inputs give the same
-//! outputs bit for bit, which is what makes lockstep runs and replays exact.
+//! Where it sits: between the plant's joint states and its commands. The
+//! core, [`Controller::step`], is pure: no clock, no I/O, no IPC; the same
+//! inputs give the same outputs bit for bit, which is what makes lockstep
+//! runs and replays exact. [`ControllerMachine`] is the step machine in wire
+//! messages (state + reference → command + diagnostics) that the controller
+//! node ([`node`]), `testbed sim` and `replay --verify` all drive; the node
+//! module is the thin shell that puts it on the bus.
 //!
 //! ```
 //! use controller::{Controller, ControllerInput, ControllerParams};

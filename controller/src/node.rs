@@ -3,6 +3,7 @@
 //! time from the trajectory process, and publishes the command and the
 //! diagnostics of that step.
 
+use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
@@ -52,7 +53,7 @@ impl From<wire::WireError> for ControllerNodeError {
 /// Real time: what has arrived by then; none yet is a fault.
 struct RefSource {
     sub: TopicSubscriber<ReferenceSample>,
-    recent: Vec<ReferenceSample>,
+    recent: VecDeque<ReferenceSample>,
     wait_for_final: bool,
 }
 
@@ -65,9 +66,9 @@ impl RefSource {
     ) -> Result<Option<ReferenceSample>, NodeError> {
         loop {
             while let Some(r) = self.sub.receive()? {
-                self.recent.push(r);
+                arrive(&mut self.recent, r);
             }
-            let settled = self.recent.iter().any(|r| r.header.t_ns >= t_ns);
+            let settled = self.recent.back().is_some_and(|r| r.header.t_ns >= t_ns);
             if settled || !self.wait_for_final {
                 return Ok(pick_reference(&mut self.recent, t_ns));
             }
@@ -78,15 +79,26 @@ impl RefSource {
     }
 }
 
+/// Keeps `recent` in time order: samples from one publisher come in order,
+/// so this is a push at the back; a late one is put in its place.
+fn arrive(recent: &mut VecDeque<ReferenceSample>, r: ReferenceSample) {
+    if recent.back().is_none_or(|b| b.header.t_ns <= r.header.t_ns) {
+        recent.push_back(r);
+    } else {
+        let i = recent.partition_point(|x| x.header.t_ns <= r.header.t_ns);
+        recent.insert(i, r);
+    }
+}
+
 /// The newest sample at or before `t_ns`, dropping the older ones. Samples
 /// after `t_ns` are kept: when the plant runs late, the trajectory's timer is
-/// ahead of it and those samples are needed for the next states.
-fn pick_reference(recent: &mut Vec<ReferenceSample>, t_ns: u64) -> Option<ReferenceSample> {
-    recent.sort_by_key(|r| r.header.t_ns);
-    let i = recent.iter().rposition(|r| r.header.t_ns <= t_ns)?;
-    let r = recent[i];
-    recent.drain(..i);
-    Some(r)
+/// ahead of it and those samples are needed for the next states. O(1) per
+/// state (the lockstep trajectory runs a thousand samples ahead).
+fn pick_reference(recent: &mut VecDeque<ReferenceSample>, t_ns: u64) -> Option<ReferenceSample> {
+    while recent.get(1).is_some_and(|r| r.header.t_ns <= t_ns) {
+        recent.pop_front();
+    }
+    recent.front().filter(|r| r.header.t_ns <= t_ns).copied()
 }
 
 /// Runs the controller node to the end of the run.
@@ -105,7 +117,7 @@ pub fn run(
         .publisher::<ControllerDiagnostics>(Topic::Diagnostics, mode.delivery())?;
     let mut reference = RefSource {
         sub: link.bus.subscriber(Topic::Reference)?,
-        recent: Vec::with_capacity(64),
+        recent: VecDeque::with_capacity(2048),
         wait_for_final: mode == Mode::Lockstep,
     };
     link.ready_and_wait_for_start()?;
@@ -161,15 +173,23 @@ mod tests {
         }
     }
 
+    fn arrived(ts: &[u64]) -> VecDeque<ReferenceSample> {
+        let mut recent = VecDeque::new();
+        for &t in ts {
+            arrive(&mut recent, sample(t));
+        }
+        recent
+    }
+
     #[test]
     fn newest_sample_not_after_the_state_wins() {
-        let mut recent: Vec<_> = [3, 1, 2, 5].map(sample).to_vec();
+        let mut recent = arrived(&[3, 1, 2, 5]);
         assert_eq!(pick_reference(&mut recent, 4).unwrap().header.t_ns, 3);
         assert_eq!(
             recent.iter().map(|r| r.header.t_ns).collect::<Vec<_>>(),
             [3, 5]
         );
-        assert!(pick_reference(&mut vec![sample(7)], 6).is_none());
+        assert!(pick_reference(&mut arrived(&[7]), 6).is_none());
     }
 
     /// Regression: with the plant 20 periods behind the trajectory, the
@@ -177,7 +197,7 @@ mod tests {
     /// state, and faulted with no reference.
     #[test]
     fn reference_is_found_when_the_plant_runs_late() {
-        let mut recent: Vec<_> = (0..40).map(sample).collect();
+        let mut recent = arrived(&(0..40).collect::<Vec<_>>());
         for k in 0..40 {
             assert_eq!(pick_reference(&mut recent, k).unwrap().header.t_ns, k);
         }

@@ -1,11 +1,13 @@
-//! The `testbed` command's internals: the in-process closed loop, the node
-//! processes, the launcher, the run summary and CSV output.
+//! The `testbed` command's internals: the in-process run, the node
+//! dispatcher, the launcher, the analysis of a run and what is printed.
 //!
-//! Where it sits: at the top. `testbed sim` loads a [`scenario::Plan`], runs
-//! [`sim::run`] and feeds each [`record::StepRecord`] to a
-//! [`summary::SummaryBuilder`]. `testbed run` spawns the [`node`] processes
-//! (plant, trajectory, controller) that talk over iceoryx2 ([`wire`]), and
-//! [`run`] supervises them and assembles the same records from the topics.
+//! Where it sits: at the top. `testbed sim` loads a [`scenario::Plan`] and
+//! [`sim::run`] calls the role crates' step machines in order; `testbed run`
+//! writes each node its config ([`node::configs`]), spawns the nodes (whose
+//! code lives in the role crates; [`node`] only dispatches to them) and
+//! [`run`] supervises them. Either way the rows come from one
+//! [`assemble::RecordAssembler`] and feed a [`summary::SummaryBuilder`];
+//! [`analysis`] reads a run's log back for `run` and `replay`.
 
 pub mod analysis;
 pub mod assemble;

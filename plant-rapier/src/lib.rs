@@ -1,13 +1,14 @@
 //! The simulated arm: a Rapier multibody (f64) built from a URDF.
 //!
-//! Where it sits: the plant process (or `testbed sim`'s in-process loop)
-//! owns a [`Rig`]: the Rapier [`Plant`] with what a real arm adds that the
-//! controller does not know (friction, a payload, the disturbance d(t),
-//! saturation, sensor noise and quantisation, actuation delay, lost
-//! commands; see [`PlantConfig`]). Each period it publishes the true and
-//! the measured joint state and steps with the command that reached the
-//! motors. The controller never sees anything in here: M, C and G live
-//! only in Rapier.
+//! Where it sits: at the start and the end of each period. The core is the
+//! checked [`ArmModel`], the Rapier [`Plant`] and the [`Rig`] around it with
+//! what a real arm adds that the controller does not know (friction, a
+//! payload, the disturbance d(t), saturation, sensor noise and quantisation,
+//! actuation delay, lost commands; see [`PlantConfig`]). [`PlantMachine`]
+//! is its step machine in wire messages (command → joint state), driven by
+//! the plant node ([`node`], the clock of a multi-process run) and by
+//! `testbed sim`. The controller never sees anything in here: M, C and G
+//! live only in Rapier.
 //!
 //! ```
 //! use plant_rapier::{ArmModel, Plant, PlantConfig, TWO_LINK_URDF};

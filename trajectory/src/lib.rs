@@ -1,9 +1,10 @@
 //! The reference trajectory q_d(t) and the constraint envelope k_c(t).
 //!
-//! Where it sits: the `trajectory` process (and the in-process loop of
-//! `testbed sim`) calls [`Reference::sample_into`] each control period and
-//! hands the controller q_d, q̇_d, q̈_d, k_c and k̇_c. Everything here is a pure
+//! Where it sits: at the head of the data flow, feeding the controller q_d,
+//! q̇_d, q̈_d, k_c and k̇_c. The core ([`Reference::sample_into`]) is a pure
 //! function of sim time: no clock, no I/O, so a log alone can reproduce it.
+//! [`TrajectoryMachine`] turns it into wire samples; the trajectory node
+//! ([`node`]) publishes them, and `testbed sim` calls the same machine.
 //!
 //! Each signal is a [`Sinusoid`], `offset + sin·sin(ωt) + cos·cos(ωt)`, which
 //! writes the paper's reference (Section IV) exactly:

@@ -17,6 +17,13 @@
 //!
 //! Services live under a per-run prefix ([`RunPrefix`]), so two runs, or two
 //! tests, never see each other.
+//!
+//! Besides the messages and topics: the node protocol every process follows
+//! ([`NodeLink`]: READY, START, DONE, STOP), the typed config file through
+//! which the launcher hands each node its part of the plan
+//! ([`write_config`], [`read_config`]), each data message's field list
+//! ([`data_message!`], [`MessageFields`]) from which the log's codec is made,
+//! and absolute-deadline sleeping ([`clock`]).
 
 pub mod clock;
 mod config;
