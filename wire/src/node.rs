@@ -13,7 +13,8 @@ use crate::{
 };
 
 /// Timing mode of a multi-process run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Mode {
     /// The plant steps on an absolute-deadline grid at the scenario rate,
     /// holding the latest command; a late command is a deadline miss.

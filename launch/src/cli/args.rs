@@ -38,8 +38,8 @@ pub(crate) struct SimArgs {
 pub(crate) struct RunArgs {
     #[command(flatten)]
     pub(crate) common: ScenarioArgs,
-    /// Timing mode.
-    #[arg(long, value_enum, default_value = "realtime")]
+    /// Timing mode: realtime or lockstep.
+    #[arg(long, value_parser = launch::mode::parse, default_value = "realtime")]
     pub(crate) mode: Mode,
     /// Control rate in Hz instead of the scenario's rate_hz.
     #[arg(long, value_name = "HZ")]

@@ -23,8 +23,8 @@ pub struct NodeArgs {
     /// The node's config, as the launcher wrote it (`runs/<id>/nodes/<name>.json`).
     #[arg(long, value_name = "FILE")]
     pub config: PathBuf,
-    /// Timing mode.
-    #[arg(long, value_enum)]
+    /// Timing mode: realtime or lockstep.
+    #[arg(long, value_parser = crate::mode::parse)]
     pub mode: Mode,
     /// Exit when this process (the launcher) is gone.
     #[arg(long, value_name = "PID")]
@@ -81,7 +81,7 @@ pub fn run(kind: NodeKind, args: &NodeArgs) -> Result<(), NodeRunError> {
         eprintln!("testbed node {}: warning: {refused}", kind.name());
     }
     let prefix = RunPrefix::parse(&args.prefix)?;
-    let mode = wire::Mode::from(args.mode);
+    let mode = args.mode;
     let result = match kind {
         NodeKind::Plant => {
             let config = read_config(&args.config)?;
