@@ -63,7 +63,7 @@ fn default_locks(full: &ArmModel) -> Vec<(String, f64, String)> {
     locks
 }
 
-/// The widest envelope offset a joint may be given: 0.6 rad, or 0.3 of
+/// The widest envelope offset a joint may be given: 1 rad, or 0.3 of
 /// its half range.
 fn kc_cap(model: &ArmModel) -> Vec<f64> {
     model
@@ -75,7 +75,7 @@ fn kc_cap(model: &ArmModel) -> Vec<f64> {
                 .map_or(f64::INFINITY, |(lo, hi)| 0.5 * (hi - lo));
             match model.joints[ji].kind {
                 JointKind::Prismatic => 0.15 * half,
-                _ => (0.3 * half).min(0.6),
+                _ => (0.3 * half).min(1.0),
             }
         })
         .collect()
