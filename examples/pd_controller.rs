@@ -19,7 +19,7 @@ use std::time::Duration;
 
 use controller::node::ControllerNodeConfig;
 use wire::{
-    Command, ControllerDiagnostics, JointState, Mode, NodeKind, NodeLink, ReferenceSample,
+    Command, ControllerDiagnostics, JointState, Mode, NodeKind, NodeLink, ReferenceWindow,
     RunPrefix, STATE_FINAL, Topic, monotonic_ns, read_config,
 };
 
@@ -56,7 +56,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let n = config.dof;
     let mut link = NodeLink::connect(NodeKind::Controller, &prefix, None)?;
     let states = link.bus.subscriber::<JointState>(Topic::JointState)?;
-    let references = link.bus.subscriber::<ReferenceSample>(Topic::Reference)?;
+    let mut references = ReferenceWindow::new(&link, mode)?;
     let commands = link
         .bus
         .publisher::<Command>(Topic::Command, mode.delivery())?;
@@ -64,29 +64,15 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .bus
         .publisher::<ControllerDiagnostics>(Topic::Diagnostics, mode.delivery())?;
     link.ready_and_wait_for_start()?;
-    let mut recent: Vec<ReferenceSample> = Vec::new();
     let mut handled = 0;
     'run: loop {
         while let Some(s) = states.receive()? {
             if s.flags & STATE_FINAL != 0 {
                 break 'run;
             }
-            // The newest reference at or before the state; in lockstep wait
-            // until one at or after it has come, so the choice is final.
-            let r = loop {
-                while let Some(r) = references.receive()? {
-                    recent.push(r);
-                }
-                let settled = recent.iter().any(|r| r.header.t_ns >= s.header.t_ns);
-                if settled || mode == Mode::Realtime {
-                    break recent
-                        .iter()
-                        .rev()
-                        .find(|r| r.header.t_ns <= s.header.t_ns)
-                        .copied();
-                }
-                link.bus.wait(Duration::from_millis(1))?;
-            };
+            // The same rule as the testbed's controller: the newest sample
+            // at or before the state, final in lockstep.
+            let r = references.take(&mut link, s.header.t_ns)?;
             let r = r.unwrap_or_default();
             let mut d = ControllerDiagnostics {
                 header: s.header,

@@ -30,7 +30,7 @@ pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
 pub use default_for_arm::ArmDefault;
 pub use gains::{GainChoice, JointGain};
 pub use plan::{Overrides, Plan, load, plan};
-pub use probe::{Probe, max_inverse_inertia};
+pub use probe::Probe;
 pub use robot::RobotSource;
 pub use wire::ns_to_s;
 

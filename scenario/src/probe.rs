@@ -70,13 +70,3 @@ impl Probe {
             .fold(0.0, f64::max)
     }
 }
-
-/// The largest eigenvalue of M(q)⁻¹ at `q` (rad⁻¹ s⁻² per N m).
-pub fn max_inverse_inertia(model: &ArmModel, q: &[f64]) -> Result<f64, PlantError> {
-    let p = Probe::at(model, q, &vec![0.0; model.dof()])?;
-    Ok(p.minv
-        .symmetric_eigenvalues()
-        .iter()
-        .copied()
-        .fold(0.0, f64::max))
-}

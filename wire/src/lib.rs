@@ -31,6 +31,7 @@ mod domain;
 mod fields;
 mod messages;
 mod node;
+mod reference;
 mod topics;
 
 pub use config::{ConfigError, read_config, write_config};
@@ -39,6 +40,7 @@ pub use fields::{FieldRef, FieldSource, MessageFields};
 pub use iceoryx2::prelude::ZeroCopySend;
 pub use messages::*;
 pub use node::{Mode, NodeError, NodeLink, ns_to_s};
+pub use reference::ReferenceWindow;
 pub use topics::{
     Bus, Delivery, RunPrefix, SUBSCRIBER_BUFFER, Topic, TopicPublisher, TopicSubscriber, WireError,
     monotonic_ns,
