@@ -7,8 +7,9 @@
 //! actuation delay, lost commands; see [`PlantConfig`]). [`PlantMachine`]
 //! is its step machine in wire messages (command → joint state), driven by
 //! the plant node ([`node`], the clock of a multi-process run) and by
-//! `testbed sim`. The controller never sees anything in here: M, C and G
-//! live only in Rapier.
+//! `testbed sim`. The arm's description is [`arm_model`]'s; the controller
+//! never sees the Rapier side (its model-based reference laws evaluate the
+//! same URDF with `arm_model::dynamics`, not with Rapier).
 //!
 //! ```
 //! use plant_rapier::{ArmModel, Plant, PlantConfig, TWO_LINK_URDF};
@@ -33,111 +34,29 @@
 mod config;
 pub mod effects;
 mod machine;
-mod model;
 pub mod node;
 mod plant;
 mod rig;
 
+pub use arm_model::{
+    ArmModel, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks, MergedLink,
+    MimicJoint, MimicSpec, ModelError, Origin, TWO_LINK_URDF,
+};
 pub use config::{
     ActuationConfig, DisturbanceConfig, FrictionConfig, PayloadConfig, PerJoint, PlantConfig,
     SensorConfig,
 };
 pub use effects::Effects;
 pub use machine::PlantMachine;
-pub use model::{
-    ArmModel, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks, MergedLink,
-    MimicJoint, MimicSpec, Origin,
-};
 pub use plant::Plant;
 pub use rig::Rig;
-
-/// The paper's two-link arm (SPEC §1), embedded so the default scenario
-/// needs no files.
-pub const TWO_LINK_URDF: &str = include_str!("../../robots/two_link.urdf");
 
 /// Why an arm cannot be built or stepped. Each variant names what is wrong.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum PlantError {
-    /// The text is not a URDF document.
-    #[error("not a valid URDF: {0}")]
-    Parse(String),
-    /// Two links or two joints share a name.
-    #[error("two {what}s are named '{name}'")]
-    Duplicate {
-        /// "link" or "joint".
-        what: &'static str,
-        /// The shared name.
-        name: String,
-    },
-    /// No `<link>` at all.
-    #[error("the URDF has no links")]
-    NoLinks,
-    /// A joint names a link that does not exist.
-    #[error("joint '{joint}': {role} link '{link}' does not exist")]
-    MissingLink {
-        /// The joint.
-        joint: String,
-        /// "parent" or "child".
-        role: &'static str,
-        /// The missing link name.
-        link: String,
-    },
-    /// A link is the child of two joints.
-    #[error("link '{link}' is the child of two joints, '{first}' and '{second}'")]
-    TwoParents {
-        /// The link.
-        link: String,
-        /// First joint.
-        first: String,
-        /// Second joint.
-        second: String,
-    },
-    /// Every link has a parent: the joints form a loop.
-    #[error("the URDF has no root link (every link is some joint's child): the joints form a loop")]
-    NoRoot,
-    /// More than one link has no parent.
-    #[error("the URDF has several root links ({}); an arm needs exactly one", .0.join(", "))]
-    ManyRoots(Vec<String>),
-    /// A link cannot be reached from the root.
-    #[error("link '{link}' is on a loop of joints and cannot be reached from the root")]
-    Cycle {
-        /// A link on the loop.
-        link: String,
-    },
-    /// A joint kind the plant cannot simulate.
-    #[error(
-        "joint '{joint}' is {kind}; only revolute, continuous, prismatic and fixed joints are supported"
-    )]
-    UnsupportedJoint {
-        /// The joint.
-        joint: String,
-        /// Its kind.
-        kind: String,
-    },
-    /// A `<mimic>` that cannot be simulated.
-    #[error("joint '{joint}' has <mimic>: {reason}")]
-    Mimic {
-        /// The joint.
-        joint: String,
-        /// What is wrong with it.
-        reason: String,
-    },
-    /// An actuated joint with a zero axis.
-    #[error("joint '{joint}' has a zero-length axis")]
-    ZeroAxis {
-        /// The joint.
-        joint: String,
-    },
-    /// Lower limit above upper.
-    #[error("joint '{joint}': limit lower {lower} is above upper {upper}")]
-    BadLimits {
-        /// The joint.
-        joint: String,
-        /// Lower limit.
-        lower: f64,
-        /// Upper limit.
-        upper: f64,
-    },
+    /// The URDF or a lock cannot be read into a model.
+    #[error(transparent)]
+    Model(#[from] ModelError),
     /// Mass or inertia that no rigid body has.
     #[error("link '{link}': {reason}")]
     BadInertia {

@@ -2,9 +2,9 @@
 //! scenario's effects around it. One [`Rig::step`] is one control period.
 
 use crate::effects::{Actuator, Disturbance, Effects, Sensor, stream};
-use crate::model::ArmModel;
 use crate::plant::Plant;
 use crate::{PlantConfig, PlantError};
+use arm_model::ArmModel;
 
 /// Random streams, one per effect (see [`crate::effects`]).
 const SENSOR_STREAM: u64 = 1;
@@ -96,7 +96,7 @@ impl Rig {
                                 model.link_names().join(", ")
                             ),
                         })?;
-                let at = crate::model::iso(&frame)
+                let at = arm_model::iso(&frame)
                     * nalgebra::Point3::new(p.offset[0], p.offset[1], p.offset[2]);
                 Some(Payload {
                     link,

@@ -1,132 +1,27 @@
 //! The plant for n > 2 against an independent recursive Newton-Euler
-//! evaluation of the same URDF, written here from the model's kinematic and
-//! inertial data (nothing of Rapier's is used).
+//! evaluation of the same URDF (`arm_model::dynamics`, written from the
+//! model's kinematic and inertial data; nothing of Rapier's is used). The
+//! model-based controller laws use that same code, so this test checks
+//! their model too.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
-use plant_rapier::{ArmModel, JointKind, Origin, Plant, PlantConfig};
+use arm_model::dynamics::Dynamics;
+use plant_rapier::{ArmModel, JointKind, Plant, PlantConfig};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const G: Vector3<f64> = Vector3::new(0.0, 0.0, -9.81);
-
-fn iso(o: &Origin) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::new(o.xyz[0], o.xyz[1], o.xyz[2]),
-        UnitQuaternion::from_euler_angles(o.rpy[0], o.rpy[1], o.rpy[2]),
-    )
-}
-
-/// The coordinates of every moving joint (controlled, then mimic) from the
-/// controlled ones: q_f = multiplier · q_leader (+ offset for positions).
-fn expand(m: &ArmModel, x: &[f64], offset: bool) -> Vec<f64> {
-    let mut out = x.to_vec();
-    for c in &m.mimic {
-        out.push(c.multiplier * x[c.leader] + if offset { c.offset } else { 0.0 });
-    }
-    out
-}
-
-/// Inverse dynamics in the controlled joints' coordinates, mimic couplings
-/// and URDF damping included: the generalised force Jᵀ(M q̈ + C q̇ + G + D q̇)
-/// of the full tree, with J the coupling's Jacobian.
+/// Inverse dynamics of `arm_model::dynamics` (the model-based laws' model)
+/// plus the URDF damping the plant applies: Jᵀ(M q̈ + C q̇ + G + D q̇) of
+/// the full tree, J the mimic coupling's Jacobian.
 fn rnea(m: &ArmModel, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
-    let (qf, qdf, qddf) = (
-        expand(m, q, true),
-        expand(m, qd, false),
-        expand(m, qdd, false),
-    );
-    let full = rnea_full(m, &qf, &qdf, &qddf);
-    let moving: Vec<usize> = m.moving_joints().collect();
-    let mut tau: Vec<f64> = (0..m.dof())
-        .map(|k| full[k] + m.joints[moving[k]].damping * qdf[k])
-        .collect();
-    for (i, c) in m.mimic.iter().enumerate() {
-        let k = m.dof() + i;
-        tau[c.leader] += c.multiplier * (full[k] + m.joints[c.joint].damping * qdf[k]);
+    let mut tau = Dynamics::new(m, 1.0).inverse(q, qd, qdd).to_vec();
+    for (k, &ji) in m.actuated.iter().enumerate() {
+        tau[k] += m.joints[ji].damping * qd[k];
     }
-    tau
-}
-
-/// Inverse dynamics τ = M(q) q̈ + C(q, q̇) q̇ + G(q) of every moving joint,
-/// all in the world frame.
-fn rnea_full(m: &ArmModel, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
-    let nl = m.links.len();
-    let mut pose = vec![Isometry3::identity(); nl];
-    let mut w = vec![Vector3::zeros(); nl];
-    let mut wd = vec![Vector3::zeros(); nl];
-    // Linear acceleration of each link frame's origin.
-    let mut a = vec![Vector3::zeros(); nl];
-    let mut axis_w = vec![Vector3::zeros(); m.joints.len()];
-    let moving: Vec<usize> = m.moving_joints().collect();
-    let dof_of = |ji: usize| moving.iter().position(|&a| a == ji);
-    for &ji in &m.topological {
-        let j = &m.joints[ji];
-        let (p, c) = (j.parent, j.child);
-        let k = dof_of(ji).unwrap();
-        let ax = Vector3::new(j.axis[0], j.axis[1], j.axis[2]);
-        let motion = match j.kind {
-            JointKind::Prismatic => Isometry3::translation(ax.x * q[k], ax.y * q[k], ax.z * q[k]),
-            _ => Isometry3::from_parts(
-                Translation3::identity(),
-                UnitQuaternion::from_scaled_axis(ax * q[k]),
-            ),
-        };
-        pose[c] = pose[p] * iso(&j.origin) * motion;
-        let z = pose[c].rotation * ax;
-        axis_w[ji] = z;
-        let r = pose[c].translation.vector - pose[p].translation.vector;
-        match j.kind {
-            JointKind::Prismatic => {
-                w[c] = w[p];
-                wd[c] = wd[p];
-                a[c] = a[p]
-                    + wd[p].cross(&r)
-                    + w[p].cross(&w[p].cross(&r))
-                    + z * qdd[k]
-                    + 2.0 * w[p].cross(&(z * qd[k]));
-            }
-            _ => {
-                w[c] = w[p] + z * qd[k];
-                wd[c] = wd[p] + z * qdd[k] + w[p].cross(&(z * qd[k]));
-                a[c] = a[p] + wd[p].cross(&r) + w[p].cross(&w[p].cross(&r));
-            }
-        }
-    }
-    // Backward pass: force and moment (about the link frame origin) each
-    // link's joint must supply.
-    let mut f = vec![Vector3::zeros(); nl];
-    let mut n = vec![Vector3::zeros(); nl];
-    for (li, l) in m.links.iter().enumerate() {
-        if li == m.root {
-            continue;
-        }
-        let io = iso(&l.inertial_origin);
-        let com = pose[li] * Point3::from(io.translation.vector);
-        let rc = com.coords - pose[li].translation.vector;
-        let [ixx, ixy, ixz, iyy, iyz, izz] = l.inertia;
-        let i_local = Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
-        let rot = (pose[li].rotation * io.rotation).to_rotation_matrix();
-        let i_w = rot.matrix() * i_local * rot.matrix().transpose();
-        let a_com = a[li] + wd[li].cross(&rc) + w[li].cross(&w[li].cross(&rc));
-        let fi = l.mass * (a_com - G);
-        f[li] = fi;
-        n[li] = rc.cross(&fi) + i_w * wd[li] + w[li].cross(&(i_w * w[li]));
-    }
-    let mut tau = vec![0.0; moving.len()];
-    for &ji in m.topological.iter().rev() {
-        let j = &m.joints[ji];
-        let (p, c) = (j.parent, j.child);
-        let k = dof_of(ji).unwrap();
-        tau[k] = match j.kind {
-            JointKind::Prismatic => f[c].dot(&axis_w[ji]),
-            _ => n[c].dot(&axis_w[ji]),
-        };
-        let r = pose[c].translation.vector - pose[p].translation.vector;
-        let (fc, nc) = (f[c], n[c]);
-        f[p] += fc;
-        n[p] += nc + r.cross(&fc);
+    for c in &m.mimic {
+        let v = c.multiplier * qd[c.leader];
+        tau[c.leader] += c.multiplier * m.joints[c.joint].damping * v;
     }
     tau
 }

@@ -33,8 +33,11 @@ impl RobotSource {
             file: file.clone(),
             cause,
         })?;
-        let model = ArmModel::from_urdf_str_locked(&urdf, locks)
-            .map_err(|cause| ScenarioError::Plant { file, cause })?;
+        let model =
+            ArmModel::from_urdf_str_locked(&urdf, locks).map_err(|cause| ScenarioError::Plant {
+                file,
+                cause: cause.into(),
+            })?;
         Ok(Self {
             path: Some(path.to_path_buf()),
             urdf,
@@ -47,7 +50,7 @@ impl RobotSource {
         let model = ArmModel::from_urdf_str_locked(&self.urdf, locks).map_err(|cause| {
             ScenarioError::Plant {
                 file: self.label(),
-                cause,
+                cause: cause.into(),
             }
         })?;
         Ok(Self {
@@ -61,7 +64,7 @@ impl RobotSource {
         let model =
             ArmModel::from_urdf_str_locked(urdf, locks).map_err(|cause| ScenarioError::Plant {
                 file: label.to_string(),
-                cause,
+                cause: cause.into(),
             })?;
         Ok(Self {
             path: Some(PathBuf::from(label)),

@@ -4,8 +4,8 @@
 use rapier3d_f64::prelude::*;
 
 use super::{Coupled, Dof, pose};
-use crate::model::{ArmModel, JointKind};
 use crate::{PlantConfig, PlantError};
+use arm_model::{ArmModel, JointKind};
 
 /// Where controlled joint `ji` lives in the multibody.
 pub(super) fn dof_of(
@@ -140,7 +140,7 @@ pub(super) fn mass_properties(link: &crate::LinkInfo) -> MassProperties {
     let [ixx, ixy, ixz, iyy, iyz, izz] = link.inertia;
     let tensor = nalgebra::Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
     // URDF gives the tensor in the inertial frame; Rapier wants it in the link frame.
-    let frame = crate::model::iso(&link.inertial_origin);
+    let frame = arm_model::iso(&link.inertial_origin);
     let r = frame.rotation.to_rotation_matrix();
     let in_link = r.matrix() * tensor * r.matrix().transpose();
     let eigen = in_link.symmetric_eigen();

@@ -3,8 +3,8 @@
 use rapier3d_f64::glamx::EulerRot;
 use rapier3d_f64::prelude::*;
 
-use crate::model::{ArmModel, Origin};
 use crate::{PlantConfig, PlantError};
+use arm_model::{ArmModel, Origin};
 
 mod build;
 

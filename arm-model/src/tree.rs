@@ -11,15 +11,15 @@ use super::{
     ArmModel, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks, MergedLink,
     MimicJoint,
 };
-use crate::PlantError;
+use crate::ModelError;
 
 /// Parses, checks and simplifies a URDF robot.
-pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, PlantError> {
+pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, ModelError> {
     let mut index = HashMap::new();
     let mut links = Vec::with_capacity(robot.links.len());
     for (i, l) in robot.links.iter().enumerate() {
         if index.insert(l.name.clone(), i).is_some() {
-            return Err(PlantError::Duplicate {
+            return Err(ModelError::Duplicate {
                 what: "link",
                 name: l.name.clone(),
             });
@@ -27,21 +27,21 @@ pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, P
         links.push(link_info(l)?);
     }
     if links.is_empty() {
-        return Err(PlantError::NoLinks);
+        return Err(ModelError::NoLinks);
     }
     let mut joints = Vec::with_capacity(robot.joints.len());
     let mut parent_of: Vec<Option<usize>> = vec![None; links.len()];
     let mut joint_names = HashMap::new();
     for (ji, j) in robot.joints.iter().enumerate() {
         if joint_names.insert(j.name.clone(), ji).is_some() {
-            return Err(PlantError::Duplicate {
+            return Err(ModelError::Duplicate {
                 what: "joint",
                 name: j.name.clone(),
             });
         }
         let info = joint_info(j, &index)?;
         if let Some(other) = parent_of[info.child] {
-            return Err(PlantError::TwoParents {
+            return Err(ModelError::TwoParents {
                 link: links[info.child].name.clone(),
                 first: robot.joints[other].name.clone(),
                 second: j.name.clone(),
@@ -61,7 +61,7 @@ pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, P
     Ok(model)
 }
 
-fn find_root(links: &[LinkInfo], joints: &[JointInfo]) -> Result<usize, PlantError> {
+fn find_root(links: &[LinkInfo], joints: &[JointInfo]) -> Result<usize, ModelError> {
     let mut has_parent = vec![false; links.len()];
     for j in joints {
         has_parent[j.child] = true;
@@ -69,8 +69,8 @@ fn find_root(links: &[LinkInfo], joints: &[JointInfo]) -> Result<usize, PlantErr
     let roots: Vec<usize> = (0..links.len()).filter(|&i| !has_parent[i]).collect();
     match roots.as_slice() {
         [r] => Ok(*r),
-        [] => Err(PlantError::NoRoot),
-        many => Err(PlantError::ManyRoots(
+        [] => Err(ModelError::NoRoot),
+        many => Err(ModelError::ManyRoots(
             many.iter().map(|&i| links[i].name.clone()).collect(),
         )),
     }
@@ -82,7 +82,7 @@ fn depth_first(
     links: &[LinkInfo],
     joints: &[JointInfo],
     root: usize,
-) -> Result<Vec<usize>, PlantError> {
+) -> Result<Vec<usize>, ModelError> {
     let mut children: Vec<Vec<usize>> = vec![Vec::new(); links.len()];
     for (ji, j) in joints.iter().enumerate() {
         children[j.parent].push(ji);
@@ -101,7 +101,7 @@ fn depth_first(
         stack.extend(children[child].iter().rev());
     }
     match reached.iter().position(|r| !r) {
-        Some(i) => Err(PlantError::Cycle {
+        Some(i) => Err(ModelError::Cycle {
             link: links[i].name.clone(),
         }),
         None => Ok(order),
@@ -112,11 +112,11 @@ fn depth_first(
 /// with the multiplier and offset composed along the chain.
 type Leaders = HashMap<String, (String, f64, f64)>;
 
-fn resolve_mimics(joints: &[JointInfo]) -> Result<Leaders, PlantError> {
+fn resolve_mimics(joints: &[JointInfo]) -> Result<Leaders, ModelError> {
     let by_name: HashMap<&str, &JointInfo> = joints.iter().map(|j| (j.name.as_str(), j)).collect();
     let mut out = Leaders::new();
     for j in joints {
-        let mimic_err = |reason: String| PlantError::Mimic {
+        let mimic_err = |reason: String| ModelError::Mimic {
             joint: j.name.clone(),
             reason,
         };
@@ -158,8 +158,8 @@ fn apply_locks(
     joints: &mut [JointInfo],
     leaders: &Leaders,
     locks: &Locks,
-) -> Result<Vec<LockedJoint>, PlantError> {
-    let invalid = |name: &str, value: f64, need: String| PlantError::InvalidConfig {
+) -> Result<Vec<LockedJoint>, ModelError> {
+    let invalid = |name: &str, value: f64, need: String| ModelError::InvalidConfig {
         key: format!("plant.lock.{name}"),
         value: value.to_string(),
         need,
@@ -242,7 +242,7 @@ fn settle_masses(
     links: &mut [LinkInfo],
     joints: &[JointInfo],
     root: usize,
-) -> Result<(Vec<IgnoredLink>, Vec<String>), PlantError> {
+) -> Result<(Vec<IgnoredLink>, Vec<String>), ModelError> {
     // Links reached from the root through fixed joints only never move.
     let mut moves = vec![false; links.len()];
     let mut welded = vec![false; links.len()];
@@ -360,7 +360,7 @@ fn finish(
     leaders: &Leaders,
     locked: Vec<LockedJoint>,
     ignored: Vec<IgnoredLink>,
-) -> Result<ArmModel, PlantError> {
+) -> Result<ArmModel, ModelError> {
     let root = find_root(&f.links, &f.joints)?;
     let topological = depth_first(&f.links, &f.joints, root)?;
     let actuated: Vec<usize> = topological
@@ -369,7 +369,7 @@ fn finish(
         .filter(|&ji| !leaders.contains_key(&f.joints[ji].name))
         .collect();
     if actuated.is_empty() {
-        return Err(PlantError::NoActuatedJoints);
+        return Err(ModelError::NoActuatedJoints);
     }
     let mut mimic = Vec::new();
     for &ji in &topological {
@@ -379,7 +379,7 @@ fn finish(
         let leader = actuated
             .iter()
             .position(|&a| &f.joints[a].name == leader)
-            .ok_or_else(|| PlantError::Mimic {
+            .ok_or_else(|| ModelError::Mimic {
                 joint: f.joints[ji].name.clone(),
                 reason: format!("it follows '{leader}', which is not a controlled joint"),
             })?;

@@ -35,8 +35,7 @@ fn the_two_link_arm_reads_as_specified() {
 /// 0.1 m, I = 0.5·0.2²/12 about it) folds into link3 by the parallel-axis theorem.
 #[test]
 fn fixed_joint_mass_merges_into_the_parent() {
-    let m =
-        ArmModel::from_urdf_str(include_str!("../../../robots/three_link_planar.urdf")).unwrap();
+    let m = ArmModel::from_urdf_str(include_str!("../../robots/three_link_planar.urdf")).unwrap();
     assert_eq!(m.dof(), 3);
     assert!(m.links.iter().all(|l| l.name != "tool"));
     let l3 = m.links.iter().find(|l| l.name == "link3").unwrap();
@@ -283,5 +282,5 @@ fn bad_locks_name_the_key() {
     assert!(lock_err("arm", f64::NAN).contains("plant.lock.arm = NaN"));
     let all: Locks = [("arm".to_string(), 0.0), ("finger1".to_string(), 0.0)].into();
     let e = ArmModel::from_urdf_str_locked(&text, &all).unwrap_err();
-    assert_eq!(e, PlantError::NoActuatedJoints);
+    assert_eq!(e, ModelError::NoActuatedJoints);
 }

@@ -4,13 +4,14 @@
 use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
 
 use super::{LinkInfo, Origin};
-use crate::PlantError;
+use crate::ModelError;
 
 /// A link lighter than this fraction of the heaviest moving link is
 /// negligible: real URDFs use 1e-9 kg for frames that are not bodies.
 pub(super) const NEGLIGIBLE_MASS_RATIO: f64 = 1e-6;
 
-pub(crate) fn iso(o: &Origin) -> Isometry3<f64> {
+/// The rigid transform of a URDF `<origin>`.
+pub fn iso(o: &Origin) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(o.xyz[0], o.xyz[1], o.xyz[2]),
         UnitQuaternion::from_euler_angles(o.rpy[0], o.rpy[1], o.rpy[2]),
@@ -81,9 +82,9 @@ const TRIANGLE_SLACK: f64 = 0.25;
 /// inequality. Rounding in published files is allowed for: a tensor that
 /// breaks the inequality by at most 25 % (published files do) is still positive semi-definite and
 /// simulates; the note returned says so.
-pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Option<String>, PlantError> {
+pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Option<String>, ModelError> {
     let bad = |reason: String| {
-        Err(PlantError::BadInertia {
+        Err(ModelError::BadInertia {
             link: link.to_string(),
             reason,
         })

@@ -4,17 +4,17 @@
 use std::collections::HashMap;
 
 use super::{JointInfo, JointKind, LinkInfo, MimicSpec, Origin};
-use crate::PlantError;
+use crate::ModelError;
 
-fn finite(field: String, v: f64) -> Result<f64, PlantError> {
+fn finite(field: String, v: f64) -> Result<f64, ModelError> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(PlantError::NotFinite { field, value: v })
+        Err(ModelError::NotFinite { field, value: v })
     }
 }
 
-fn origin(field: &str, o: &urdf_rs::Pose) -> Result<Origin, PlantError> {
+fn origin(field: &str, o: &urdf_rs::Pose) -> Result<Origin, ModelError> {
     let mut out = Origin::default();
     for k in 0..3 {
         out.xyz[k] = finite(format!("{field} origin xyz"), o.xyz.0[k])?;
@@ -25,11 +25,11 @@ fn origin(field: &str, o: &urdf_rs::Pose) -> Result<Origin, PlantError> {
 
 /// A link's mass properties as written; only a negative mass is refused
 /// here (what a link of no mass lists is judged later).
-pub(super) fn link_info(l: &urdf_rs::Link) -> Result<LinkInfo, PlantError> {
+pub(super) fn link_info(l: &urdf_rs::Link) -> Result<LinkInfo, ModelError> {
     let field = format!("link '{}'", l.name);
     let mass = finite(format!("{field} mass"), l.inertial.mass.value)?;
     if mass < 0.0 {
-        return Err(PlantError::BadInertia {
+        return Err(ModelError::BadInertia {
             link: l.name.clone(),
             reason: format!("mass {mass} is negative"),
         });
@@ -47,21 +47,21 @@ pub(super) fn link_info(l: &urdf_rs::Link) -> Result<LinkInfo, PlantError> {
     })
 }
 
-fn kind_of(j: &urdf_rs::Joint) -> Result<JointKind, PlantError> {
+fn kind_of(j: &urdf_rs::Joint) -> Result<JointKind, ModelError> {
     use urdf_rs::JointType as T;
     match j.joint_type {
         T::Revolute => Ok(JointKind::Revolute),
         T::Continuous => Ok(JointKind::Continuous),
         T::Prismatic => Ok(JointKind::Prismatic),
         T::Fixed => Ok(JointKind::Fixed),
-        T::Floating | T::Planar | T::Spherical => Err(PlantError::UnsupportedJoint {
+        T::Floating | T::Planar | T::Spherical => Err(ModelError::UnsupportedJoint {
             joint: j.name.clone(),
             kind: format!("{:?}", j.joint_type).to_lowercase(),
         }),
     }
 }
 
-fn mimic(j: &urdf_rs::Joint, field: &str) -> Result<Option<MimicSpec>, PlantError> {
+fn mimic(j: &urdf_rs::Joint, field: &str) -> Result<Option<MimicSpec>, ModelError> {
     let Some(m) = &j.mimic else {
         return Ok(None);
     };
@@ -79,13 +79,13 @@ fn mimic(j: &urdf_rs::Joint, field: &str) -> Result<Option<MimicSpec>, PlantErro
 pub(super) fn joint_info(
     j: &urdf_rs::Joint,
     index: &HashMap<String, usize>,
-) -> Result<JointInfo, PlantError> {
+) -> Result<JointInfo, ModelError> {
     let kind = kind_of(j)?;
     let link = |name: &str, role: &'static str| {
         index
             .get(name)
             .copied()
-            .ok_or_else(|| PlantError::MissingLink {
+            .ok_or_else(|| ModelError::MissingLink {
                 joint: j.name.clone(),
                 role,
                 link: name.to_string(),
@@ -94,7 +94,7 @@ pub(super) fn joint_info(
     let parent = link(&j.parent.link, "parent")?;
     let child = link(&j.child.link, "child")?;
     if parent == child {
-        return Err(PlantError::Cycle {
+        return Err(ModelError::Cycle {
             link: j.child.link.clone(),
         });
     }
@@ -106,7 +106,7 @@ pub(super) fn joint_info(
     let norm = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
     if kind.is_actuated() {
         if norm < 1e-9 {
-            return Err(PlantError::ZeroAxis {
+            return Err(ModelError::ZeroAxis {
                 joint: j.name.clone(),
             });
         }
@@ -139,7 +139,7 @@ fn limits(
     j: &urdf_rs::Joint,
     kind: JointKind,
     field: &str,
-) -> Result<Option<(f64, f64)>, PlantError> {
+) -> Result<Option<(f64, f64)>, ModelError> {
     let lower = finite(format!("{field} limit lower"), j.limit.lower)?;
     let upper = finite(format!("{field} limit upper"), j.limit.upper)?;
     // A revolute or prismatic joint without a usable <limit> (lower = upper,
@@ -147,7 +147,7 @@ fn limits(
     Ok(match kind {
         JointKind::Revolute | JointKind::Prismatic if lower < upper => Some((lower, upper)),
         JointKind::Revolute | JointKind::Prismatic if lower > upper => {
-            return Err(PlantError::BadLimits {
+            return Err(ModelError::BadLimits {
                 joint: j.name.clone(),
                 lower,
                 upper,
@@ -158,7 +158,7 @@ fn limits(
 }
 
 /// `<dynamics damping friction>`, both ≥ 0 (zero when absent).
-fn dynamics(j: &urdf_rs::Joint, field: &str) -> Result<(f64, f64), PlantError> {
+fn dynamics(j: &urdf_rs::Joint, field: &str) -> Result<(f64, f64), ModelError> {
     let (damping, friction) = match &j.dynamics {
         Some(d) => (
             finite(format!("{field} dynamics damping"), d.damping)?,
@@ -168,7 +168,7 @@ fn dynamics(j: &urdf_rs::Joint, field: &str) -> Result<(f64, f64), PlantError> {
     };
     for (what, v) in [("damping", damping), ("friction", friction)] {
         if v < 0.0 {
-            return Err(PlantError::InvalidConfig {
+            return Err(ModelError::InvalidConfig {
                 key: format!("{field} dynamics {what}"),
                 value: v.to_string(),
                 need: "≥ 0".into(),

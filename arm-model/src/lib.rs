@@ -1,22 +1,40 @@
-//! A URDF arm read into a checked, engine-neutral description.
+//! A URDF arm read into a checked, engine-neutral description, and its
+//! rigid-body dynamics computed from that description alone.
 //!
-//! Parsing and checking happen here, once, so that the Rapier builder only
-//! ever sees a tree it can simulate, and every problem is reported with the
-//! link or joint it concerns. The loader is as lenient as the format is in
-//! practice: a link of zero or negligible mass contributes nothing whatever
-//! inertia it lists, the fixed root's mass properties are irrelevant,
-//! `<mimic>` joints become coupled joints, and joints a scenario locks
-//! become fixed ones.
+//! Where it sits: under both ends of the loop. The plant (`plant-rapier`)
+//! builds its Rapier multibody from an [`ArmModel`]; the model-based
+//! reference laws of the controller (`pd-gravity`, `ctc`) evaluate M, C and
+//! G with [`dynamics`], a recursive Newton–Euler written from the same data
+//! and sharing nothing with Rapier. Parsing and checking happen here, once,
+//! so that every consumer sees a tree it can use, and every problem is
+//! reported with the link or joint it concerns. The loader is as lenient as
+//! the format is in practice: a link of zero or negligible mass contributes
+//! nothing whatever inertia it lists, the fixed root's mass properties are
+//! irrelevant, `<mimic>` joints become coupled joints, and joints a scenario
+//! locks become fixed ones.
+//!
+//! ```
+//! use arm_model::{ArmModel, TWO_LINK_URDF, dynamics::Dynamics};
+//! let model = ArmModel::from_urdf_str(TWO_LINK_URDF).unwrap();
+//! let mut dynamics = Dynamics::new(&model, 1.0);
+//! let g = dynamics.gravity(&[0.0, 0.0]).to_vec();
+//! assert!(g[0] > 0.0); // holding the arm level takes a positive shoulder torque
+//! ```
 
+pub mod dynamics;
+mod error;
 mod inertia;
 mod parse;
 mod tree;
 
 use std::collections::BTreeMap;
 
-use crate::PlantError;
+pub use error::ModelError;
+pub use inertia::iso;
 
-pub(crate) use inertia::iso;
+/// The paper's two-link arm (SPEC §1), embedded so the default scenario
+/// needs no files.
+pub const TWO_LINK_URDF: &str = include_str!("../../robots/two_link.urdf");
 
 /// A rigid transform from a URDF `<origin xyz rpy>`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -195,15 +213,15 @@ pub type Locks = BTreeMap<String, f64>;
 
 impl ArmModel {
     /// Parses and checks a URDF document.
-    pub fn from_urdf_str(text: &str) -> Result<Self, PlantError> {
+    pub fn from_urdf_str(text: &str) -> Result<Self, ModelError> {
         Self::from_urdf_str_locked(text, &Locks::new())
     }
 
     /// Parses and checks a URDF document with the joints in `locks` held
     /// at the given positions.
-    pub fn from_urdf_str_locked(text: &str, locks: &Locks) -> Result<Self, PlantError> {
+    pub fn from_urdf_str_locked(text: &str, locks: &Locks) -> Result<Self, ModelError> {
         let robot =
-            urdf_rs::read_from_string(text).map_err(|e| PlantError::Parse(e.to_string()))?;
+            urdf_rs::read_from_string(text).map_err(|e| ModelError::Parse(e.to_string()))?;
         tree::build(&robot, locks)
     }
 

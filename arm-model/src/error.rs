@@ -1,0 +1,115 @@
+//! Why a URDF cannot be read into an [`ArmModel`](crate::ArmModel).
+
+/// What is wrong with a URDF or a lock. Each variant names the element.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ModelError {
+    /// The text is not a URDF document.
+    #[error("not a valid URDF: {0}")]
+    Parse(String),
+    /// Two links or two joints share a name.
+    #[error("two {what}s are named '{name}'")]
+    Duplicate {
+        /// "link" or "joint".
+        what: &'static str,
+        /// The shared name.
+        name: String,
+    },
+    /// No `<link>` at all.
+    #[error("the URDF has no links")]
+    NoLinks,
+    /// A joint names a link that does not exist.
+    #[error("joint '{joint}': {role} link '{link}' does not exist")]
+    MissingLink {
+        /// The joint.
+        joint: String,
+        /// "parent" or "child".
+        role: &'static str,
+        /// The missing link name.
+        link: String,
+    },
+    /// A link is the child of two joints.
+    #[error("link '{link}' is the child of two joints, '{first}' and '{second}'")]
+    TwoParents {
+        /// The link.
+        link: String,
+        /// First joint.
+        first: String,
+        /// Second joint.
+        second: String,
+    },
+    /// Every link has a parent: the joints form a loop.
+    #[error("the URDF has no root link (every link is some joint's child): the joints form a loop")]
+    NoRoot,
+    /// More than one link has no parent.
+    #[error("the URDF has several root links ({}); an arm needs exactly one", .0.join(", "))]
+    ManyRoots(Vec<String>),
+    /// A link cannot be reached from the root.
+    #[error("link '{link}' is on a loop of joints and cannot be reached from the root")]
+    Cycle {
+        /// A link on the loop.
+        link: String,
+    },
+    /// A joint kind the plant cannot simulate.
+    #[error(
+        "joint '{joint}' is {kind}; only revolute, continuous, prismatic and fixed joints are supported"
+    )]
+    UnsupportedJoint {
+        /// The joint.
+        joint: String,
+        /// Its kind.
+        kind: String,
+    },
+    /// A `<mimic>` that cannot be simulated.
+    #[error("joint '{joint}' has <mimic>: {reason}")]
+    Mimic {
+        /// The joint.
+        joint: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// An actuated joint with a zero axis.
+    #[error("joint '{joint}' has a zero-length axis")]
+    ZeroAxis {
+        /// The joint.
+        joint: String,
+    },
+    /// Lower limit above upper.
+    #[error("joint '{joint}': limit lower {lower} is above upper {upper}")]
+    BadLimits {
+        /// The joint.
+        joint: String,
+        /// Lower limit.
+        lower: f64,
+        /// Upper limit.
+        upper: f64,
+    },
+    /// Mass or inertia that no rigid body has.
+    #[error("link '{link}': {reason}")]
+    BadInertia {
+        /// The link.
+        link: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Only fixed joints.
+    #[error("the URDF has no actuated (revolute, continuous or prismatic) joint")]
+    NoActuatedJoints,
+    /// A NaN or infinite number.
+    #[error("{field}: {value} is not a finite number")]
+    NotFinite {
+        /// Where it was found.
+        field: String,
+        /// The value.
+        value: f64,
+    },
+    /// A setting out of range (a lock, say).
+    #[error("{key} = {value} is invalid: it must be {need}")]
+    InvalidConfig {
+        /// The scenario key.
+        key: String,
+        /// The value.
+        value: String,
+        /// What it must be.
+        need: String,
+    },
+}
