@@ -1,6 +1,8 @@
-//! One control step of the paper's law (SPEC §4–§10).
+//! One control step of the paper's law (SPEC §4–§10), and of its ablations
+//! and the classic barrier law (BASELINES.md), which switch parts of it off.
 
 use crate::params::{BarrierMode, ControllerParams, Integrator};
+use crate::LawName;
 use crate::rbf::Rbf;
 use crate::shifting::shifting;
 use crate::weight_update::{advance_euler, advance_exact};
@@ -20,16 +22,67 @@ pub struct ControllerInput<'a> {
     pub q_d: &'a [f64],
     /// Desired velocities q̇_d(t).
     pub qd_d: &'a [f64],
+    /// Desired accelerations q̈_d(t) (only `ctc` uses them).
+    pub qdd_d: &'a [f64],
     /// Envelope k_c(t) (> 0).
     pub kc: &'a [f64],
     /// Envelope rate k̇_c(t).
     pub kc_dot: &'a [f64],
 }
 
+/// Which parts of the paper's law are on (BASELINES.md: its ablations and
+/// `blf` are the same law with parts switched off).
+#[derive(Debug, Clone, Copy)]
+struct Parts {
+    /// γ(t) from SPEC §4; off: γ ≡ 1, γ̇ ≡ 0.
+    shift: bool,
+    /// The actor and the critic; off: actor output ≡ 0, no updates.
+    networks: bool,
+    /// The critic; off: Ĵ ≡ 0, critic not updated.
+    critic: bool,
+    /// The barrier's β (1 for `blf`).
+    beta: f64,
+}
+
+impl Parts {
+    fn of(p: &ControllerParams) -> Result<Self, ControllerError> {
+        let all = Parts {
+            shift: true,
+            networks: true,
+            critic: true,
+            beta: p.beta,
+        };
+        Ok(match p.law {
+            LawName::Nac => all,
+            LawName::NacNoShift => Parts { shift: false, ..all },
+            LawName::NacNoCritic => Parts { critic: false, ..all },
+            LawName::NacNoNetworks => Parts {
+                networks: false,
+                critic: false,
+                ..all
+            },
+            LawName::Blf => Parts {
+                shift: false,
+                networks: false,
+                critic: false,
+                beta: 1.0,
+            },
+            other => {
+                return Err(ControllerError::InvalidParameter {
+                    key: "controller.law".into(),
+                    value: other.to_string(),
+                    need: "the paper's law, an ablation of it, or blf".into(),
+                });
+            }
+        })
+    }
+}
+
 /// The controller: parameters, the two networks and their weights.
 #[derive(Debug, Clone)]
 pub struct Controller {
     p: ControllerParams,
+    parts: Parts,
     n: usize,
     /// K1_i and K2_i resolved for the n joints.
     k1: Vec<f64>,
@@ -59,26 +112,30 @@ impl Controller {
         if dof == 0 {
             return Err(ControllerError::NoJoints);
         }
-        let nn = params.neurons;
-        let rbf = || Rbf::new(nn, params.center_min, params.center_max, params.width);
+        let parts = Parts::of(&params)?;
+        let p = &params;
+        let rbf = |dim| Rbf::new(p.rbf_layout, p.neurons, dim, p.center_min, p.center_max, p.width);
+        let (actor, critic) = (rbf(4 * dof), rbf(2 * dof));
+        let (na, nc) = (actor.len(), critic.len());
         let k1 = params.k1.resolve("controller.k1", dof)?;
         let k2 = params.k2.resolve("controller.k2", dof)?;
         Ok(Self {
             k1,
             k2,
-            actor: rbf(),
-            critic: rbf(),
+            actor,
+            critic,
+            parts,
             n: dof,
-            wa: vec![0.0; nn * dof],
-            wc: vec![0.0; nn],
+            wa: vec![0.0; na * dof],
+            wc: vec![0.0; nc],
             prev_zc: vec![0.0; 2 * dof],
             prev_t: None,
             za: vec![0.0; 4 * dof],
             zc: vec![0.0; 2 * dof],
             zc_dot: vec![0.0; 2 * dof],
-            sa: vec![0.0; nn],
-            sc: vec![0.0; nn],
-            lambda: vec![0.0; nn],
+            sa: vec![0.0; na],
+            sc: vec![0.0; nc],
+            lambda: vec![0.0; nc],
             p: params,
         })
     }
@@ -93,7 +150,7 @@ impl Controller {
         &self.p
     }
 
-    /// Actor weights Ŵ_a (N×n, column-major).
+    /// Actor weights Ŵ_a (features × n, column-major).
     pub fn actor_weights(&self) -> &[f64] {
         &self.wa
     }
@@ -119,7 +176,7 @@ impl Controller {
         out.fault = None;
         out.barrier_breached = false;
         if let Some(fault) = check_input(input, n) {
-            self.publish_fault(out, fault);
+            publish_fault(out, fault);
             return;
         }
         self.errors_and_barrier(input, out);
@@ -130,7 +187,7 @@ impl Controller {
             && out.delta.is_finite()
             && self.lambda.iter().all(|x| x.is_finite());
         if !finite_out {
-            self.publish_fault(out, Fault::NonFiniteOutput);
+            publish_fault(out, Fault::NonFiniteOutput);
             return;
         }
 
@@ -141,7 +198,12 @@ impl Controller {
     fn errors_and_barrier(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
         let n = self.n;
         let p = &self.p;
-        let (gamma, gamma_dot) = shifting(input.t, p.tc);
+        let beta = self.parts.beta;
+        let (gamma, gamma_dot) = if self.parts.shift {
+            shifting(input.t, p.tc)
+        } else {
+            (1.0, 0.0)
+        };
         out.gamma = gamma;
         out.gamma_dot = gamma_dot;
 
@@ -188,11 +250,11 @@ impl Controller {
             out.d[i] = d_raw;
             let z1 = out.z1[i];
             out.alpha[i] = -self.k1[i] * z1
-                - p.a * gamma_dot * gamma_dot * z1 * z1_sq / (p.beta * d)
+                - p.a * gamma_dot * gamma_dot * z1 * z1_sq / (beta * d)
                 + input.qd_d[i]
                 + (kc_dot / kc) * z1;
             out.z2[i] = input.qd[i] - out.alpha[i];
-            out.tau_barrier[i] = -gamma * out.z1g[i] / (p.beta * d);
+            out.tau_barrier[i] = -gamma * out.z1g[i] / (beta * d);
         }
     }
 
@@ -206,14 +268,20 @@ impl Controller {
         self.za[3 * n..].copy_from_slice(&out.z2);
         self.zc[..n].copy_from_slice(&out.z1);
         self.zc[n..].copy_from_slice(&out.z2);
-        self.actor.features(&self.za, &mut self.sa);
-        self.critic.features(&self.zc, &mut self.sc);
+        // Switched-off networks keep S = 0, so their outputs are 0.
+        if self.parts.networks {
+            self.actor.features(&self.za, &mut self.sa);
+        }
+        if self.parts.critic {
+            self.critic.features(&self.zc, &mut self.sc);
+        }
 
         let nn = self.sa.len();
         for j in 0..n {
             let col = &self.wa[j * nn..(j + 1) * nn];
             out.tau_actor[j] = dot(col, &self.sa);
             out.tau_feedback[j] = -self.k2[j] * out.z2[j];
+            out.tau_model[j] = 0.0;
             out.tau[j] = out.tau_actor[j] + out.tau_feedback[j] + out.tau_barrier[j];
             out.wa_norm[j] = dot(col, col).sqrt();
         }
@@ -225,6 +293,11 @@ impl Controller {
     fn critic_signals(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
         let p = &self.p;
         out.r = p.q_weight * dot(&self.zc, &self.zc) + p.r_weight * dot(&out.tau, &out.tau);
+        if !self.parts.critic {
+            // Ŵ_c stays 0, so δ = r whatever Λ is.
+            out.delta = out.r;
+            return;
+        }
         match self.prev_t {
             Some(t0) if input.t > t0 => {
                 let h = input.t - t0;
@@ -251,28 +324,36 @@ impl Controller {
             Integrator::Exact => advance_exact,
             Integrator::Euler => advance_euler,
         };
-        advance(&mut self.wc, &self.lambda, out.r, p.sigma_c, p.eta_c, dt);
+        self.prev_zc.copy_from_slice(&self.zc);
+        self.prev_t = Some(out.t);
+        if self.parts.critic {
+            advance(&mut self.wc, &self.lambda, out.r, p.sigma_c, p.eta_c, dt);
+        }
+        if !self.parts.networks {
+            return;
+        }
         for j in 0..n {
             let c = out.z2[j] / p.sigma_a + p.k_a * out.j_hat;
             let col = &mut self.wa[j * nn..(j + 1) * nn];
             advance(col, &self.sa, c, p.sigma_a, p.eta_a, dt);
         }
-        self.prev_zc.copy_from_slice(&self.zc);
-        self.prev_t = Some(out.t);
     }
 
-    fn publish_fault(&self, out: &mut Diagnostics, fault: Fault) {
-        out.fault = Some(fault);
-        out.tau.iter_mut().for_each(|x| *x = 0.0);
-    }
 }
 
-fn check_input(input: &ControllerInput<'_>, n: usize) -> Option<Fault> {
+/// A step that publishes zero torque because of `fault` (SPEC §10).
+pub(crate) fn publish_fault(out: &mut Diagnostics, fault: Fault) {
+    out.fault = Some(fault);
+    out.tau.iter_mut().for_each(|x| *x = 0.0);
+}
+
+pub(crate) fn check_input(input: &ControllerInput<'_>, n: usize) -> Option<Fault> {
     let slices = [
         input.q,
         input.qd,
         input.q_d,
         input.qd_d,
+        input.qdd_d,
         input.kc,
         input.kc_dot,
     ];
@@ -289,7 +370,7 @@ fn check_input(input: &ControllerInput<'_>, n: usize) -> Option<Fault> {
     None
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 

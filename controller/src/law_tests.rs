@@ -4,6 +4,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::*;
+use crate::{LawName, RbfLayout};
 use proptest::prelude::*;
 
 const Q: [f64; 2] = [0.3, 1.0];
@@ -12,6 +13,7 @@ const Q_D: [f64; 2] = [0.2, 1.1];
 const QD_D: [f64; 2] = [0.5, 0.3];
 const KC: [f64; 2] = [0.5, 0.4];
 const KC_DOT: [f64; 2] = [0.05, -0.02];
+const QDD_D: [f64; 2] = [0.0, 0.0];
 
 /// t = 1 s with T_c = 2 s: γ = 0.875, γ̇ = 0.375.
 fn input() -> ControllerInput<'static> {
@@ -21,6 +23,7 @@ fn input() -> ControllerInput<'static> {
         qd: &QD,
         q_d: &Q_D,
         qd_d: &QD_D,
+        qdd_d: &QDD_D,
         kc: &KC,
         kc_dot: &KC_DOT,
     }
@@ -84,7 +87,7 @@ fn tau_is_the_sum_of_its_three_terms_and_actor_uses_the_weights() {
     let wa = c.actor_weights().to_vec();
     c.step(1e-3, &later, &mut d);
     let nn = c.params().neurons;
-    let rbf = Rbf::new(nn, -5.0, 5.0, 1.0);
+    let rbf = Rbf::new(RbfLayout::Diagonal, nn, 8, -5.0, 5.0, 1.0);
     let za: Vec<f64> = [&Q[..], &QD[..], &d.z1[..], &d.z2[..]].concat();
     let mut sa = vec![0.0; nn];
     rbf.features(&za, &mut sa);
@@ -167,7 +170,7 @@ fn first_step_uses_zero_zc_dot_and_the_critic_sees_r() {
     assert_eq!(d.delta, d.r);
     assert_eq!((d.j_hat, d.wc_norm), (0.0, 0.0));
     // Critic moved along Λ = −S_c: Ŵ_c = exact update from 0 with s = Λ, c = r.
-    let rbf = Rbf::new(10, -5.0, 5.0, 1.0);
+    let rbf = Rbf::new(RbfLayout::Diagonal, 10, 4, -5.0, 5.0, 1.0);
     let mut sc = [0.0; 10];
     rbf.features(&zc, &mut sc);
     let lambda: Vec<f64> = sc.iter().map(|s| -s).collect();
@@ -188,7 +191,7 @@ fn euler_integrator_takes_one_euler_step() {
     // From zero weights Euler gives Ŵ_a[:, j] = −Δt σ_a c_j S_a with c_j = Z2_j/σ_a + k_a Ĵ (Ĵ = 0).
     let za: Vec<f64> = [&Q[..], &QD[..], &d.z1[..], &d.z2[..]].concat();
     let mut sa = [0.0; 10];
-    Rbf::new(10, -5.0, 5.0, 1.0).features(&za, &mut sa);
+    Rbf::new(RbfLayout::Diagonal, 10, 8, -5.0, 5.0, 1.0).features(&za, &mut sa);
     for j in 0..2 {
         for (k, s) in sa.iter().enumerate() {
             let expected = -1e-3 * 50.0 * (d.z2[j] / 50.0) * s;
@@ -249,4 +252,110 @@ proptest! {
         prop_assert!(d.fault.is_none() && !d.barrier_breached);
         prop_assert!(d.tau.iter().all(|x| x.is_finite()));
     }
+}
+
+fn with_law(law: LawName) -> ControllerParams {
+    ControllerParams {
+        law,
+        ..Default::default()
+    }
+}
+
+// No shift (γ ≡ 1, γ̇ ≡ 0) at the same input: D = k_c² − Z1² = [0.24, 0.15],
+// α = −15 Z1 + q̇_d + (k̇_c/k_c) Z1 = [−0.99, 1.805], Z2 = [1.09, −2.005],
+// τ = −15 Z2 − Z1/(β D).
+#[test]
+fn no_shift_and_blf_by_hand() {
+    let (_, d) = step_once(with_law(LawName::NacNoShift), &input());
+    assert_eq!((d.gamma, d.gamma_dot), (1.0, 0.0));
+    close(d.d[0], 0.24, 1e-15);
+    close(d.alpha[0], -0.99, 1e-14);
+    close(d.alpha[1], 1.805, 1e-14);
+    close(d.tau[0], -16.35 - 0.1 / 2.4, 1e-14);
+    close(d.tau[1], 30.075 + 0.1 / 1.5, 1e-14);
+    // blf: β = 1, and no networks.
+    let (c, d) = step_once(with_law(LawName::Blf), &input());
+    close(d.tau[0], -16.35 - 0.1 / 0.24, 1e-14);
+    close(d.tau[1], 30.075 + 0.1 / 0.15, 1e-14);
+    assert!(c.actor_weights().iter().all(|w| *w == 0.0));
+}
+
+/// Started outside the envelope, the paper's law has γ(0) = 0 and no
+/// barrier; without the shift the guard acts at once.
+#[test]
+fn without_the_shift_a_start_outside_the_envelope_breaches() {
+    let q = [0.9, 1.0];
+    let at_zero = ControllerInput {
+        t: 0.0,
+        q: &q,
+        ..input()
+    };
+    let (_, d) = step_once(ControllerParams::default(), &at_zero);
+    assert!(!d.barrier_breached && d.gamma == 0.0);
+    let (_, d) = step_once(with_law(LawName::NacNoShift), &at_zero);
+    assert!(d.barrier_breached);
+    assert!(d.d[0] < 0.0 && d.tau.iter().all(|t| t.is_finite()));
+    // Clamped D = ε k_c²: the barrier term is −Z1 / (β ε k_c²).
+    close(d.tau_barrier[0], -0.7 / (10.0 * 1e-6 * 0.25), 1e-12);
+}
+
+#[test]
+fn ablations_switch_off_their_networks() {
+    let run = |law| {
+        let mut c = Controller::new(with_law(law), 2).unwrap();
+        let mut d = c.diagnostics();
+        for k in 0..3 {
+            let i = ControllerInput {
+                t: 1.0 + k as f64 * 1e-3,
+                ..input()
+            };
+            c.step(1e-3, &i, &mut d);
+        }
+        (c, d)
+    };
+    let (c, d) = run(LawName::Nac);
+    assert!(c.actor_weights().iter().any(|w| *w != 0.0));
+    assert!(c.critic_weights().iter().any(|w| *w != 0.0));
+    assert!(d.j_hat != 0.0);
+    let (c, d) = run(LawName::NacNoCritic);
+    assert!(c.actor_weights().iter().any(|w| *w != 0.0));
+    assert!(c.critic_weights().iter().all(|w| *w == 0.0));
+    assert_eq!((d.j_hat, d.delta), (0.0, d.r));
+    let (c, d) = run(LawName::NacNoNetworks);
+    assert!(c.actor_weights().iter().all(|w| *w == 0.0));
+    assert!(c.critic_weights().iter().all(|w| *w == 0.0));
+    assert_eq!(d.tau_actor, [0.0, 0.0]);
+    // Without networks the torque is the feedback and the barrier alone.
+    for i in 0..2 {
+        assert_eq!(d.tau[i], d.tau_feedback[i] + d.tau_barrier[i]);
+    }
+}
+
+/// The per-input layout activates the actor where the diagonal one cannot.
+#[test]
+fn per_input_centres_make_the_actor_act() {
+    let actor_after = |layout| {
+        let p = ControllerParams {
+            rbf_layout: layout,
+            ..Default::default()
+        };
+        let mut c = Controller::new(p, 2).unwrap();
+        let mut d = c.diagnostics();
+        for k in 0..200 {
+            let i = ControllerInput {
+                t: 1.0 + k as f64 * 1e-3,
+                ..input()
+            };
+            c.step(1e-3, &i, &mut d);
+        }
+        d.tau_actor[0].abs()
+    };
+    let diagonal = actor_after(RbfLayout::Diagonal);
+    let per_input = actor_after(RbfLayout::PerInput);
+    assert!(per_input > 100.0 * diagonal, "{per_input} vs {diagonal}");
+}
+
+#[test]
+fn other_laws_are_not_built_as_the_papers() {
+    assert!(Controller::new(with_law(LawName::Pd), 2).is_err());
 }

@@ -1,10 +1,15 @@
 //! The paper's reinforcement-learning neuroadaptive controller under deferred
-//! constraints, as pure math (SPEC §3–§12).
+//! constraints, as pure math (SPEC §3–§12), and the laws it is compared with
+//! (BASELINES.md): its ablations, the classic barrier law, PD, PD with
+//! gravity, computed torque and prescribed performance control.
 //!
-//! Where it sits: between the plant's joint states and its commands. The
-//! core, [`Controller::step`], is pure: no clock, no I/O, no IPC; the same
-//! inputs give the same outputs bit for bit, which is what makes lockstep
-//! runs and replays exact. [`ControllerMachine`] is the step machine in wire
+//! Where it sits: between the plant's joint states and its commands. Each
+//! law's step ([`Controller::step`] for the paper's, [`Law::step`] for any)
+//! is pure: no clock, no I/O, no IPC; the same inputs give the same outputs
+//! bit for bit, which is what makes lockstep runs and replays exact. The
+//! model-based laws (`pd-gravity`, `ctc`) evaluate the arm's URDF model with
+//! `arm_model::dynamics`, never the plant's engine. [`ControllerMachine`]
+//! is the step machine in wire
 //! messages (state + reference → command + diagnostics) that the controller
 //! node ([`node`]), `testbed sim` and `replay --verify` all drive; the node
 //! module is the thin shell that puts it on the bus.
@@ -15,30 +20,40 @@
 //! let mut diag = c.diagnostics();
 //! let input = ControllerInput {
 //!     t: 0.0, q: &[0.6, 1.8], qd: &[0.0, 0.0],
-//!     q_d: &[0.0, 1.0], qd_d: &[2.0, 0.0], kc: &[0.5, 0.55], kc_dot: &[0.05, 0.0],
+//!     q_d: &[0.0, 1.0], qd_d: &[2.0, 0.0], qdd_d: &[0.0, -1.0],
+//!     kc: &[0.5, 0.55], kc_dot: &[0.05, 0.0],
 //! };
 //! c.step(1e-3, &input, &mut diag);
 //! assert!(diag.tau.iter().all(|t| t.is_finite()));
 //! assert!(diag.fault.is_none());
 //! ```
 //!
-//! Limitations: the RBF centres lie on the diagonal of the input space, as in
-//! the paper (SPEC §8); with them the actor's contribution stays small and
-//! the loop behaves as feedback plus barrier.
+//! Limitations: by default the RBF centres lie on the diagonal of the input
+//! space, as in the paper (SPEC §8); with them the actor's contribution
+//! stays small and the loop behaves as feedback plus barrier. The
+//! `per-input` layout ([`RbfLayout`]) covers each input's range instead.
 
+mod feedback;
 mod gain;
 mod law;
+mod law_name;
+mod laws;
 mod machine;
 pub mod node;
 mod params;
+mod ppc;
 mod rbf;
 mod shifting;
 mod weight_update;
 
+pub use feedback::Feedback;
 pub use gain::Gain;
 pub use law::{Controller, ControllerInput, barrier_lyapunov};
+pub use law_name::LawName;
+pub use laws::Law;
 pub use machine::ControllerMachine;
-pub use params::{BarrierMode, ControllerParams, Integrator};
+pub use params::{BarrierMode, ControllerParams, Integrator, RbfLayout};
+pub use ppc::{Ppc, XI_LIMIT};
 pub use rbf::Rbf;
 pub use shifting::shifting;
 pub use weight_update::{advance_euler, advance_exact};
@@ -59,6 +74,19 @@ pub enum ControllerError {
     /// Zero joints.
     #[error("the controller needs at least one joint")]
     NoJoints,
+    /// A key set that the chosen law does not take.
+    #[error("{key} is not a parameter of law '{law}' (it takes {takes})")]
+    NotAParameter {
+        /// The scenario key, e.g. `controller.beta`.
+        key: String,
+        /// The chosen law.
+        law: LawName,
+        /// The keys the law takes.
+        takes: String,
+    },
+    /// A model-based law was built without the arm's model.
+    #[error("law '{0}' is model-based and needs the arm's URDF model")]
+    NeedsModel(LawName),
 }
 
 /// Why a step published zero torque instead of the law's output (SPEC §10).
@@ -116,10 +144,12 @@ pub struct Diagnostics {
     pub tau: Vec<f64>,
     /// Actor term (Ŵ_aᵀ S_a)_i.
     pub tau_actor: Vec<f64>,
-    /// Feedback term −K2 Z2_i.
+    /// Feedback term (−K2 Z2_i for the paper's law).
     pub tau_feedback: Vec<f64>,
     /// Barrier term −γ Z1γ_i / (β D_i).
     pub tau_barrier: Vec<f64>,
+    /// Model term of a model-based law (zero for the others).
+    pub tau_model: Vec<f64>,
     /// Critic value Ĵ = Ŵ_cᵀ S_c.
     pub j_hat: f64,
     /// TD error δ.
@@ -154,6 +184,7 @@ impl Diagnostics {
             tau_actor: z(),
             tau_feedback: z(),
             tau_barrier: z(),
+            tau_model: z(),
             j_hat: 0.0,
             delta: 0.0,
             r: 0.0,

@@ -4,27 +4,31 @@
 
 use wire::{Command, ControllerDiagnostics, Header, JointState, ReferenceSample, joints};
 
-use crate::{Controller, ControllerError, ControllerInput, ControllerParams, Diagnostics, Fault};
+use arm_model::ArmModel;
+
+use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Fault, Law};
 
 /// The law behind wire messages.
 #[derive(Debug, Clone)]
 pub struct ControllerMachine {
-    law: Controller,
+    law: Law,
     diag: Diagnostics,
     n: usize,
     dt: f64,
 }
 
 impl ControllerMachine {
-    /// The law with `params` for `dof` joints at a period of `period_ns`.
+    /// The law with `params` for `dof` joints at a period of `period_ns`;
+    /// `model` is the arm's, which only the model-based laws read.
     pub fn new(
-        params: ControllerParams,
+        params: &ControllerParams,
         dof: usize,
         period_ns: u64,
+        model: Option<&ArmModel>,
     ) -> Result<Self, ControllerError> {
-        let law = Controller::new(params, dof)?;
+        let law = Law::new(params, dof, model)?;
         Ok(Self {
-            diag: law.diagnostics(),
+            diag: Diagnostics::new(dof),
             law,
             n: dof,
             dt: wire::ns_to_s(period_ns),
@@ -60,6 +64,7 @@ impl ControllerMachine {
                     qd: &state.qd_measured[..n],
                     q_d: &r.q_d[..n],
                     qd_d: &r.qd_d[..n],
+                    qdd_d: &r.qdd_d[..n],
                     kc: &r.kc[..n],
                     kc_dot: &r.kc_dot[..n],
                 };
@@ -104,6 +109,7 @@ fn diag_msg(header: Header, d: &Diagnostics, r: &ReferenceSample) -> ControllerD
         wc_norm: d.wc_norm,
         q_d: r.q_d,
         qd_d: r.qd_d,
+        qdd_d: r.qdd_d,
         kc_in: r.kc,
         kc_dot: r.kc_dot,
         z1: joints(&d.z1),
@@ -116,6 +122,7 @@ fn diag_msg(header: Header, d: &Diagnostics, r: &ReferenceSample) -> ControllerD
         tau_actor: joints(&d.tau_actor),
         tau_feedback: joints(&d.tau_feedback),
         tau_barrier: joints(&d.tau_barrier),
+        tau_model: joints(&d.tau_model),
         wa_norm: joints(&d.wa_norm),
     }
 }

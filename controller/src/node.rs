@@ -11,10 +11,12 @@ use wire::{
     STATE_FINAL, Topic, monotonic_ns,
 };
 
+use arm_model::{ArmModel, Locks};
+
 use crate::{ControllerError, ControllerMachine, ControllerParams};
 
-/// What the launcher hands the controller node: only gains and sizes,
-/// never the arm's model.
+/// What the launcher hands the controller node: gains and sizes, and the
+/// arm's URDF only for a model-based law.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ControllerNodeConfig {
@@ -24,6 +26,38 @@ pub struct ControllerNodeConfig {
     pub dof: usize,
     /// Control period, ns.
     pub period_ns: u64,
+    /// The arm's model, for `pd-gravity` and `ctc` (None for the others).
+    #[serde(default)]
+    pub model: Option<NodeModel>,
+}
+
+/// The URDF a model-based law evaluates, with the run's locked joints.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodeModel {
+    /// The URDF text.
+    pub urdf: String,
+    /// Joint name → locked position.
+    pub lock: Locks,
+}
+
+impl ControllerNodeConfig {
+    /// The step machine this configuration describes.
+    pub fn machine(&self) -> Result<ControllerMachine, ControllerError> {
+        let model = match &self.model {
+            Some(m) => Some(
+                ArmModel::from_urdf_str_locked(&m.urdf, &m.lock).map_err(|e| {
+                    ControllerError::InvalidParameter {
+                        key: "model.urdf".into(),
+                        value: "the run's URDF".into(),
+                        need: format!("a URDF the arm model reads ({e})"),
+                    }
+                })?,
+            ),
+            None => None,
+        };
+        ControllerMachine::new(&self.params, self.dof, self.period_ns, model.as_ref())
+    }
 }
 
 /// Why the controller node stopped.
@@ -49,7 +83,7 @@ pub fn run(
     config: &ControllerNodeConfig,
     mode: Mode,
 ) -> Result<(), ControllerNodeError> {
-    let mut m = ControllerMachine::new(config.params.clone(), config.dof, config.period_ns)?;
+    let mut m = config.machine()?;
     let states = link.bus.subscriber::<JointState>(Topic::JointState)?;
     let commands = link
         .bus

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{ControllerError, Gain};
+use crate::{ControllerError, Gain, LawName};
 
 /// How the weight ODEs are advanced over one control period (SPEC §9).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -25,10 +25,28 @@ pub enum BarrierMode {
     Norm,
 }
 
+/// Where the RBF networks' centres lie (SPEC §8 and the option beside it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RbfLayout {
+    /// The paper's: N centres c_j·1 on the diagonal of the input space.
+    /// Far from every input once the state leaves the diagonal, so the
+    /// actor stays nearly inert (SPEC §8).
+    #[default]
+    Diagonal,
+    /// N one-dimensional neurons per input, centres spread over
+    /// [center_min, center_max] and width `width` per input: every input
+    /// value in the range has a neuron near it (N × inputs features).
+    PerInput,
+}
+
 /// Every parameter of the law. Unset keys take the paper's values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ControllerParams {
+    /// The law (default: "nac", the paper's). Every other key must be one
+    /// the law takes ([`LawName::keys`]) or be left at its default.
+    pub law: LawName,
     /// Prescribed time T_c at which the constraint is fully on (default: 2, s).
     pub tc: f64,
     /// Position-error gain K1 = diag(K1_i): one number or one per joint
@@ -56,6 +74,8 @@ pub struct ControllerParams {
     pub center_max: f64,
     /// RBF width η (default: 1).
     pub width: f64,
+    /// Where the centres lie (default: "diagonal", the paper's).
+    pub rbf_layout: RbfLayout,
     /// Young's-inequality weight a in α (default: 1).
     pub a: f64,
     /// Critic discount time constant ψ (default: 1, s).
@@ -72,11 +92,17 @@ pub struct ControllerParams {
     pub barrier: BarrierMode,
     /// Guard ε: D is clamped to at least ε k_c² (default: 1e-6).
     pub breach_epsilon: f64,
+    /// `pd-gravity`, `ctc`: every link's mass and inertia in the law's copy
+    /// of the model is scaled by this (default: 1, the URDF's).
+    pub model_scale: f64,
+    /// `ppc`: the final velocity-funnel width ρ2,∞ (default: 2, rad/s).
+    pub rho2_inf: f64,
 }
 
 impl Default for ControllerParams {
     fn default() -> Self {
         Self {
+            law: LawName::Nac,
             tc: 2.0,
             k1: Gain::All(15.0),
             k2: Gain::All(15.0),
@@ -89,6 +115,7 @@ impl Default for ControllerParams {
             center_min: -5.0,
             center_max: 5.0,
             width: 1.0,
+            rbf_layout: RbfLayout::Diagonal,
             a: 1.0,
             psi: 1.0,
             k_a: 0.1,
@@ -97,6 +124,8 @@ impl Default for ControllerParams {
             integrator: Integrator::Exact,
             barrier: BarrierMode::PerJoint,
             breach_epsilon: 1e-6,
+            model_scale: 1.0,
+            rho2_inf: 2.0,
         }
     }
 }
@@ -131,6 +160,8 @@ impl ControllerParams {
             ("q_weight", self.q_weight, NonNegative),
             ("r_weight", self.r_weight, NonNegative),
             ("breach_epsilon", self.breach_epsilon, OpenUnit),
+            ("model_scale", self.model_scale, Positive),
+            ("rho2_inf", self.rho2_inf, Positive),
         ];
         for (key, value, bound) in checks {
             let (ok, need) = match bound {
@@ -160,6 +191,7 @@ impl ControllerParams {
                 need: "at least 1".into(),
             });
         }
+        self.check_keys_belong()?;
         if self.center_min > self.center_max {
             return Err(ControllerError::InvalidParameter {
                 key: "controller.center_min".into(),
@@ -168,6 +200,78 @@ impl ControllerParams {
             });
         }
         Ok(())
+    }
+}
+
+impl ControllerParams {
+    /// Every key whose value differs from its default.
+    pub fn changed_keys(&self) -> Vec<&'static str> {
+        let d = Self::default();
+        let changed = [
+            ("law", self.law != d.law),
+            ("tc", self.tc != d.tc),
+            ("k1", self.k1 != d.k1),
+            ("k2", self.k2 != d.k2),
+            ("beta", self.beta != d.beta),
+            ("sigma_a", self.sigma_a != d.sigma_a),
+            ("sigma_c", self.sigma_c != d.sigma_c),
+            ("eta_a", self.eta_a != d.eta_a),
+            ("eta_c", self.eta_c != d.eta_c),
+            ("neurons", self.neurons != d.neurons),
+            ("center_min", self.center_min != d.center_min),
+            ("center_max", self.center_max != d.center_max),
+            ("width", self.width != d.width),
+            ("rbf_layout", self.rbf_layout != d.rbf_layout),
+            ("a", self.a != d.a),
+            ("psi", self.psi != d.psi),
+            ("k_a", self.k_a != d.k_a),
+            ("q_weight", self.q_weight != d.q_weight),
+            ("r_weight", self.r_weight != d.r_weight),
+            ("integrator", self.integrator != d.integrator),
+            ("barrier", self.barrier != d.barrier),
+            ("breach_epsilon", self.breach_epsilon != d.breach_epsilon),
+            ("model_scale", self.model_scale != d.model_scale),
+            ("rho2_inf", self.rho2_inf != d.rho2_inf),
+        ];
+        changed.iter().filter(|(_, c)| *c).map(|(k, _)| *k).collect()
+    }
+
+    /// A key set away from its default that the chosen law does not take
+    /// is an error naming it (a value that would silently do nothing).
+    fn check_keys_belong(&self) -> Result<(), ControllerError> {
+        match self.changed_keys().into_iter().find(|k| !self.law.takes(k)) {
+            Some(key) => Err(ControllerError::NotAParameter {
+                key: format!("controller.{key}"),
+                law: self.law,
+                takes: self.law.keys().join(", "),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// The same run's parameters for `law`: the keys every law shares (T_c,
+    /// K1, K2) and those both laws take are kept, the rest go back to their
+    /// defaults. This is how `compare` matches every law to one scenario.
+    pub fn for_law(&self, law: LawName) -> Self {
+        let mut p = Self {
+            law,
+            tc: self.tc,
+            k1: self.k1.clone(),
+            k2: self.k2.clone(),
+            ..Self::default()
+        };
+        let keep = |key: &str| law.takes(key) && self.law.takes(key);
+        macro_rules! carry {
+            ($($field:ident),*) => {
+                $(if keep(stringify!($field)) { p.$field = self.$field.clone(); })*
+            };
+        }
+        carry!(
+            beta, sigma_a, sigma_c, eta_a, eta_c, neurons, center_min, center_max, width,
+            rbf_layout, a, psi, k_a, q_weight, r_weight, integrator, barrier, breach_epsilon,
+            model_scale, rho2_inf
+        );
+        p
     }
 }
 
@@ -189,6 +293,48 @@ mod tests {
             (p.neurons, p.center_min, p.center_max, p.width),
             (10, -5.0, 5.0, 1.0)
         );
+    }
+
+    #[test]
+    fn a_key_the_law_does_not_take_is_named() {
+        let p = ControllerParams {
+            law: LawName::Pd,
+            beta: 5.0,
+            ..Default::default()
+        };
+        let e = p.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("controller.beta") && e.contains("law 'pd'") && e.contains("tc, k1, k2"),
+            "{e}"
+        );
+        // Left at its default, a key of another law is no error.
+        let p = ControllerParams {
+            law: LawName::Pd,
+            ..Default::default()
+        };
+        p.validate().unwrap();
+        let p = ControllerParams {
+            law: LawName::Ctc,
+            model_scale: 0.8,
+            ..Default::default()
+        };
+        p.validate().unwrap();
+    }
+
+    #[test]
+    fn for_law_keeps_shared_keys_and_resets_the_others() {
+        let nac = ControllerParams {
+            k1: Gain::Each(vec![20.0, 30.0]),
+            tc: 1.5,
+            beta: 4.0,
+            ..Default::default()
+        };
+        let pd = nac.for_law(LawName::Pd);
+        assert_eq!((pd.law, pd.tc, &pd.k1), (LawName::Pd, 1.5, &nac.k1));
+        assert_eq!(pd.beta, 10.0);
+        pd.validate().unwrap();
+        assert_eq!(nac.for_law(LawName::NacNoShift).beta, 4.0);
+        assert_eq!(pd.for_law(LawName::Nac).beta, 10.0);
     }
 
     #[test]

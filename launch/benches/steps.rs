@@ -23,7 +23,7 @@ fn controller_step(c: &mut Criterion) {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let mut v =
             |scale: f64| -> Vec<f64> { (0..n).map(|_| rng.random_range(-scale..scale)).collect() };
-        let (q, qd, q_d, qd_d, kc_dot) = (v(1.0), v(1.0), v(1.0), v(1.0), v(0.1));
+        let (q, qd, q_d, qd_d, qdd_d, kc_dot) = (v(1.0), v(1.0), v(1.0), v(1.0), v(1.0), v(0.1));
         let kc = vec![0.5; n];
         let mut law = Controller::new(ControllerParams::default(), n).unwrap();
         let mut diag = law.diagnostics();
@@ -37,6 +37,7 @@ fn controller_step(c: &mut Criterion) {
                     qd: &qd,
                     q_d: &q_d,
                     qd_d: &qd_d,
+                    qdd_d: &qdd_d,
                     kc: &kc,
                     kc_dot: &kc_dot,
                 };

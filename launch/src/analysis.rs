@@ -276,8 +276,11 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
     let n = plan.robot.model.dof();
     let verifier = if opts.verify {
         Some(
-            Verifier::new(plan.scenario.controller.clone(), n, plan.period_ns)
-                .map_err(|e| meta_err(path, e.to_string()))?,
+            Verifier::new(
+                crate::node::configs::controller(&plan)
+                    .machine()
+                    .map_err(|e| meta_err(path, e.to_string()))?,
+            ),
         )
     } else {
         None

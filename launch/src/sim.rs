@@ -3,7 +3,7 @@
 //! nodes exchange, and the step records come from the same assembler that
 //! reads a multi-process run's log: so lockstep reproduces this bit for bit.
 
-use controller::{ControllerError, ControllerMachine};
+use controller::ControllerError;
 use plant_rapier::PlantError;
 use scenario::Plan;
 use trajectory::TrajectoryMachine;
@@ -66,8 +66,7 @@ pub fn run_measured(
         .machine()
         .map_err(plant_err)?;
     let n = plant.dof();
-    let mut controller =
-        ControllerMachine::new(plan.scenario.controller.clone(), n, plan.period_ns)?;
+    let mut controller = crate::node::configs::controller(plan).machine()?;
     let mut reference = TrajectoryMachine::new(plan.reference.clone(), plan.reference_period_ns);
     let mut records = RecordAssembler::new(n, plan.dt(), plan.steps);
     let mut state = plant.state(0, 0);

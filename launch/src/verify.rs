@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use controller::{ControllerError, ControllerMachine};
+use controller::ControllerMachine;
 use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample};
 
 /// Re-drives a fresh controller machine step by step.
@@ -21,22 +21,18 @@ pub struct Verifier {
 }
 
 impl Verifier {
-    /// A controller with `params` for `n` joints at a period of `period_ns`.
-    pub fn new(
-        params: controller::ControllerParams,
-        n: usize,
-        period_ns: u64,
-    ) -> Result<Self, ControllerError> {
-        Ok(Self {
-            machine: ControllerMachine::new(params, n, period_ns)?,
-            n,
+    /// The run's controller machine, fresh.
+    pub fn new(machine: ControllerMachine) -> Self {
+        Self {
+            n: machine.dof(),
+            machine,
             next: 0,
             states: BTreeMap::new(),
             diags: BTreeMap::new(),
             commands: BTreeMap::new(),
             max_abs_torque_diff: 0.0,
             steps: 0,
-        })
+        }
     }
 
     /// Adds a logged state.
@@ -75,7 +71,7 @@ impl Verifier {
                 reserved: 0,
                 q_d: d.q_d,
                 qd_d: d.qd_d,
-                qdd_d: [0.0; wire::MAX_DOF],
+                qdd_d: d.qdd_d,
                 kc: d.kc_in,
                 kc_dot: d.kc_dot,
             };

@@ -111,7 +111,7 @@ crate::data_message! {
 
 crate::data_message! {
     /// Everything the controller computed at one step (SPEC §12).
-    #[type_name("testbed.ControllerDiagnostics.v1")]
+    #[type_name("testbed.ControllerDiagnostics.v2")]
     pub struct ControllerDiagnostics {
         /// seq and t_ns of the state acted on.
         header: Header,
@@ -141,6 +141,8 @@ crate::data_message! {
         q_d: Joints => J,
         /// The reference used: q̇_d.
         qd_d: Joints => J,
+        /// The reference used: q̈_d.
+        qdd_d: Joints => J,
         /// The envelope used, per joint as given: k_c,i.
         kc_in: Joints => J,
         /// The envelope rate used: k̇_c,i.
@@ -161,10 +163,14 @@ crate::data_message! {
         tau: Joints => J,
         /// Actor term of τ.
         tau_actor: Joints => J,
-        /// −K2 Z2 term of τ.
+        /// Feedback term of τ (−K2 Z2 for the paper's law).
         tau_feedback: Joints => J,
         /// Barrier term of τ.
         tau_barrier: Joints => J,
+        /// Model term of a model-based law (G for `pd-gravity`, the whole
+        /// computed torque for `ctc`, whose feedback acts through M; zero
+        /// for the model-free laws).
+        tau_model: Joints => J,
         /// ‖Ŵ_a‖ per joint before the update.
         wa_norm: Joints => J,
     }

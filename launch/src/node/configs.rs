@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use controller::node::ControllerNodeConfig;
+use controller::node::{ControllerNodeConfig, NodeModel};
 use logger::RunMetadata;
 use logger::node::LoggerNodeConfig;
 use plant_rapier::node::PlantNodeConfig;
@@ -29,12 +29,18 @@ pub fn plant(plan: &Plan) -> PlantNodeConfig {
     }
 }
 
-/// The controller's part: gains and sizes only, never the model.
+/// The controller's part: gains and sizes, and the URDF only for a
+/// model-based law.
 pub fn controller(plan: &Plan) -> ControllerNodeConfig {
+    let params = &plan.scenario.controller;
     ControllerNodeConfig {
-        params: plan.scenario.controller.clone(),
+        params: params.clone(),
         dof: plan.robot.model.dof(),
         period_ns: plan.period_ns,
+        model: params.law.model_based().then(|| NodeModel {
+            urdf: plan.robot.urdf.clone(),
+            lock: plan.scenario.plant.lock.clone(),
+        }),
     }
 }
 

@@ -1,0 +1,117 @@
+//! The unconstrained reference laws of BASELINES.md: `pd`, and the
+//! model-based `pd-gravity` and `ctc`, with gains matched to the paper's
+//! K1, K2 so that a difference in a comparison comes from the structure.
+
+use arm_model::ArmModel;
+use arm_model::dynamics::Dynamics;
+
+use crate::law::{check_input, publish_fault};
+use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Fault, LawName};
+
+/// `pd`, `pd-gravity` or `ctc` for n joints.
+#[derive(Debug, Clone)]
+pub struct Feedback {
+    law: LawName,
+    n: usize,
+    k1: Vec<f64>,
+    k2: Vec<f64>,
+    /// The law's copy of the arm's model (model-based laws only).
+    model: Option<Dynamics>,
+    /// Scratch: q̈_d − K_d' ė − K_p' e for `ctc`.
+    v: Vec<f64>,
+}
+
+impl Feedback {
+    /// The law `params.law` (one of pd, pd-gravity, ctc); the model-based
+    /// ones evaluate `model`, scaled by `params.model_scale`.
+    pub fn new(
+        params: &ControllerParams,
+        dof: usize,
+        model: Option<&ArmModel>,
+    ) -> Result<Self, ControllerError> {
+        let law = params.law;
+        let model = match (law.model_based(), model) {
+            (false, _) => None,
+            (true, Some(m)) if m.dof() == dof => Some(Dynamics::new(m, params.model_scale)),
+            (true, Some(m)) => {
+                return Err(ControllerError::InvalidParameter {
+                    key: "controller.law".into(),
+                    value: format!("{law} with a model of {} joints", m.dof()),
+                    need: format!("a model of the {dof} controlled joints"),
+                });
+            }
+            (true, None) => return Err(ControllerError::NeedsModel(law)),
+        };
+        Ok(Self {
+            law,
+            n: dof,
+            k1: params.k1.resolve("controller.k1", dof)?,
+            k2: params.k2.resolve("controller.k2", dof)?,
+            model,
+            v: vec![0.0; dof],
+        })
+    }
+
+    /// One step: τ into `out.tau` and the errors into `out`.
+    pub fn step(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
+        out.t = input.t;
+        out.fault = None;
+        out.barrier_breached = false;
+        if let Some(fault) = check_input(input, self.n) {
+            publish_fault(out, fault);
+            return;
+        }
+        // No shift: these laws see the constraint as on (γ = 1) and ignore it.
+        out.gamma = 1.0;
+        out.gamma_dot = 0.0;
+        for i in 0..self.n {
+            let e = input.q[i] - input.q_d[i];
+            let ed = input.qd[i] - input.qd_d[i];
+            out.z1[i] = e;
+            out.z1g[i] = e;
+            out.alpha[i] = input.qd_d[i];
+            out.z2[i] = ed;
+            out.kc[i] = input.kc[i];
+            out.d[i] = input.kc[i] * input.kc[i] - e * e;
+            out.tau_actor[i] = 0.0;
+            out.tau_barrier[i] = 0.0;
+            out.wa_norm[i] = 0.0;
+            // K_p = K1 K2, K_d = K2 (pd); K_p' = K1 K2, K_d' = K1 + K2 (ctc).
+            let (k1, k2) = (self.k1[i], self.k2[i]);
+            match self.law {
+                LawName::Ctc => self.v[i] = input.qdd_d[i] - (k1 + k2) * ed - k1 * k2 * e,
+                _ => out.tau_feedback[i] = -k1 * k2 * e - k2 * ed,
+            }
+        }
+        self.model_terms(input, out);
+        (out.j_hat, out.delta, out.r, out.wc_norm) = (0.0, 0.0, 0.0, 0.0);
+        if out.tau.iter().any(|x| !x.is_finite()) {
+            publish_fault(out, Fault::NonFiniteOutput);
+        }
+    }
+
+    /// τ from the feedback and the model: G(q) for `pd-gravity`; for `ctc`
+    /// M(q) v + C(q, q̇) q̇ + G(q), one Newton–Euler pass with q̈ = v. Its
+    /// feedback acts through M, so all of it is the model term.
+    fn model_terms(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
+        let n = self.n;
+        match (self.law, self.model.as_mut()) {
+            (LawName::PdGravity, Some(m)) => {
+                out.tau_model.copy_from_slice(m.gravity(input.q));
+            }
+            (LawName::Ctc, Some(m)) => {
+                out.tau_model
+                    .copy_from_slice(m.inverse(input.q, input.qd, &self.v));
+                out.tau_feedback.iter_mut().for_each(|x| *x = 0.0);
+            }
+            _ => out.tau_model.iter_mut().for_each(|x| *x = 0.0),
+        }
+        for i in 0..n {
+            out.tau[i] = out.tau_model[i] + out.tau_feedback[i];
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "feedback_tests.rs"]
+mod tests;

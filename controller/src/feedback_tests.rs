@@ -1,0 +1,105 @@
+//! `pd`, `pd-gravity` and `ctc` on steps worked out by hand.
+
+#![allow(clippy::unwrap_used)]
+
+use super::*;
+use arm_model::TWO_LINK_URDF;
+
+const Q: [f64; 2] = [0.5, -0.5];
+const QD: [f64; 2] = [1.0, -1.0];
+const Q_D: [f64; 2] = [0.2, 0.1];
+const QD_D: [f64; 2] = [0.5, 0.5];
+const QDD_D: [f64; 2] = [2.0, -1.0];
+const KC: [f64; 2] = [0.5, 0.5];
+
+fn input() -> ControllerInput<'static> {
+    ControllerInput {
+        t: 1.0,
+        q: &Q,
+        qd: &QD,
+        q_d: &Q_D,
+        qd_d: &QD_D,
+        qdd_d: &QDD_D,
+        kc: &KC,
+        kc_dot: &[0.0, 0.0],
+    }
+}
+
+fn params(law: LawName) -> ControllerParams {
+    ControllerParams {
+        law,
+        k1: crate::Gain::Each(vec![2.0, 4.0]),
+        k2: crate::Gain::All(3.0),
+        ..Default::default()
+    }
+}
+
+fn step(law: LawName, model: Option<&ArmModel>) -> Diagnostics {
+    let mut f = Feedback::new(&params(law), 2, model).unwrap();
+    let mut d = Diagnostics::new(2);
+    f.step(&input(), &mut d);
+    d
+}
+
+// e = [0.3, −0.6], ė = [0.5, −1.5]; K_p = K1 K2 = [6, 12], K_d = K2 = 3.
+#[test]
+fn pd_by_hand_both_signs() {
+    let d = step(LawName::Pd, None);
+    assert!((d.tau[0] - (-1.8 - 1.5)).abs() < 1e-15);
+    assert!((d.tau[1] - (7.2 + 4.5)).abs() < 1e-15);
+    assert_eq!(d.z1, [0.3, -0.6]);
+    assert_eq!(d.z2, [0.5, -1.5]);
+    assert_eq!(d.tau_model, [0.0, 0.0]);
+    assert!(d.fault.is_none() && !d.barrier_breached);
+}
+
+#[test]
+fn pd_gravity_adds_the_models_gravity() {
+    let model = ArmModel::from_urdf_str(TWO_LINK_URDF).unwrap();
+    let d = step(LawName::PdGravity, Some(&model));
+    let g = Dynamics::new(&model, 1.0).gravity(&Q).to_vec();
+    assert_eq!(d.tau_model, g);
+    assert!((d.tau[0] - (g[0] - 3.3)).abs() < 1e-12);
+    assert!((d.tau[1] - (g[1] + 11.7)).abs() < 1e-12);
+}
+
+// v = q̈_d − (K1 + K2) ė − K1 K2 e = [2 − 2.5 − 1.8, −1 + 10.5 + 7.2].
+#[test]
+fn ctc_is_the_models_inverse_dynamics_at_the_commanded_acceleration() {
+    let model = ArmModel::from_urdf_str(TWO_LINK_URDF).unwrap();
+    let d = step(LawName::Ctc, Some(&model));
+    let want = Dynamics::new(&model, 1.0)
+        .inverse(&Q, &QD, &[2.0 - 2.5 - 1.8, -1.0 + 10.5 + 7.2])
+        .to_vec();
+    for i in 0..2 {
+        assert!((d.tau[i] - want[i]).abs() < 1e-12, "{:?} vs {want:?}", d.tau);
+    }
+    // A model 20 % light scales every term of the torque by 0.8.
+    let light = ControllerParams {
+        model_scale: 0.8,
+        ..params(LawName::Ctc)
+    };
+    let mut f = Feedback::new(&light, 2, Some(&model)).unwrap();
+    let mut d8 = Diagnostics::new(2);
+    f.step(&input(), &mut d8);
+    for i in 0..2 {
+        assert!((d8.tau[i] - 0.8 * want[i]).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn a_model_based_law_without_a_model_is_refused() {
+    let e = Feedback::new(&params(LawName::Ctc), 2, None).unwrap_err();
+    assert_eq!(e, ControllerError::NeedsModel(LawName::Ctc));
+    assert!(e.to_string().contains("'ctc' is model-based"));
+}
+
+#[test]
+fn a_non_finite_input_gives_zero_torque_and_a_fault() {
+    let mut f = Feedback::new(&params(LawName::Pd), 2, None).unwrap();
+    let mut d = Diagnostics::new(2);
+    let q = [f64::NAN, 0.0];
+    f.step(&ControllerInput { q: &q, ..input() }, &mut d);
+    assert_eq!(d.fault, Some(Fault::NonFiniteInput));
+    assert_eq!(d.tau, [0.0, 0.0]);
+}
