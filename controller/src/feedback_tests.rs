@@ -72,7 +72,11 @@ fn ctc_is_the_models_inverse_dynamics_at_the_commanded_acceleration() {
         .inverse(&Q, &QD, &[2.0 - 2.5 - 1.8, -1.0 + 10.5 + 7.2])
         .to_vec();
     for i in 0..2 {
-        assert!((d.tau[i] - want[i]).abs() < 1e-12, "{:?} vs {want:?}", d.tau);
+        assert!(
+            (d.tau[i] - want[i]).abs() < 1e-12,
+            "{:?} vs {want:?}",
+            d.tau
+        );
     }
     // A model 20 % light scales every term of the torque by 0.8.
     let light = ControllerParams {

@@ -1,8 +1,8 @@
 //! One control step of the paper's law (SPEC §4–§10), and of its ablations
 //! and the classic barrier law (BASELINES.md), which switch parts of it off.
 
-use crate::params::{BarrierMode, ControllerParams, Integrator};
 use crate::LawName;
+use crate::params::{BarrierMode, ControllerParams, Integrator};
 use crate::rbf::Rbf;
 use crate::shifting::shifting;
 use crate::weight_update::{advance_euler, advance_exact};
@@ -54,8 +54,14 @@ impl Parts {
         };
         Ok(match p.law {
             LawName::Nac => all,
-            LawName::NacNoShift => Parts { shift: false, ..all },
-            LawName::NacNoCritic => Parts { critic: false, ..all },
+            LawName::NacNoShift => Parts {
+                shift: false,
+                ..all
+            },
+            LawName::NacNoCritic => Parts {
+                critic: false,
+                ..all
+            },
             LawName::NacNoNetworks => Parts {
                 networks: false,
                 critic: false,
@@ -114,7 +120,16 @@ impl Controller {
         }
         let parts = Parts::of(&params)?;
         let p = &params;
-        let rbf = |dim| Rbf::new(p.rbf_layout, p.neurons, dim, p.center_min, p.center_max, p.width);
+        let rbf = |dim| {
+            Rbf::new(
+                p.rbf_layout,
+                p.neurons,
+                dim,
+                p.center_min,
+                p.center_max,
+                p.width,
+            )
+        };
         let (actor, critic) = (rbf(4 * dof), rbf(2 * dof));
         let (na, nc) = (actor.len(), critic.len());
         let k1 = params.k1.resolve("controller.k1", dof)?;
@@ -249,8 +264,7 @@ impl Controller {
             out.kc[i] = kc;
             out.d[i] = d_raw;
             let z1 = out.z1[i];
-            out.alpha[i] = -self.k1[i] * z1
-                - p.a * gamma_dot * gamma_dot * z1 * z1_sq / (beta * d)
+            out.alpha[i] = -self.k1[i] * z1 - p.a * gamma_dot * gamma_dot * z1 * z1_sq / (beta * d)
                 + input.qd_d[i]
                 + (kc_dot / kc) * z1;
             out.z2[i] = input.qd[i] - out.alpha[i];
@@ -338,7 +352,6 @@ impl Controller {
             advance(col, &self.sa, c, p.sigma_a, p.eta_a, dt);
         }
     }
-
 }
 
 /// A step that publishes zero torque because of `fault` (SPEC §10).

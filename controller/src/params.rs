@@ -233,7 +233,11 @@ impl ControllerParams {
             ("model_scale", self.model_scale != d.model_scale),
             ("rho2_inf", self.rho2_inf != d.rho2_inf),
         ];
-        changed.iter().filter(|(_, c)| *c).map(|(k, _)| *k).collect()
+        changed
+            .iter()
+            .filter(|(_, c)| *c)
+            .map(|(k, _)| *k)
+            .collect()
     }
 
     /// A key set away from its default that the chosen law does not take
@@ -267,9 +271,26 @@ impl ControllerParams {
             };
         }
         carry!(
-            beta, sigma_a, sigma_c, eta_a, eta_c, neurons, center_min, center_max, width,
-            rbf_layout, a, psi, k_a, q_weight, r_weight, integrator, barrier, breach_epsilon,
-            model_scale, rho2_inf
+            beta,
+            sigma_a,
+            sigma_c,
+            eta_a,
+            eta_c,
+            neurons,
+            center_min,
+            center_max,
+            width,
+            rbf_layout,
+            a,
+            psi,
+            k_a,
+            q_weight,
+            r_weight,
+            integrator,
+            barrier,
+            breach_epsilon,
+            model_scale,
+            rho2_inf
         );
         p
     }

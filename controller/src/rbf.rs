@@ -151,8 +151,12 @@ mod tests {
         let x = [0.3, -0.2, 0.8, 0.1];
         let v = [1.0, -2.0, 0.5, 3.0];
         let len = rbf.len();
-        let (mut s, mut d, mut sp, mut sm) =
-            (vec![0.0; len], vec![0.0; len], vec![0.0; len], vec![0.0; len]);
+        let (mut s, mut d, mut sp, mut sm) = (
+            vec![0.0; len],
+            vec![0.0; len],
+            vec![0.0; len],
+            vec![0.0; len],
+        );
         rbf.features(&x, &mut s);
         rbf.directional_derivative(&x, &v, &s, &mut d);
         let h = 1e-6;

@@ -275,13 +275,11 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
     let (plan, mode) = plan_from(&head)?;
     let n = plan.robot.model.dof();
     let verifier = if opts.verify {
-        Some(
-            Verifier::new(
-                crate::node::configs::controller(&plan)
-                    .machine()
-                    .map_err(|e| meta_err(path, e.to_string()))?,
-            ),
-        )
+        Some(Verifier::new(
+            crate::node::configs::controller(&plan)
+                .machine()
+                .map_err(|e| meta_err(path, e.to_string()))?,
+        ))
     } else {
         None
     };

@@ -255,6 +255,7 @@ fn load(robot: Option<&Path>, opts: &BenchOptions) -> Result<Plan, BenchError> {
             duration_s: opts.duration_s,
             rate_hz: None,
             robot: robot.map(Path::to_path_buf),
+            law: None,
         },
     )?)
 }

@@ -12,7 +12,10 @@
 pub mod analysis;
 pub mod assemble;
 pub mod bench;
+pub mod compare;
+pub mod compare_plots;
 pub mod csv_out;
+pub mod law_info;
 pub mod mode;
 pub mod node;
 pub mod plots;

@@ -12,35 +12,38 @@ use scenario::Plan;
 
 use crate::analysis::Series;
 
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-const FAMILY: &str = "sans-serif";
+pub(crate) static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+pub(crate) const FAMILY: &str = "sans-serif";
 /// More points than a figure can show only make SVGs large.
 const MAX_POINTS: usize = 4000;
-const COLORS: [RGBColor; 6] = [
+pub(crate) const COLORS: [RGBColor; 9] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
     RGBColor(23, 190, 207),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
 ];
 
 /// One curve.
-struct Line<'a> {
-    label: String,
-    y: &'a [f64],
-    color: RGBColor,
-    dashed: bool,
+pub(crate) struct Line<'a> {
+    pub(crate) label: String,
+    pub(crate) y: &'a [f64],
+    pub(crate) color: RGBColor,
+    pub(crate) dashed: bool,
 }
 
 /// One panel of a figure (one joint).
-struct Panel<'a> {
-    title: String,
-    y_label: &'static str,
-    lines: Vec<Line<'a>>,
+pub(crate) struct Panel<'a> {
+    pub(crate) title: String,
+    pub(crate) y_label: &'static str,
+    pub(crate) lines: Vec<Line<'a>>,
 }
 
-fn err(e: impl std::fmt::Display) -> String {
+pub(crate) fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
@@ -133,7 +136,7 @@ fn draw_panels<DB: DrawingBackend>(
 }
 
 /// Writes `name.png` and `name.svg`.
-fn save(
+pub(crate) fn save(
     dir: &Path,
     name: &str,
     title: &str,
@@ -169,7 +172,7 @@ fn bounds(a: &[f64], b: &[f64], sign: f64) -> Vec<f64> {
 /// A figure could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
-pub struct PlotError(String);
+pub struct PlotError(pub(crate) String);
 
 /// Writes every figure into `dir` (created if needed); returns how many.
 pub fn write_all(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, PlotError> {
@@ -200,7 +203,7 @@ fn line(label: String, y: &[f64], i: usize, dashed: bool) -> Line<'_> {
     }
 }
 
-const RED: RGBColor = RGBColor(214, 39, 40);
+pub(crate) const RED: RGBColor = RGBColor(214, 39, 40);
 
 /// Fig. 1: q with q_d ± k_c.
 fn positions(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), String> {

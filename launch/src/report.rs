@@ -3,8 +3,9 @@
 use std::fmt::Write;
 
 use launch::analysis::LogAnalysis;
+use launch::law_info::LawInfo;
 use launch::run::timing::{Percentiles, TimingSummary};
-use launch::summary::Summary;
+use launch::summary::{ArmMetrics, Summary};
 use scenario::Plan;
 use serde::Serialize;
 
@@ -29,6 +30,11 @@ pub struct Report {
     pub locked_joints: Vec<String>,
     /// Joints coupled by `<mimic>`, not controlled.
     pub mimic_joints: Vec<String>,
+    /// The control law, whether it is model-based, and its parameters.
+    pub law: LawInfo,
+    /// Controller compute time per step, µs (in process: timed around each
+    /// step; a logged run: as the controller node measured it).
+    pub compute_us: Percentiles,
     /// The run's figures.
     #[serde(flatten)]
     pub summary: Summary,
@@ -97,11 +103,13 @@ fn gains(plan: &Plan) -> Gains {
 }
 
 impl Report {
-    /// For an in-process run.
-    pub fn from_sim(plan: &Plan, summary: Summary, wall_time_s: f64) -> Self {
+    /// For an in-process run; `compute_ns` is each controller step's time.
+    pub fn from_sim(plan: &Plan, summary: Summary, wall_time_s: f64, compute_ns: &[u64]) -> Self {
         let sim_s = summary.steps as f64 * summary.dt_s;
         let g = gains(plan);
         Self {
+            law: LawInfo::of(&plan.scenario.controller),
+            compute_us: Percentiles::of(compute_ns.iter().map(|n| *n as f64 / 1e3).collect()),
             scenario: plan.scenario.name.clone(),
             scenario_source: plan.source.clone(),
             robot: plan.robot.label(),
@@ -133,6 +141,8 @@ impl Report {
         let sim_s = a.summary.steps as f64 * a.summary.dt_s;
         let g = gains(&a.plan);
         Self {
+            law: LawInfo::of(&a.plan.scenario.controller),
+            compute_us: a.timing.controller_compute_us,
             k1: g.k1,
             k2: g.k2,
             k2_below_analysis: g.below,
@@ -171,6 +181,7 @@ pub fn table(r: &Report) -> String {
     heading(&mut out, r);
     joint_table(&mut out, &r.summary);
     verdicts(&mut out, &r.summary);
+    metric_lines(&mut out, &r.summary.metrics, &r.compute_us);
     if let Some(t) = &r.timing {
         timing_lines(&mut out, t);
     }
@@ -202,6 +213,7 @@ fn heading(out: &mut String, r: &Report) {
             .collect::<Vec<_>>()
             .join(", ")
     };
+    let _ = writeln!(out, "law {}", r.law.label());
     let _ = writeln!(out, "gains: K1 = [{}], K2 = [{}]", fmt(&r.k1), fmt(&r.k2));
     if !r.k2_below_analysis.is_empty() {
         let _ = writeln!(
@@ -279,6 +291,38 @@ fn verdicts(out: &mut String, s: &Summary) {
         out,
         "plant effects: {active}; saturated {} steps, commands lost {}, held {}",
         e.saturated_steps, e.dropped_commands, e.held_commands
+    );
+}
+
+/// BASELINES.md's metrics for the whole arm.
+fn metric_lines(out: &mut String, m: &ArmMetrics, compute: &Percentiles) {
+    let _ = writeln!(
+        out,
+        "errors after T_c (sums over joints): IAE {}, ISE {}, ITAE {}; RMS {}",
+        opt(m.iae_after_tc, 5),
+        opt(m.ise_after_tc, 6),
+        opt(m.itae_after_tc, 4),
+        opt(m.rms_error_after_tc, 5)
+    );
+    let entered = m.entered_envelope_s.map_or_else(
+        || "never (outside at the end)".into(),
+        |t| format!("{t:.3} s"),
+    );
+    let _ = writeln!(
+        out,
+        "envelope: inside for good from {entered}; violated {:.3} s ({:.3} s after T_c)",
+        m.violation_s, m.violation_after_tc_s
+    );
+    let _ = writeln!(
+        out,
+        "effort: int tau^2 {:.3} ({:.3} after T_c), torque rate int dtau^2 {:.1}, peak |tau| {:.2}, \
+         saturated {:.3} s; breaches {}",
+        m.effort, m.effort_after_tc, m.torque_rate, m.peak_abs_torque, m.saturated_s, m.breaches
+    );
+    let _ = writeln!(
+        out,
+        "controller compute per step: p50 {:.2} us, p99 {:.2} us",
+        compute.p50, compute.p99
     );
 }
 

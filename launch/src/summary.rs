@@ -30,6 +30,22 @@ pub struct JointSummary {
     pub max_abs_torque: f64,
     /// max ‖Ŵ_a‖ (column norm).
     pub max_actor_weight_norm: f64,
+    /// IAE ∫|e| dt over t ≥ T_c, rad s.
+    pub iae_after_tc: Option<f64>,
+    /// ISE ∫e² dt over t ≥ T_c, rad² s.
+    pub ise_after_tc: Option<f64>,
+    /// ITAE ∫t|e| dt over t ≥ T_c (t from the start of the run), rad s².
+    pub itae_after_tc: Option<f64>,
+    /// When |e| < k_c held from then to the end (0: always inside; None:
+    /// outside at the last step), s.
+    pub entered_envelope_s: Option<f64>,
+    /// ∫1[|e| ≥ k_c] dt over the run, s.
+    pub violation_s: f64,
+    /// ∫1[|e| ≥ k_c] dt over t ≥ T_c, s.
+    pub violation_after_tc_s: f64,
+    /// Torque rate ∫τ̇² dt with τ̇ the change between steps over Δt (the
+    /// first step's rise from rest excluded), N² m² / s.
+    pub torque_rate_integral: f64,
 }
 
 /// The whole run.
@@ -56,6 +72,44 @@ pub struct Summary {
     pub fault_steps: u64,
     /// Every state, torque and error was finite and no step faulted.
     pub finite: bool,
+    /// The metrics of BASELINES.md for the whole arm.
+    pub metrics: ArmMetrics,
+}
+
+/// BASELINES.md's metrics for the whole arm: sums over joints of the
+/// integrals, the worst joint for the rest.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ArmMetrics {
+    /// Σ IAE over t ≥ T_c.
+    pub iae_after_tc: Option<f64>,
+    /// Σ ISE over t ≥ T_c.
+    pub ise_after_tc: Option<f64>,
+    /// Σ ITAE over t ≥ T_c.
+    pub itae_after_tc: Option<f64>,
+    /// RMS of e over every joint and step with t ≥ T_c.
+    pub rms_error_after_tc: Option<f64>,
+    /// max |e| over t ≥ T_c.
+    pub max_abs_error_after_tc: Option<f64>,
+    /// min (k_c − |e|) over t ≥ T_c.
+    pub min_margin_after_tc: Option<f64>,
+    /// When every joint was inside for good (None: some joint ends outside).
+    pub entered_envelope_s: Option<f64>,
+    /// Time with some joint at or outside its envelope, s.
+    pub violation_s: f64,
+    /// The same over t ≥ T_c, s.
+    pub violation_after_tc_s: f64,
+    /// Σ ∫τ² dt over the run.
+    pub effort: f64,
+    /// Σ ∫τ² dt over t ≥ T_c.
+    pub effort_after_tc: f64,
+    /// Σ ∫τ̇² dt.
+    pub torque_rate: f64,
+    /// max |τ| over joints and steps.
+    pub peak_abs_torque: f64,
+    /// Time with some torque clipped at its effort limit, s.
+    pub saturated_s: f64,
+    /// Steps where the law's guard acted (barrier clamp, or funnel clamp for `ppc`).
+    pub breaches: u64,
 }
 
 /// The plant effects of a run, as its logged states flag them.
@@ -87,6 +141,16 @@ pub struct SummaryBuilder {
     effort_after: Vec<f64>,
     max_tau: Vec<f64>,
     max_wa: Vec<f64>,
+    iae: Vec<f64>,
+    itae: Vec<f64>,
+    last_violation: Vec<Option<f64>>,
+    violation: Vec<f64>,
+    violation_after: Vec<f64>,
+    any_violation: f64,
+    any_violation_after: f64,
+    prev_tau: Option<Vec<f64>>,
+    torque_rate: Vec<f64>,
+    t_last: f64,
     breached: u64,
     faults: u64,
     finite: bool,
@@ -114,6 +178,16 @@ impl SummaryBuilder {
             effort_after: vec![0.0; n],
             max_tau: vec![0.0; n],
             max_wa: vec![0.0; n],
+            iae: vec![0.0; n],
+            itae: vec![0.0; n],
+            last_violation: vec![None; n],
+            violation: vec![0.0; n],
+            violation_after: vec![0.0; n],
+            any_violation: 0.0,
+            any_violation_after: 0.0,
+            prev_tau: None,
+            torque_rate: vec![0.0; n],
+            t_last: 0.0,
             breached: 0,
             faults: 0,
             finite: true,
@@ -143,6 +217,7 @@ impl SummaryBuilder {
         self.finite &= all_finite && !r.fault;
         let after = r.t >= self.tc;
         self.after_tc += u64::from(after);
+        self.add_baseline_metrics(r, after);
         for i in 0..self.names.len() {
             let e = (r.q[i] - r.q_d[i]).abs();
             self.max_ratio[i] = nan_max(self.max_ratio[i], r.z1g[i].abs() / r.kc[i]);
@@ -156,6 +231,53 @@ impl SummaryBuilder {
                 self.sum_sq_err[i] += e * e;
                 self.effort_after[i] += tau2;
             }
+        }
+    }
+
+    /// The integrals and times of BASELINES.md's metrics for one step.
+    fn add_baseline_metrics(&mut self, r: &StepRecord<'_>, after: bool) {
+        let dt = self.dt;
+        self.t_last = r.t;
+        let mut any = false;
+        for i in 0..self.names.len() {
+            let e = (r.q[i] - r.q_d[i]).abs();
+            // NaN counts as outside.
+            let outside = !(e < r.kc[i]);
+            if outside {
+                any = true;
+                self.last_violation[i] = Some(r.t);
+                self.violation[i] += dt;
+                if after {
+                    self.violation_after[i] += dt;
+                }
+            }
+            if after {
+                self.iae[i] += e * dt;
+                self.itae[i] += r.t * e * dt;
+            }
+            if let Some(prev) = &self.prev_tau {
+                let d = r.tau[i] - prev[i];
+                self.torque_rate[i] += d * d / dt;
+            }
+        }
+        if any {
+            self.any_violation += dt;
+            if after {
+                self.any_violation_after += dt;
+            }
+        }
+        match self.prev_tau.as_mut() {
+            Some(p) => p.copy_from_slice(r.tau),
+            None => self.prev_tau = Some(r.tau.to_vec()),
+        }
+    }
+
+    /// When joint `i` entered its envelope for good.
+    fn entered(&self, i: usize) -> Option<f64> {
+        match self.last_violation[i] {
+            None => Some(0.0),
+            Some(t) if t >= self.t_last => None,
+            Some(t) => Some(t + self.dt),
         }
     }
 
@@ -174,8 +296,16 @@ impl SummaryBuilder {
                 effort_integral_after_tc: self.effort_after[i],
                 max_abs_torque: self.max_tau[i],
                 max_actor_weight_norm: self.max_wa[i],
+                iae_after_tc: when(self.iae[i]),
+                ise_after_tc: when(self.sum_sq_err[i] * self.dt),
+                itae_after_tc: when(self.itae[i]),
+                entered_envelope_s: self.entered(i),
+                violation_s: self.violation[i],
+                violation_after_tc_s: self.violation_after[i],
+                torque_rate_integral: self.torque_rate[i],
             })
             .collect();
+        let metrics = self.arm_metrics(&joints, any_after);
         let satisfied = any_after
             && joints
                 .iter()
@@ -196,6 +326,38 @@ impl SummaryBuilder {
             barrier_breached_steps: self.breached,
             fault_steps: self.faults,
             finite: self.finite,
+            metrics,
+        }
+    }
+
+    fn arm_metrics(&self, joints: &[JointSummary], any_after: bool) -> ArmMetrics {
+        let when = |v: f64| any_after.then_some(v);
+        let sum = |f: fn(&JointSummary) -> f64| joints.iter().map(f).sum::<f64>();
+        let fold = |f: fn(&JointSummary) -> Option<f64>, max: bool| {
+            let vals = joints.iter().map(f);
+            if max {
+                vals.fold(Some(0.0), |a, b| Some(nan_max(a?, b?)))
+            } else {
+                vals.fold(Some(f64::INFINITY), |a, b| Some(nan_min(a?, b?)))
+            }
+        };
+        let n_after = (self.after_tc as usize * joints.len()).max(1) as f64;
+        ArmMetrics {
+            iae_after_tc: when(self.iae.iter().sum()),
+            ise_after_tc: when(self.sum_sq_err.iter().sum::<f64>() * self.dt),
+            itae_after_tc: when(self.itae.iter().sum()),
+            rms_error_after_tc: when((self.sum_sq_err.iter().sum::<f64>() / n_after).sqrt()),
+            max_abs_error_after_tc: fold(|j| j.max_abs_error_after_tc, true),
+            min_margin_after_tc: fold(|j| j.min_margin_after_tc, false),
+            entered_envelope_s: fold(|j| j.entered_envelope_s, true),
+            violation_s: self.any_violation,
+            violation_after_tc_s: self.any_violation_after,
+            effort: sum(|j| j.effort_integral),
+            effort_after_tc: sum(|j| j.effort_integral_after_tc),
+            torque_rate: sum(|j| j.torque_rate_integral),
+            peak_abs_torque: joints.iter().map(|j| j.max_abs_torque).fold(0.0, nan_max),
+            saturated_s: self.saturated as f64 * self.dt,
+            breaches: self.breached,
         }
     }
 }
@@ -266,6 +428,32 @@ mod tests {
         assert_eq!(j.effort_integral_after_tc, (1.0 + 0.25) * 0.5);
         assert_eq!(j.max_abs_torque, 2.0);
         assert!(s.constraint_satisfied_after_tc && s.finite);
+        // BASELINES.md's metrics, after T_c = 1 s, Δt = 0.5 s.
+        let close = |a: Option<f64>, b: f64| assert!((a.unwrap() - b).abs() < 1e-15, "{a:?} {b}");
+        close(j.iae_after_tc, (0.3 + 0.4) * 0.5);
+        close(j.ise_after_tc, (0.09 + 0.16) * 0.5);
+        close(j.itae_after_tc, (1.0 * 0.3 + 1.5 * 0.4) * 0.5);
+        assert_eq!((j.violation_s, j.violation_after_tc_s), (0.5, 0.0));
+        assert_eq!(j.entered_envelope_s, Some(0.5));
+        assert_eq!(j.torque_rate_integral, (9.0 + 4.0 + 0.25) / 0.5);
+        let m = &s.metrics;
+        assert_eq!(
+            (m.iae_after_tc, m.effort_after_tc),
+            (j.iae_after_tc, 1.25 * 0.5)
+        );
+        assert_eq!((m.violation_s, m.entered_envelope_s), (0.5, Some(0.5)));
+        assert_eq!(m.peak_abs_torque, 2.0);
+    }
+
+    #[test]
+    fn ending_outside_never_enters_for_good() {
+        let mut b = SummaryBuilder::new(vec!["a".into()], 0.5, 1.0);
+        b.add(&rec(0.0, &[0.1], &[0.0], &[1.0], &[0.5]));
+        b.add(&rec(0.5, &[0.6], &[0.6], &[1.0], &[0.5]));
+        let s = b.finish();
+        assert_eq!(s.joints[0].entered_envelope_s, None);
+        assert_eq!(s.metrics.entered_envelope_s, None);
+        assert_eq!(s.metrics.violation_s, 0.5);
     }
 
     #[test]

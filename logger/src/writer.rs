@@ -52,6 +52,12 @@ pub struct RunMetadata {
     pub mimic_joints: String,
     /// Whether URDF damping and friction act.
     pub urdf_dynamics: bool,
+    /// The control law (`nac`, `pd`, `ctc`, …).
+    pub law: String,
+    /// Whether the law uses the URDF's model (M, C, G).
+    pub model_based: bool,
+    /// The law's parameters as `key=value` pairs.
+    pub law_parameters: String,
 }
 
 impl RunMetadata {
@@ -71,6 +77,9 @@ impl RunMetadata {
             ("locked_joints".into(), self.locked_joints.clone()),
             ("mimic_joints".into(), self.mimic_joints.clone()),
             ("urdf_dynamics".into(), self.urdf_dynamics.to_string()),
+            ("law".into(), self.law.clone()),
+            ("model_based".into(), self.model_based.to_string()),
+            ("law_parameters".into(), self.law_parameters.clone()),
             (
                 "start_time_unix_ns".into(),
                 self.start_time_unix_ns.to_string(),

@@ -73,6 +73,10 @@ pub struct Overrides {
     /// Replaces the robot; with no scenario file, the default scenario for
     /// that arm is used.
     pub robot: Option<PathBuf>,
+    /// Runs this law on the scenario: its shared keys (T_c, K1, K2) are
+    /// kept, keys the law does not take go back to their defaults
+    /// ([`controller::ControllerParams::for_law`]), as in `compare`.
+    pub law: Option<controller::LawName>,
 }
 
 /// Loads a scenario file (or the built-in paper scenario when `path` is
@@ -122,6 +126,10 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
     if let Some(r) = overrides.rate_hz {
         scenario.rate_hz = r;
         scenario.validate(&format!("{source} with --rate {r}"))?;
+    }
+    if let Some(law) = overrides.law {
+        scenario.controller = scenario.controller.for_law(law);
+        scenario.validate(&format!("{source} with --law {law}"))?;
     }
     let locks = &scenario.plant.lock;
     let robot = match (arm, &scenario.robot, &base) {

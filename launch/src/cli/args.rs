@@ -20,6 +20,11 @@ pub(crate) struct ScenarioArgs {
     /// Run for this many seconds instead of the scenario's duration_s.
     #[arg(long, value_name = "S")]
     pub(crate) duration: Option<f64>,
+    /// Run this law instead of the scenario's (nac, nac-no-shift,
+    /// nac-no-critic, nac-no-networks, blf, pd, pd-gravity, ctc, ppc): T_c,
+    /// K1 and K2 are the scenario's, keys the law does not take are reset.
+    #[arg(long, value_name = "LAW")]
+    pub(crate) law: Option<controller::LawName>,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub(crate) json: bool,
@@ -101,4 +106,37 @@ pub(crate) struct ReplayArgs {
     /// report the largest difference from the logged torques.
     #[arg(long)]
     pub(crate) verify: bool,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct CompareArgs {
+    /// Scenario file (TOML), or the name of a shipped one [default: the paper's].
+    #[arg(long, value_name = "FILE|NAME")]
+    pub(crate) scenario: Option<PathBuf>,
+    /// Run this arm (URDF) instead of the scenario's; with no --scenario,
+    /// the default scenario for the arm.
+    #[arg(long, value_name = "URDF")]
+    pub(crate) robot: Option<PathBuf>,
+    /// Run for this many seconds instead of the scenario's duration_s.
+    #[arg(long, value_name = "S")]
+    pub(crate) duration: Option<f64>,
+    /// The laws, comma-separated [default: nac, nac-no-shift, nac-no-critic,
+    /// nac-no-networks, blf, pd, ctc, ppc; pd-gravity on request].
+    #[arg(long, value_name = "LAW,…", value_delimiter = ',')]
+    pub(crate) laws: Vec<controller::LawName>,
+    /// Seeds per law: the scenario's seed, seed + 1, … (table: median and worst).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub(crate) seeds: u64,
+    /// Worker threads [default: one per CPU].
+    #[arg(long, value_name = "N")]
+    pub(crate) threads: Option<usize>,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Write one row per law and seed, with every metric, to this CSV file.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) csv: Option<PathBuf>,
+    /// Write the comparison figures (PNG and SVG) here.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) plots: Option<PathBuf>,
 }

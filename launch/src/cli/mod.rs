@@ -2,6 +2,7 @@
 
 mod args;
 mod bench;
+mod compare;
 mod replay;
 mod robot;
 mod run;
@@ -19,7 +20,7 @@ use scenario::Overrides;
 use wire::NodeKind;
 
 use crate::report::{self, Report};
-use args::{BenchArgs, ReplayArgs, RunArgs, ScenarioArgs, SimArgs};
+use args::{BenchArgs, CompareArgs, ReplayArgs, RunArgs, ScenarioArgs, SimArgs};
 
 /// Run the paper's RL neuroadaptive controller under deferred constraints on
 /// a simulated arm.
@@ -51,6 +52,9 @@ enum Command {
     Bench(BenchArgs),
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
     Replay(ReplayArgs),
+    /// Run several laws (the paper's, its ablations, baselines) on the same
+    /// scenario and seeds, in process on every core, and score them.
+    Compare(CompareArgs),
     /// List the shipped scenarios and what each one demonstrates.
     Scenarios,
     /// Run one node of a stack (the launcher starts these; start one by hand
@@ -95,6 +99,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Run(args) => run::run_stack(args, cli.verbose),
         Command::Replay(args) => replay::replay(args),
         Command::Bench(args) => bench::bench(args),
+        Command::Compare(args) => compare::compare(args),
         Command::Scenarios => {
             print!("{}", scenarios::scenario_list());
             Ok(ExitCode::SUCCESS)
@@ -116,6 +121,7 @@ pub(crate) fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario:
         duration_s: common.duration,
         rate_hz: rate,
         robot: common.robot.clone(),
+        law: common.law,
     };
     let path = common.scenario.as_deref().map(resolve_scenario);
     Ok(scenario::load(path.as_deref(), &overrides)?)

@@ -32,7 +32,8 @@ pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
         plan.scenario.controller.tc,
     );
     let start = Instant::now();
-    let result = in_process::run(&plan, |r| {
+    let mut costs = in_process::StepCosts::default();
+    let result = in_process::run_measured(&plan, Some(&mut costs), |r| {
         summary.add(r);
         match csv.as_mut() {
             Some(w) => csv_out::write_row(w, r),
@@ -46,6 +47,7 @@ pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     result.with_context(|| format!("running {}", plan.source))?;
-    print_report(&Report::from_sim(&plan, summary.finish(), wall), args.json)?;
+    let report = Report::from_sim(&plan, summary.finish(), wall, &costs.controller_ns);
+    print_report(&report, args.json)?;
     Ok(ExitCode::SUCCESS)
 }

@@ -73,7 +73,11 @@ pub fn metadata(plan: &Plan, mode: Mode, out: &Path, toml: &str) -> RunMetadata 
     let n = m.dof();
     let gains = |g: &controller::Gain| format!("{:?}", g.resolve("gain", n).unwrap_or_default());
     let (locked, mimic) = joint_roles(plan);
+    let law = crate::law_info::LawInfo::of(&plan.scenario.controller);
     RunMetadata {
+        law: law.law.to_string(),
+        model_based: law.model_based,
+        law_parameters: law.parameters_text(),
         run_id: out
             .parent()
             .and_then(|p| p.file_name())

@@ -1,0 +1,191 @@
+//! `testbed compare`: the laws side by side on one scenario.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use launch::compare::{self, CompareOptions, Comparison, METRICS};
+
+use super::args::{CompareArgs, ScenarioArgs};
+
+pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
+    if args.seeds == 0 {
+        bail!("--seeds 0: compare needs at least one seed");
+    }
+    if args.threads == Some(0) {
+        bail!("--threads 0: compare needs at least one thread");
+    }
+    // Refuse an unwritable CSV before the runs, not after them.
+    let csv = match &args.csv {
+        Some(path) => Some((
+            path,
+            std::fs::File::create(path)
+                .with_context(|| format!("cannot create CSV file {}", path.display()))?,
+        )),
+        None => None,
+    };
+    let common = ScenarioArgs {
+        scenario: args.scenario.clone(),
+        robot: args.robot.clone(),
+        duration: args.duration,
+        law: None,
+        json: args.json,
+        csv: None,
+    };
+    let plan = super::load(&common, None)?;
+    let laws = if args.laws.is_empty() {
+        compare::DEFAULT_LAWS.to_vec()
+    } else {
+        args.laws.clone()
+    };
+    let opts = CompareOptions {
+        laws,
+        seeds: args.seeds,
+        threads: args.threads,
+        series: args.plots.is_some(),
+    };
+    let result =
+        compare::compare(&plan, &opts).with_context(|| format!("comparing on {}", plan.source))?;
+    if let Some((path, file)) = csv {
+        let mut w = std::io::BufWriter::new(file);
+        write_csv(&mut w, &result)
+            .and_then(|_| w.flush())
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(dir) = &args.plots {
+        let n = launch::compare_plots::write_all(dir, &result, &plan)
+            .with_context(|| format!("writing figures to {}", dir.display()))?;
+        eprintln!("testbed: wrote {n} figures to {}", dir.display());
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&result)?);
+    } else {
+        print!("{}", table(&result));
+    }
+    let failed: Vec<String> = result
+        .laws
+        .iter()
+        .flat_map(|l| {
+            l.runs.iter().filter_map(|r| {
+                r.failure
+                    .as_ref()
+                    .map(|f| format!("{} seed {}: {f}", l.law.law, r.seed))
+            })
+        })
+        .collect();
+    for f in &failed {
+        eprintln!("testbed: warning: {f}");
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Columns of the table: (metric, heading, decimals).
+const COLUMNS: [(&str, &str, usize); 12] = [
+    ("iae", "IAE", 4),
+    ("ise", "ISE", 6),
+    ("itae", "ITAE", 3),
+    ("max_abs_error", "max|e|", 5),
+    ("entered_s", "enter[s]", 3),
+    ("violation_s", "viol[s]", 3),
+    ("violation_after_tc_s", "viol>Tc", 3),
+    ("effort_after_tc", "eff>Tc", 1),
+    ("torque_rate", "int dtau^2", 0),
+    ("saturated_s", "sat[s]", 3),
+    ("breaches", "breach", 0),
+    ("compute_p50_us", "cpu p50us", 2),
+];
+
+fn cell(v: Option<f64>, prec: usize) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.prec$}"),
+        Some(_) => "never".into(),
+        None => "n/a".into(),
+    }
+}
+
+/// One row per law (median over seeds; a second "worst" row when N > 1).
+pub(crate) fn table(c: &Comparison) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "compare on {} ({}), robot {}: {} s per run, {} seed(s), {} threads, {:.2} s wall",
+        c.scenario, c.scenario_source, c.robot, c.duration_s, c.seeds, c.threads, c.wall_time_s
+    );
+    let _ = writeln!(
+        out,
+        "metrics after T_c unless marked; sums over joints; model: URDF = the law uses the URDF's M, C, G\n"
+    );
+    let _ = write!(out, "{:<16} {:<5} {:>6}", "law", "model", "kept");
+    for (_, h, _) in COLUMNS {
+        let _ = write!(out, " {h:>10}");
+    }
+    let _ = writeln!(out);
+    for row in &c.laws {
+        let stats: Vec<(&str, &compare::Stats)> = if c.seeds > 1 {
+            vec![("median", &row.median), ("worst", &row.worst)]
+        } else {
+            vec![("", &row.median)]
+        };
+        for (which, s) in stats {
+            let name = if which.is_empty() || which == "median" {
+                row.law.law.to_string()
+            } else {
+                format!("  ({which})")
+            };
+            let model = if row.law.model_based { "URDF" } else { "free" };
+            let kept = format!("{}/{}", row.kept_envelope, row.runs.len());
+            let _ = write!(out, "{name:<16} {model:<5} {kept:>6}");
+            for (key, _, prec) in COLUMNS {
+                let _ = write!(out, " {:>10}", cell(s.get(key), prec));
+            }
+            let _ = writeln!(out);
+        }
+    }
+    let _ = writeln!(
+        out,
+        "\nkept: runs with |e| < k_c for every t >= T_c; enter: when every joint was inside for good; \
+         breach: steps the barrier's guard or the funnel's clamp acted"
+    );
+    out
+}
+
+/// One row per law and seed: `law,model_based,seed,failed,` then every metric.
+fn write_csv(w: &mut impl std::io::Write, c: &Comparison) -> std::io::Result<()> {
+    let names: Vec<&str> = METRICS.iter().map(|m| m.name).collect();
+    writeln!(
+        w,
+        "law,model_based,seed,failed,kept_envelope,{}",
+        names.join(",")
+    )?;
+    for row in &c.laws {
+        for run in &row.runs {
+            let one = compare::stats_of(run);
+            let values: Vec<String> = one
+                .0
+                .iter()
+                .map(|(_, v)| {
+                    if v.is_finite() {
+                        format!("{v:?}")
+                    } else {
+                        String::new()
+                    }
+                })
+                .collect();
+            let kept = run.failure.is_none()
+                && run.summary.constraint_satisfied_after_tc
+                && run.summary.finite;
+            writeln!(
+                w,
+                "{},{},{},{},{},{}",
+                row.law.law,
+                row.law.model_based,
+                run.seed,
+                run.failure.is_some(),
+                kept,
+                values.join(",")
+            )?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,401 @@
+//! `testbed compare`: every law on the same scenario and seeds, in process,
+//! on every core, scored on BASELINES.md's metrics.
+//!
+//! Each run is exactly `testbed sim --law L` with the scenario's seed + s:
+//! the same plan ([`plan_for`]), the same loop ([`crate::sim`]), the same
+//! summary, so a row can be checked against a single run bit for bit.
+
+use controller::LawName;
+use rayon::prelude::*;
+use scenario::Plan;
+use serde::Serialize;
+
+use crate::law_info::LawInfo;
+use crate::run::timing::Percentiles;
+use crate::sim::{self, StepCosts};
+use crate::summary::{Summary, SummaryBuilder};
+
+/// The laws `compare` runs when none are named: the paper's law, its
+/// ablations, the classic barrier law, PD, computed torque and PPC.
+pub const DEFAULT_LAWS: [LawName; 8] = [
+    LawName::Nac,
+    LawName::NacNoShift,
+    LawName::NacNoCritic,
+    LawName::NacNoNetworks,
+    LawName::Blf,
+    LawName::Pd,
+    LawName::Ctc,
+    LawName::Ppc,
+];
+
+/// Why a comparison could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    /// A law or seed turns the scenario into an invalid one.
+    #[error("{law}, seed {seed}: {cause}")]
+    Plan {
+        /// The law.
+        law: LawName,
+        /// The seed.
+        seed: u64,
+        /// The cause.
+        cause: scenario::ScenarioError,
+    },
+    /// The worker threads could not be started.
+    #[error("cannot start {threads} worker threads: {cause}")]
+    Threads {
+        /// Threads asked for.
+        threads: usize,
+        /// The cause.
+        cause: String,
+    },
+    /// Nothing to run.
+    #[error("{0}")]
+    Empty(&'static str),
+}
+
+/// What to run.
+#[derive(Debug, Clone)]
+pub struct CompareOptions {
+    /// The laws, in table order.
+    pub laws: Vec<LawName>,
+    /// Seeds per law: the scenario's seed, +1, … (at least 1).
+    pub seeds: u64,
+    /// Worker threads (None: one per CPU).
+    pub threads: Option<usize>,
+    /// Keep the first seed's error, envelope and torque per law, for figures.
+    pub series: bool,
+}
+
+/// The first seed's curves of one law, for the overlay figures.
+#[derive(Debug, Clone, Default)]
+pub struct LawSeries {
+    /// Sim time, s.
+    pub t: Vec<f64>,
+    /// e = q − q_d per joint (the true state).
+    pub e: Vec<Vec<f64>>,
+    /// k_c per joint.
+    pub kc: Vec<Vec<f64>>,
+}
+
+/// One run of one law.
+#[derive(Debug, Clone, Serialize)]
+pub struct LawRun {
+    /// The seed of every random effect.
+    pub seed: u64,
+    /// Why the run stopped early, if it did (the summary covers the steps before).
+    pub failure: Option<String>,
+    /// The run's summary, as `testbed sim --law` prints it.
+    pub summary: Summary,
+    /// Controller compute per step, µs.
+    pub compute_us: Percentiles,
+    /// The curves (first seed, with `series`).
+    #[serde(skip)]
+    pub series: Option<LawSeries>,
+}
+
+/// One law over every seed.
+#[derive(Debug, Clone, Serialize)]
+pub struct LawRow {
+    /// The law, whether it is model-based, and its parameters.
+    pub law: LawInfo,
+    /// Each seed's run.
+    pub runs: Vec<LawRun>,
+    /// Per metric, the median over seeds.
+    pub median: Stats,
+    /// Per metric, the worst seed's value.
+    pub worst: Stats,
+    /// Seeds whose run kept |e| < k_c for every t ≥ T_c, finite.
+    pub kept_envelope: u64,
+}
+
+/// The whole comparison.
+#[derive(Debug, Clone, Serialize)]
+pub struct Comparison {
+    /// Scenario name.
+    pub scenario: String,
+    /// Where it came from.
+    pub scenario_source: String,
+    /// The robot.
+    pub robot: String,
+    /// Sim time per run, s.
+    pub duration_s: f64,
+    /// Seeds per law.
+    pub seeds: u64,
+    /// Worker threads used.
+    pub threads: usize,
+    /// Wall time of all runs, s.
+    pub wall_time_s: f64,
+    /// One row per law.
+    pub laws: Vec<LawRow>,
+}
+
+/// One value per metric of [`METRICS`], in order (JSON: an object; an
+/// infinite value, i.e. a missing one counted as the worst, is null).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stats(pub Vec<(&'static str, f64)>);
+
+impl Stats {
+    /// The value of metric `name`.
+    pub fn get(&self, name: &str) -> Option<f64> {
+        self.0.iter().find(|(k, _)| *k == name).map(|(_, v)| *v)
+    }
+}
+
+impl Serialize for Stats {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = s.serialize_map(Some(self.0.len()))?;
+        for (k, v) in &self.0 {
+            map.serialize_entry(k, &v.is_finite().then_some(*v))?;
+        }
+        map.end()
+    }
+}
+
+/// A metric of the table: its name, unit and which way is worse.
+pub struct Metric {
+    /// Name (JSON key and column).
+    pub name: &'static str,
+    /// Unit, for headings.
+    pub unit: &'static str,
+    /// Larger is worse (false: smaller is worse, as for the margin).
+    pub larger_is_worse: bool,
+    get: fn(&LawRun) -> Option<f64>,
+}
+
+/// BASELINES.md's metrics, in table order. A missing value (the run ended
+/// before T_c, or never entered the envelope for good) counts as the worst.
+pub const METRICS: &[Metric] = &[
+    m("iae", "rad s", true, |r| r.summary.metrics.iae_after_tc),
+    m("ise", "rad² s", true, |r| r.summary.metrics.ise_after_tc),
+    m("itae", "rad s²", true, |r| r.summary.metrics.itae_after_tc),
+    m("max_abs_error", "rad", true, |r| {
+        r.summary.metrics.max_abs_error_after_tc
+    }),
+    m("min_margin", "rad", false, |r| {
+        r.summary.metrics.min_margin_after_tc
+    }),
+    m("entered_s", "s", true, |r| {
+        r.summary.metrics.entered_envelope_s
+    }),
+    m("violation_s", "s", true, |r| {
+        Some(r.summary.metrics.violation_s)
+    }),
+    m("violation_after_tc_s", "s", true, |r| {
+        Some(r.summary.metrics.violation_after_tc_s)
+    }),
+    m("effort_after_tc", "N² m² s", true, |r| {
+        Some(r.summary.metrics.effort_after_tc)
+    }),
+    m("torque_rate", "N² m²/s", true, |r| {
+        Some(r.summary.metrics.torque_rate)
+    }),
+    m("peak_torque", "N m", true, |r| {
+        Some(r.summary.metrics.peak_abs_torque)
+    }),
+    m("saturated_s", "s", true, |r| {
+        Some(r.summary.metrics.saturated_s)
+    }),
+    m("breaches", "steps", true, |r| {
+        Some(r.summary.metrics.breaches as f64)
+    }),
+    m("compute_p50_us", "µs", true, |r| Some(r.compute_us.p50)),
+    m("compute_p99_us", "µs", true, |r| Some(r.compute_us.p99)),
+];
+
+const fn m(
+    name: &'static str,
+    unit: &'static str,
+    larger_is_worse: bool,
+    get: fn(&LawRun) -> Option<f64>,
+) -> Metric {
+    Metric {
+        name,
+        unit,
+        larger_is_worse,
+        get,
+    }
+}
+
+/// The plan of `testbed sim --law <law>` with seed `plan.seed + s`.
+pub fn plan_for(plan: &Plan, law: LawName, s: u64) -> Result<Plan, CompareError> {
+    let mut p = plan.clone();
+    p.scenario.controller = plan.scenario.controller.for_law(law);
+    p.scenario.seed = plan.scenario.seed.wrapping_add(s);
+    let seed = p.scenario.seed;
+    p.scenario
+        .validate(&plan.source)
+        .map_err(|cause| CompareError::Plan { law, seed, cause })?;
+    Ok(p)
+}
+
+/// Runs every law on every seed and scores them.
+pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, CompareError> {
+    if opts.laws.is_empty() || opts.seeds == 0 {
+        return Err(CompareError::Empty(
+            "compare needs at least one law and one seed",
+        ));
+    }
+    let mut jobs = Vec::new();
+    for &law in &opts.laws {
+        for s in 0..opts.seeds {
+            jobs.push((law, s, plan_for(plan, law, s)?));
+        }
+    }
+    let threads = opts
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| CompareError::Threads {
+            threads,
+            cause: e.to_string(),
+        })?;
+    let start = std::time::Instant::now();
+    let runs: Vec<LawRun> = pool.install(|| {
+        jobs.par_iter()
+            .map(|(_, s, p)| run_one(p, opts.series && *s == 0))
+            .collect()
+    });
+    let wall_time_s = start.elapsed().as_secs_f64();
+    let mut runs = runs.into_iter();
+    let laws = opts
+        .laws
+        .iter()
+        .map(|&law| {
+            let mine: Vec<LawRun> = runs.by_ref().take(opts.seeds as usize).collect();
+            row(LawInfo::of(&plan.scenario.controller.for_law(law)), mine)
+        })
+        .collect();
+    Ok(Comparison {
+        scenario: plan.scenario.name.clone(),
+        scenario_source: plan.source.clone(),
+        robot: plan.robot.label(),
+        duration_s: plan.steps as f64 * plan.dt(),
+        seeds: opts.seeds,
+        threads,
+        wall_time_s,
+        laws,
+    })
+}
+
+/// One in-process run, exactly as `testbed sim` makes it.
+pub fn run_one(plan: &Plan, keep_series: bool) -> LawRun {
+    let names = plan.robot.model.joint_names();
+    let n = names.len();
+    let mut summary = SummaryBuilder::new(names, plan.dt(), plan.scenario.controller.tc);
+    let mut series = keep_series.then(|| LawSeries {
+        e: vec![Vec::new(); n],
+        kc: vec![Vec::new(); n],
+        ..LawSeries::default()
+    });
+    let mut costs = StepCosts::default();
+    let result = sim::run_measured(plan, Some(&mut costs), |r| {
+        summary.add(r);
+        if let Some(s) = series.as_mut() {
+            s.t.push(r.t);
+            for i in 0..n {
+                s.e[i].push(r.q[i] - r.q_d[i]);
+                s.kc[i].push(r.kc[i]);
+            }
+        }
+        Ok(())
+    });
+    LawRun {
+        seed: plan.scenario.seed,
+        failure: result.err().map(|e| e.to_string()),
+        summary: summary.finish(),
+        compute_us: Percentiles::of(
+            costs
+                .controller_ns
+                .iter()
+                .map(|n| *n as f64 / 1e3)
+                .collect(),
+        ),
+        series,
+    }
+}
+
+/// Every metric of one run (missing values as the worst, ±∞).
+pub fn stats_of(run: &LawRun) -> Stats {
+    Stats(METRICS.iter().map(|m| (m.name, value(m, run))).collect())
+}
+
+fn value(metric: &Metric, run: &LawRun) -> f64 {
+    let bad = if metric.larger_is_worse {
+        f64::INFINITY
+    } else {
+        f64::NEG_INFINITY
+    };
+    (metric.get)(run).filter(|x| !x.is_nan()).unwrap_or(bad)
+}
+
+fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
+    let mut median = Vec::new();
+    let mut worst = Vec::new();
+    for metric in METRICS {
+        let mut v: Vec<f64> = runs.iter().map(|r| value(metric, r)).collect();
+        v.sort_by(f64::total_cmp);
+        median.push((metric.name, median_of(&v)));
+        let w = if metric.larger_is_worse {
+            v[v.len() - 1]
+        } else {
+            v[0]
+        };
+        worst.push((metric.name, w));
+    }
+    let kept = runs
+        .iter()
+        .filter(|r| r.failure.is_none())
+        .filter(|r| r.summary.constraint_satisfied_after_tc && r.summary.finite)
+        .count() as u64;
+    LawRow {
+        law,
+        runs,
+        median: Stats(median),
+        worst: Stats(worst),
+        kept_envelope: kept,
+    }
+}
+
+/// The median of sorted values (mean of the middle two for an even count).
+fn median_of(v: &[f64]) -> f64 {
+    let k = v.len() / 2;
+    if v.len() % 2 == 1 {
+        v[k]
+    } else {
+        let (a, b) = (v[k - 1], v[k]);
+        // ∞ in the middle stays ∞ (not NaN from ∞ − ∞).
+        if a == b { a } else { 0.5 * (a + b) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_and_worst_treat_missing_values_as_worst() {
+        assert_eq!(median_of(&[1.0, 2.0, 3.0]), 2.0);
+        assert_eq!(median_of(&[1.0, 2.0, 3.0, 10.0]), 2.5);
+        assert_eq!(
+            median_of(&[1.0, f64::INFINITY, f64::INFINITY]),
+            f64::INFINITY
+        );
+        assert_eq!(median_of(&[f64::INFINITY, f64::INFINITY]), f64::INFINITY);
+    }
+
+    #[test]
+    fn no_law_is_an_error() {
+        let plan = scenario::load(None, &scenario::Overrides::default()).unwrap();
+        let opts = CompareOptions {
+            laws: vec![],
+            seeds: 1,
+            threads: Some(1),
+            series: false,
+        };
+        assert!(compare(&plan, &opts).is_err());
+    }
+}

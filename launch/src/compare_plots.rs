@@ -1,0 +1,170 @@
+//! The figures of `testbed compare`: every law's error against ±k_c per
+//! joint, and effort and violation time as bars.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+use scenario::Plan;
+
+use crate::compare::{Comparison, LawRow};
+use crate::plots::{COLORS, FAMILY, FONT, Line, Panel, PlotError, RED, err, save};
+
+/// Writes `compare_errors` and `compare_bars` (PNG and SVG) into `dir`;
+/// returns how many figures.
+pub fn write_all(dir: &Path, c: &Comparison, plan: &Plan) -> Result<usize, PlotError> {
+    std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
+    let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
+    errors(dir, c, plan).map_err(PlotError)?;
+    bars(dir, c).map_err(PlotError)?;
+    Ok(2)
+}
+
+/// The first seed's e = q − q_d of every law, one panel per joint.
+fn errors(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), String> {
+    let curves: Vec<(&LawRow, &crate::compare::LawSeries)> = c
+        .laws
+        .iter()
+        .filter_map(|row| Some((row, row.runs.first()?.series.as_ref()?)))
+        .collect();
+    let Some((_, first)) = curves.first() else {
+        return Err("no law kept its curves".into());
+    };
+    let names = plan.robot.model.joint_names();
+    let neg_kc: Vec<Vec<f64>> = first
+        .kc
+        .iter()
+        .map(|k| k.iter().map(|x| -x).collect())
+        .collect();
+    let panels: Vec<Panel<'_>> = (0..names.len())
+        .map(|i| {
+            let mut lines: Vec<Line<'_>> = curves
+                .iter()
+                .enumerate()
+                .map(|(k, (row, s))| Line {
+                    label: row.law.law.to_string(),
+                    y: &s.e[i],
+                    color: COLORS[k % COLORS.len()],
+                    dashed: false,
+                })
+                .collect();
+            lines.push(Line {
+                label: "± k_c".into(),
+                y: &first.kc[i],
+                color: RED,
+                dashed: true,
+            });
+            lines.push(Line {
+                label: String::new(),
+                y: &neg_kc[i],
+                color: RED,
+                dashed: true,
+            });
+            Panel {
+                title: format!("{}: tracking error e = q − q_d", names[i]),
+                y_label: "e [rad]",
+                lines,
+            }
+        })
+        .collect();
+    save(
+        dir,
+        "compare_errors",
+        &format!("Tracking errors of every law with ± k_c ({})", c.scenario),
+        &first.t,
+        &panels,
+        Some(plan.scenario.controller.tc),
+    )
+}
+
+/// Effort after T_c and violation time per law (medians over seeds).
+fn bars(dir: &Path, c: &Comparison) -> Result<(), String> {
+    let png = dir.join("compare_bars.png");
+    draw_bars(
+        &BitMapBackend::new(&png, (1000, 700)).into_drawing_area(),
+        c,
+    )
+    .map_err(|e| format!("{}: {e}", png.display()))?;
+    let svg = dir.join("compare_bars.svg");
+    draw_bars(&SVGBackend::new(&svg, (1000, 700)).into_drawing_area(), c)
+        .map_err(|e| format!("{}: {e}", svg.display()))
+}
+
+fn draw_bars<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    c: &Comparison,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(err)?;
+    let title = format!(
+        "Effort and envelope violation per law ({}, median over {} seed(s))",
+        c.scenario, c.seeds
+    );
+    let root = root.titled(&title, (FAMILY, 20)).map_err(err)?;
+    let areas = root.split_evenly((2, 1));
+    let panels = [
+        ("effort ∫τ² dt after T_c [N² m² s]", "effort_after_tc"),
+        (
+            "violation time ∫1[|e| ≥ k_c] dt over the run [s]",
+            "violation_s",
+        ),
+    ];
+    for (area, (caption, key)) in areas.iter().zip(panels) {
+        let values: Vec<f64> = c
+            .laws
+            .iter()
+            .map(|r| r.median.get(key).unwrap_or(0.0))
+            .collect();
+        bar_panel(area, caption, c, &values)?;
+    }
+    root.present().map_err(err)
+}
+
+fn bar_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: &str,
+    c: &Comparison,
+    values: &[f64],
+) -> Result<(), String> {
+    let top = values
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max)
+        .max(1e-9);
+    let n = values.len();
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, (FAMILY, 15))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(-0.5..(n as f64 - 0.5), 0.0..top * 1.1)
+        .map_err(err)?;
+    let names: Vec<String> = c.laws.iter().map(|r| r.law.law.to_string()).collect();
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(n)
+        .x_label_formatter(&|x| {
+            let i = x.round();
+            if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
+                names[i as usize].clone()
+            } else {
+                String::new()
+            }
+        })
+        .label_style((FAMILY, 12))
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(values.iter().enumerate().map(|(i, v)| {
+            let x = i as f64;
+            let v = if v.is_finite() { *v } else { top * 1.1 };
+            Rectangle::new(
+                [(x - 0.35, 0.0), (x + 0.35, v)],
+                COLORS[i % COLORS.len()].filled(),
+            )
+        }))
+        .map_err(err)?;
+    Ok(())
+}
