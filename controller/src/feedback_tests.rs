@@ -86,8 +86,8 @@ fn ctc_is_the_models_inverse_dynamics_at_the_commanded_acceleration() {
     let mut f = Feedback::new(&light, 2, Some(&model)).unwrap();
     let mut d8 = Diagnostics::new(2);
     f.step(&input(), &mut d8);
-    for i in 0..2 {
-        assert!((d8.tau[i] - 0.8 * want[i]).abs() < 1e-12);
+    for (a, b) in d8.tau.iter().zip(&want) {
+        assert!((a - 0.8 * b).abs() < 1e-12);
     }
 }
 

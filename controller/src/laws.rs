@@ -13,7 +13,7 @@ pub enum Law {
     /// `nac`, its ablations and `blf`: the paper's law with parts switched off.
     Nac(Box<Controller>),
     /// `pd`, `pd-gravity`, `ctc`.
-    Feedback(Feedback),
+    Feedback(Box<Feedback>),
     /// `ppc`.
     Ppc(Ppc),
 }
@@ -35,7 +35,7 @@ impl Law {
                 Law::Nac(Box::new(Controller::new(params.clone(), dof)?))
             }
             LawName::Ppc => Law::Ppc(Ppc::new(params, dof)?),
-            _ => Law::Feedback(Feedback::new(params, dof, model)?),
+            _ => Law::Feedback(Box::new(Feedback::new(params, dof, model)?)),
         })
     }
 

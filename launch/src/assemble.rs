@@ -122,6 +122,7 @@ impl RecordAssembler {
                 z1g: &d.z1g[..n],
                 z2: &d.z2[..n],
                 wa_norm: &d.wa_norm[..n],
+                tau_actor: &d.tau_actor[..n],
                 barrier_breached: d.barrier_breached != 0,
                 fault: d.fault != 0,
             };

@@ -200,6 +200,9 @@ pub const METRICS: &[Metric] = &[
     m("breaches", "steps", true, |r| {
         Some(r.summary.metrics.breaches as f64)
     }),
+    m("peak_actor_torque", "N m", true, |r| {
+        Some(r.summary.metrics.peak_actor_torque)
+    }),
     m("compute_p50_us", "µs", true, |r| Some(r.compute_us.p50)),
     m("compute_p99_us", "µs", true, |r| Some(r.compute_us.p99)),
 ];

@@ -36,6 +36,8 @@ pub struct StepRecord<'a> {
     pub z2: &'a [f64],
     /// ‖Ŵ_a‖ per joint (before this step's update).
     pub wa_norm: &'a [f64],
+    /// The actor's part of the commanded torque (zero for laws without one).
+    pub tau_actor: &'a [f64],
     /// The controller's guard clamped D.
     pub barrier_breached: bool,
     /// The controller published zero torque because of a fault.

@@ -321,8 +321,9 @@ fn metric_lines(out: &mut String, m: &ArmMetrics, compute: &Percentiles) {
     );
     let _ = writeln!(
         out,
-        "controller compute per step: p50 {:.2} us, p99 {:.2} us",
-        compute.p50, compute.p99
+        "actor: peak |tau_actor| {:.4}, int tau_actor^2 {:.4}; controller compute per step: \
+         p50 {:.2} us, p99 {:.2} us",
+        m.peak_actor_torque, m.actor_effort, compute.p50, compute.p99
     );
 }
 

@@ -110,6 +110,10 @@ pub struct ArmMetrics {
     pub saturated_s: f64,
     /// Steps where the law's guard acted (barrier clamp, or funnel clamp for `ppc`).
     pub breaches: u64,
+    /// max |actor torque| over joints and steps: what the networks add.
+    pub peak_actor_torque: f64,
+    /// Σ ∫τ_actor² dt over the run.
+    pub actor_effort: f64,
 }
 
 /// The plant effects of a run, as its logged states flag them.
@@ -150,6 +154,8 @@ pub struct SummaryBuilder {
     any_violation_after: f64,
     prev_tau: Option<Vec<f64>>,
     torque_rate: Vec<f64>,
+    peak_actor: f64,
+    actor_effort: f64,
     t_last: f64,
     breached: u64,
     faults: u64,
@@ -187,6 +193,8 @@ impl SummaryBuilder {
             any_violation_after: 0.0,
             prev_tau: None,
             torque_rate: vec![0.0; n],
+            peak_actor: 0.0,
+            actor_effort: 0.0,
             t_last: 0.0,
             breached: 0,
             faults: 0,
@@ -242,7 +250,7 @@ impl SummaryBuilder {
         for i in 0..self.names.len() {
             let e = (r.q[i] - r.q_d[i]).abs();
             // NaN counts as outside.
-            let outside = !(e < r.kc[i]);
+            let outside = e.partial_cmp(&r.kc[i]) != Some(std::cmp::Ordering::Less);
             if outside {
                 any = true;
                 self.last_violation[i] = Some(r.t);
@@ -255,6 +263,8 @@ impl SummaryBuilder {
                 self.iae[i] += e * dt;
                 self.itae[i] += r.t * e * dt;
             }
+            self.peak_actor = nan_max(self.peak_actor, r.tau_actor[i].abs());
+            self.actor_effort += r.tau_actor[i] * r.tau_actor[i] * dt;
             if let Some(prev) = &self.prev_tau {
                 let d = r.tau[i] - prev[i];
                 self.torque_rate[i] += d * d / dt;
@@ -334,11 +344,11 @@ impl SummaryBuilder {
         let when = |v: f64| any_after.then_some(v);
         let sum = |f: fn(&JointSummary) -> f64| joints.iter().map(f).sum::<f64>();
         let fold = |f: fn(&JointSummary) -> Option<f64>, max: bool| {
-            let vals = joints.iter().map(f);
+            let mut vals = joints.iter().map(f);
             if max {
-                vals.fold(Some(0.0), |a, b| Some(nan_max(a?, b?)))
+                vals.try_fold(0.0, |a, b| Some(nan_max(a, b?)))
             } else {
-                vals.fold(Some(f64::INFINITY), |a, b| Some(nan_min(a?, b?)))
+                vals.try_fold(f64::INFINITY, |a, b| Some(nan_min(a, b?)))
             }
         };
         let n_after = (self.after_tc as usize * joints.len()).max(1) as f64;
@@ -358,6 +368,8 @@ impl SummaryBuilder {
             peak_abs_torque: joints.iter().map(|j| j.max_abs_torque).fold(0.0, nan_max),
             saturated_s: self.saturated as f64 * self.dt,
             breaches: self.breached,
+            peak_actor_torque: self.peak_actor,
+            actor_effort: self.actor_effort,
         }
     }
 }
@@ -406,6 +418,7 @@ mod tests {
             z1g,
             z2: z1,
             wa_norm: tau,
+            tau_actor: tau,
             barrier_breached: false,
             fault: false,
         }

@@ -31,6 +31,7 @@ pub const SHIPPED: &[Shipped] = shipped![
     "tight_envelope",
     "saturation_slow_reference",
     "three_link_limits",
+    "paper_per_input",
 ];
 
 impl Shipped {

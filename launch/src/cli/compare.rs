@@ -81,7 +81,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
 }
 
 /// Columns of the table: (metric, heading, decimals).
-const COLUMNS: [(&str, &str, usize); 12] = [
+const COLUMNS: [(&str, &str, usize); 13] = [
     ("iae", "IAE", 4),
     ("ise", "ISE", 6),
     ("itae", "ITAE", 3),
@@ -93,11 +93,14 @@ const COLUMNS: [(&str, &str, usize); 12] = [
     ("torque_rate", "int dtau^2", 0),
     ("saturated_s", "sat[s]", 3),
     ("breaches", "breach", 0),
+    ("peak_actor_torque", "actor|tau|", 4),
     ("compute_p50_us", "cpu p50us", 2),
 ];
 
 fn cell(v: Option<f64>, prec: usize) -> String {
     match v {
+        // Too small for the column's decimals, but not zero: show it.
+        Some(x) if x != 0.0 && x.abs() < 0.5 * 10f64.powi(-(prec as i32)) => format!("{x:.2e}"),
         Some(x) if x.is_finite() => format!("{x:.prec$}"),
         Some(_) => "never".into(),
         None => "n/a".into(),

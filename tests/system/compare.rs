@@ -1,0 +1,241 @@
+//! The laws of BASELINES.md and `testbed compare`, as a user runs them.
+
+use crate::util::{fails, json, ok, testbed};
+
+const LAWS: [&str; 9] = [
+    "nac",
+    "nac-no-shift",
+    "nac-no-critic",
+    "nac-no-networks",
+    "blf",
+    "pd",
+    "pd-gravity",
+    "ctc",
+    "ppc",
+];
+
+/// The summary's own keys (a report flattens them beside its own).
+const SUMMARY_KEYS: [&str; 10] = [
+    "dof",
+    "steps",
+    "dt_s",
+    "tc_s",
+    "joints",
+    "effects",
+    "constraint_satisfied_after_tc",
+    "barrier_breached_steps",
+    "fault_steps",
+    "metrics",
+];
+
+/// Every law's lockstep stack computes exactly what its in-process loop
+/// computes, model-based ones included.
+#[test]
+fn every_law_in_lockstep_equals_its_sim_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    for law in LAWS {
+        let (run_csv, sim_csv) = (
+            dir.path().join(format!("{law}-run.csv")),
+            dir.path().join(format!("{law}-sim.csv")),
+        );
+        let common = ["--law", law, "--duration", "0.4", "--json"];
+        let run = json(&ok(testbed()
+            .args(["run", "--mode", "lockstep", "--runs-dir"])
+            .arg(dir.path())
+            .args(common)
+            .arg("--csv")
+            .arg(&run_csv)));
+        let sim = json(&ok(testbed()
+            .arg("sim")
+            .args(common)
+            .arg("--csv")
+            .arg(&sim_csv)));
+        assert!(
+            std::fs::read(&run_csv).unwrap() == std::fs::read(&sim_csv).unwrap(),
+            "{law}: lockstep CSV differs from sim"
+        );
+        for key in SUMMARY_KEYS {
+            assert_eq!(run[key], sim[key], "{law}: {key}");
+        }
+        assert_eq!(run["law"]["law"], law);
+        assert_eq!(sim["law"]["law"], law);
+        let model_based = matches!(law, "pd-gravity" | "ctc");
+        assert_eq!(run["law"]["model_based"], model_based, "{law}");
+    }
+}
+
+/// The log names the law and its parameters, and `replay --verify`
+/// re-drives a model-based law from the log alone.
+#[test]
+fn a_model_based_run_is_labelled_and_verifies_from_its_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = json(&ok(testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--law",
+            "ctc",
+            "--duration",
+            "0.3",
+        ])
+        .args(["--json", "--runs-dir"])
+        .arg(dir.path())));
+    let log = run["log"].as_str().unwrap();
+    let replay = json(&ok(testbed().args(["replay", "--verify", "--json", log])));
+    assert_eq!(replay["law"]["law"], "ctc");
+    assert_eq!(replay["law"]["model_based"], true);
+    assert_eq!(replay["law"]["parameters"]["model_scale"], 1.0);
+    assert_eq!(replay["max_abs_torque_diff"], 0.0);
+    assert_eq!(replay["verified_steps"], 300);
+    let table = String::from_utf8(ok(testbed().args(["replay", log])).stdout).unwrap();
+    assert!(table.contains("law ctc (model-based"), "{table}");
+}
+
+/// Each compare row is the single-law `sim` run of the same settings, bit
+/// for bit, seed by seed (a scenario with noise, so seeds differ).
+#[test]
+fn compare_rows_equal_single_law_sim_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let base =
+        std::fs::read_to_string(crate::util::repo_root().join("scenarios/friction_noise.toml"))
+            .unwrap();
+    assert!(base.contains("\nseed = 7\n"), "friction_noise's own seed");
+    let laws = "nac,nac-no-shift,blf,pd,pd-gravity,ctc,ppc";
+    let cmp = json(&ok(testbed()
+        .args([
+            "compare",
+            "--scenario",
+            "friction_noise",
+            "--duration",
+            "2.5",
+        ])
+        .args(["--laws", laws, "--seeds", "2", "--json"])));
+    assert!(cmp["threads"].as_u64().unwrap() >= 1);
+    let rows = cmp["laws"].as_array().unwrap();
+    assert_eq!(rows.len(), 7);
+    for row in rows {
+        let law = row["law"]["law"].as_str().unwrap();
+        let runs = row["runs"].as_array().unwrap();
+        assert_eq!(runs.len(), 2);
+        for run in runs {
+            let seed = run["seed"].as_u64().unwrap();
+            let file = dir.path().join(format!("seed{seed}.toml"));
+            let text = base.replace("\nseed = 7\n", &format!("\nseed = {seed}\n"));
+            std::fs::write(&file, text).unwrap();
+            let sim = json(&ok(testbed()
+                .args([
+                    "sim",
+                    "--duration",
+                    "2.5",
+                    "--json",
+                    "--law",
+                    law,
+                    "--scenario",
+                ])
+                .arg(&file)));
+            for key in SUMMARY_KEYS {
+                assert_eq!(run["summary"][key], sim[key], "{law} seed {seed}: {key}");
+            }
+        }
+        assert_eq!(
+            (runs[0]["seed"].as_u64(), runs[1]["seed"].as_u64()),
+            (Some(7), Some(8))
+        );
+        // The two seeds differ (sensor noise), so the medians are real medians.
+        assert_ne!(
+            runs[0]["summary"]["metrics"], runs[1]["summary"]["metrics"],
+            "{law}"
+        );
+        assert!(row["median"]["iae"].is_number() && row["worst"]["iae"].is_number());
+    }
+}
+
+#[test]
+fn compare_writes_its_table_csv_and_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("cmp.csv");
+    let out = ok(testbed()
+        .args([
+            "compare",
+            "--duration",
+            "2.5",
+            "--laws",
+            "nac,pd,ctc",
+            "--csv",
+        ])
+        .arg(&csv)
+        .arg("--plots")
+        .arg(dir.path().join("fig")));
+    let table = String::from_utf8(out.stdout).unwrap();
+    for law in ["nac ", "pd ", "ctc "] {
+        assert!(table.lines().any(|l| l.starts_with(law)), "{law}: {table}");
+    }
+    assert!(
+        table.contains("URDF"),
+        "ctc is labelled model-based: {table}"
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4);
+    assert!(lines[0].starts_with("law,model_based,seed,failed,kept_envelope,iae,"));
+    assert!(
+        lines[3].starts_with("ctc,true,0,false,true,"),
+        "{}",
+        lines[3]
+    );
+    for f in [
+        "compare_errors.png",
+        "compare_errors.svg",
+        "compare_bars.png",
+        "compare_bars.svg",
+    ] {
+        assert!(
+            dir.path().join("fig").join(f).metadata().unwrap().len() > 1000,
+            "{f}"
+        );
+    }
+}
+
+#[test]
+fn bad_law_names_and_foreign_keys_are_named() {
+    let e = fails(testbed().args(["sim", "--law", "nac2"]));
+    assert!(
+        e.contains("--law") && e.contains("unknown law 'nac2'"),
+        "{e}"
+    );
+    let e = fails(testbed().args(["compare", "--laws", "nac,bogus"]));
+    assert!(
+        e.contains("--laws") && e.contains("unknown law 'bogus'"),
+        "{e}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let f = write("law.toml", "[controller]\nlaw = \"lqr\"\n");
+    let e = fails(testbed().arg("sim").arg("--scenario").arg(&f));
+    assert!(
+        e.contains("law.toml") && e.contains("unknown variant `lqr`"),
+        "{e}"
+    );
+    let f = write("beta.toml", "[controller]\nlaw = \"pd\"\nbeta = 5.0\n");
+    let e = fails(testbed().arg("sim").arg("--scenario").arg(&f));
+    assert!(
+        e.contains("beta.toml") && e.contains("controller.beta is not a parameter of law 'pd'"),
+        "{e}"
+    );
+    let f = write("scale.toml", "[controller]\nmodel_scale = 0.8\n");
+    let e = fails(testbed().arg("sim").arg("--scenario").arg(&f));
+    assert!(
+        e.contains("controller.model_scale is not a parameter of law 'nac'"),
+        "{e}"
+    );
+    // The CLI's --law runs the same scenario with the law's own keys only.
+    let f = write("nac.toml", "[controller]\nbeta = 5.0\n");
+    ok(testbed()
+        .args(["sim", "--duration", "0.1", "--law", "pd", "--scenario"])
+        .arg(&f));
+}
