@@ -101,6 +101,8 @@ fn cell(v: Option<f64>, prec: usize) -> String {
     match v {
         // Too small for the column's decimals, but not zero: show it.
         Some(x) if x != 0.0 && x.abs() < 0.5 * 10f64.powi(-(prec as i32)) => format!("{x:.2e}"),
+        // Wider than the column: a diverging run, say.
+        Some(x) if x.is_finite() && x.abs() >= 1e7 => format!("{x:.2e}"),
         Some(x) if x.is_finite() => format!("{x:.prec$}"),
         Some(_) => "never".into(),
         None => "n/a".into(),
