@@ -5,6 +5,8 @@
 //! the same plan ([`plan_for`]), the same loop ([`crate::sim`]), the same
 //! summary, so a row can be checked against a single run bit for bit.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use controller::LawName;
 use rayon::prelude::*;
 use scenario::Plan;
@@ -286,6 +288,17 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
 
 /// One in-process run, exactly as `testbed sim` makes it.
 pub fn run_one(plan: &Plan, keep_series: bool) -> LawRun {
+    run_inner(plan, keep_series, &AtomicBool::new(false)).0
+}
+
+/// [`run_one`] without curves, given up (None) once `stop` is set.
+pub fn run_until(plan: &Plan, stop: &AtomicBool) -> Option<LawRun> {
+    let (run, stopped) = run_inner(plan, false, stop);
+    (!stopped).then_some(run)
+}
+
+/// The run, and whether `stop` cut it short.
+fn run_inner(plan: &Plan, keep_series: bool, stop: &AtomicBool) -> (LawRun, bool) {
     let names = plan.robot.model.joint_names();
     let n = names.len();
     let mut summary = SummaryBuilder::new(names, plan.dt(), plan.scenario.controller.tc);
@@ -296,6 +309,12 @@ pub fn run_one(plan: &Plan, keep_series: bool) -> LawRun {
     });
     let mut costs = StepCosts::default();
     let result = sim::run_measured(plan, Some(&mut costs), |r| {
+        if stop.load(Ordering::Relaxed) {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::Interrupted,
+                "stopped",
+            ));
+        }
         summary.add(r);
         if let Some(s) = series.as_mut() {
             s.t.push(r.t);
@@ -306,7 +325,7 @@ pub fn run_one(plan: &Plan, keep_series: bool) -> LawRun {
         }
         Ok(())
     });
-    LawRun {
+    let run = LawRun {
         seed: plan.scenario.seed,
         failure: result.err().map(|e| e.to_string()),
         summary: summary.finish(),
@@ -318,7 +337,8 @@ pub fn run_one(plan: &Plan, keep_series: bool) -> LawRun {
                 .collect(),
         ),
         series,
-    }
+    };
+    (run, stop.load(Ordering::Relaxed))
 }
 
 /// Every metric of one run (missing values as the worst, ±∞).

@@ -23,4 +23,5 @@ pub mod record;
 pub mod run;
 pub mod sim;
 pub mod summary;
+pub mod sweep;
 pub mod verify;

@@ -8,6 +8,7 @@ mod robot;
 mod run;
 mod scenarios;
 mod sim;
+mod sweep;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -55,6 +56,10 @@ enum Command {
     /// Run several laws (the paper's, its ablations, baselines) on the same
     /// scenario and seeds, in process on every core, and score them.
     Compare(CompareArgs),
+    /// Monte Carlo and parameter grids: run a sweep file on every core or
+    /// on a Slurm cluster, and report it per cell.
+    #[command(subcommand)]
+    Sweep(sweep::SweepCommand),
     /// List the shipped scenarios and what each one demonstrates.
     Scenarios,
     /// Run one node of a stack (the launcher starts these; start one by hand
@@ -100,6 +105,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Replay(args) => replay::replay(args),
         Command::Bench(args) => bench::bench(args),
         Command::Compare(args) => compare::compare(args),
+        Command::Sweep(cmd) => sweep::sweep(cmd),
         Command::Scenarios => {
             print!("{}", scenarios::scenario_list());
             Ok(ExitCode::SUCCESS)

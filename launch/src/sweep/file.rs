@@ -1,0 +1,429 @@
+//! The sweep file: a base scenario, axes over any scenario key, seeds and
+//! laws; expanded into one resolved [`Plan`] per run, all checked before
+//! anything runs.
+
+use std::path::{Path, PathBuf};
+
+use controller::LawName;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use scenario::{Overrides, Plan, RobotSource, Scenario};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use super::SweepError;
+
+/// Sweeps larger than this are refused (the manifest lists every run).
+pub const MAX_RUNS: usize = 1_000_000;
+
+/// A sweep file as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepFile {
+    /// A name for reports (default: the file's stem).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Base scenario: a shipped name or a path relative to the sweep file
+    /// (default: the paper's).
+    #[serde(default)]
+    pub scenario: Option<String>,
+    /// An arm (URDF, relative to the sweep file) instead of the scenario's;
+    /// with no `scenario`, the arm's default scenario.
+    #[serde(default)]
+    pub robot: Option<String>,
+    /// Seeds per cell: the scenario's seed, +1, … (default: 1).
+    #[serde(default = "one")]
+    pub seeds: u64,
+    /// The laws, each a cell of its own (default: the scenario's law).
+    #[serde(default)]
+    pub laws: Vec<LawName>,
+    /// Fixed values for every run, by dotted scenario key.
+    #[serde(default)]
+    pub set: toml::Table,
+    /// The axes, in order: the grid is their product.
+    #[serde(default)]
+    pub axis: Vec<Axis>,
+}
+
+fn one() -> u64 {
+    1
+}
+
+/// One axis: a scenario key and its values.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Axis {
+    /// Dotted scenario key, e.g. `controller.k1` or `plant.payload.mass`.
+    pub key: String,
+    /// The values as listed.
+    #[serde(default)]
+    pub values: Option<Vec<toml::Value>>,
+    /// `num` evenly spaced values from `start` to `stop`, both included.
+    #[serde(default)]
+    pub range: Option<Range>,
+    /// `draws` values drawn uniformly from [min, max) with `seed`.
+    #[serde(default)]
+    pub random: Option<RandomDraws>,
+}
+
+/// Evenly spaced values.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Range {
+    /// First value.
+    pub start: f64,
+    /// Last value.
+    pub stop: f64,
+    /// How many (≥ 1).
+    pub num: usize,
+}
+
+/// Seeded uniform draws.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomDraws {
+    /// Lower bound.
+    pub min: f64,
+    /// Upper bound (above `min`).
+    pub max: f64,
+    /// How many (≥ 1).
+    pub draws: usize,
+    /// The draws' own seed (default: 0).
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// One run of a sweep, resolved.
+#[derive(Debug, Clone)]
+pub struct RunSpec {
+    /// Position in the sweep (cells in axis order, then laws, then seeds).
+    pub index: usize,
+    /// Hash of the run's resolved scenario and URDF: its identity on disk.
+    pub key: String,
+    /// The axis values of its cell, in axis order.
+    pub cell: Vec<(String, toml::Value)>,
+    /// The law.
+    pub law: LawName,
+    /// The seed of every random effect.
+    pub seed: u64,
+    /// What `testbed sim` would run.
+    pub plan: Plan,
+}
+
+/// A sweep file read and expanded.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    /// Its name.
+    pub name: String,
+    /// The file it came from.
+    pub path: PathBuf,
+    /// The file's text (kept in the manifest).
+    pub text: String,
+    /// Axis keys, in order.
+    pub axes: Vec<String>,
+    /// Every run.
+    pub runs: Vec<RunSpec>,
+}
+
+impl Axis {
+    /// The axis's values; exactly one of values, range and random is given.
+    fn expand(&self, file: &str) -> Result<Vec<toml::Value>, SweepError> {
+        let bad = |reason: String| SweepError::File {
+            file: file.to_string(),
+            reason: format!("axis {}: {reason}", self.key),
+        };
+        let out = match (&self.values, &self.range, &self.random) {
+            (Some(v), None, None) => v.clone(),
+            (None, Some(r), None) => {
+                if r.num == 0 || !r.start.is_finite() || !r.stop.is_finite() {
+                    return Err(bad("range needs finite start and stop and num ≥ 1".into()));
+                }
+                let step = if r.num > 1 {
+                    (r.stop - r.start) / (r.num - 1) as f64
+                } else {
+                    0.0
+                };
+                (0..r.num)
+                    .map(|i| toml::Value::Float(r.start + step * i as f64))
+                    .collect()
+            }
+            (None, None, Some(d)) => {
+                if d.draws == 0 || !(d.min.is_finite() && d.max.is_finite() && d.min < d.max) {
+                    return Err(bad("random needs finite min < max and draws ≥ 1".into()));
+                }
+                let mut rng = ChaCha8Rng::seed_from_u64(d.seed);
+                (0..d.draws)
+                    .map(|_| toml::Value::Float(rng.random_range(d.min..d.max)))
+                    .collect()
+            }
+            _ => return Err(bad("give exactly one of values, range, random".into())),
+        };
+        if out.is_empty() {
+            return Err(bad("no values".into()));
+        }
+        Ok(out)
+    }
+}
+
+/// Sets the dotted `key` in a scenario's TOML tree, creating tables.
+fn set_key(root: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
+    let parts: Vec<&str> = key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err(format!("'{key}' is not a dotted scenario key"));
+    }
+    let mut table = root;
+    for (i, part) in parts.iter().enumerate() {
+        if i + 1 == parts.len() {
+            table.insert((*part).to_string(), value);
+            return Ok(());
+        }
+        let entry = table
+            .entry((*part).to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        table = match entry {
+            toml::Value::Table(t) => t,
+            _ => {
+                return Err(format!(
+                    "'{}' is a value, not a table",
+                    parts[..=i].join(".")
+                ));
+            }
+        };
+    }
+    Ok(())
+}
+
+/// Reads and expands the sweep file at `path`: every run's plan is built
+/// (and so validated) here.
+pub fn load(path: &Path) -> Result<Sweep, SweepError> {
+    let file = path.display().to_string();
+    let text = super::read_limited(path)?;
+    let spec: SweepFile = toml::from_str(&text).map_err(|e| SweepError::File {
+        file: file.clone(),
+        reason: e.to_string().trim_end().to_string(),
+    })?;
+    let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let base = base_plan(&spec, &base_dir, &file)?;
+    let mut axes_values = Vec::new();
+    for axis in &spec.axis {
+        axes_values.push((axis.key.clone(), axis.expand(&file)?));
+    }
+    let sets = spec.set.iter().map(|(k, v)| ("set", k.clone(), v.clone()));
+    let firsts = axes_values
+        .iter()
+        .map(|(k, v)| ("axis", k.clone(), v[0].clone()));
+    for (what, key, value) in sets.chain(firsts) {
+        check_key(&base, what, &key, value, &file)?;
+    }
+    let laws = if spec.laws.is_empty() {
+        vec![base.scenario.controller.law]
+    } else {
+        spec.laws.clone()
+    };
+    if spec.seeds == 0 {
+        return Err(SweepError::File {
+            file,
+            reason: "seeds = 0: a sweep needs at least one seed".into(),
+        });
+    }
+    let cells = cartesian(&axes_values);
+    let total = cells
+        .len()
+        .saturating_mul(laws.len())
+        .saturating_mul(spec.seeds as usize);
+    if total > MAX_RUNS {
+        return Err(SweepError::File {
+            file,
+            reason: format!("{total} runs: at most {MAX_RUNS} per sweep"),
+        });
+    }
+    let mut runs = Vec::with_capacity(total);
+    for cell in &cells {
+        for &law in &laws {
+            for s in 0..spec.seeds {
+                let index = runs.len();
+                let plan = resolve(&base, &spec, cell, law, s, &base_dir, &file)?;
+                runs.push(RunSpec {
+                    index,
+                    key: run_key(&plan)?,
+                    cell: cell.clone(),
+                    law,
+                    seed: plan.scenario.seed,
+                    plan,
+                });
+            }
+        }
+    }
+    let name = spec.name.clone().unwrap_or_else(|| {
+        path.file_stem()
+            .map_or_else(|| "sweep".into(), |s| s.to_string_lossy().to_string())
+    });
+    Ok(Sweep {
+        name,
+        path: path.to_path_buf(),
+        text,
+        axes: spec.axis.iter().map(|a| a.key.clone()).collect(),
+        runs,
+    })
+}
+
+fn base_plan(spec: &SweepFile, dir: &Path, file: &str) -> Result<Plan, SweepError> {
+    let scenario = spec.scenario.as_ref().map(|s| {
+        let p = dir.join(s);
+        if p.exists() {
+            p
+        } else {
+            scenario::find_shipped(s).map_or(p, |sh| sh.path())
+        }
+    });
+    let overrides = Overrides {
+        robot: spec.robot.as_ref().map(|r| dir.join(r)),
+        ..Overrides::default()
+    };
+    scenario::load(scenario.as_deref(), &overrides).map_err(|cause| SweepError::Scenario {
+        file: file.to_string(),
+        cause,
+    })
+}
+
+/// A key names a scenario key: setting it alone on the base scenario
+/// parses (the error names the key, not a line of a generated file).
+fn check_key(
+    base: &Plan,
+    what: &str,
+    key: &str,
+    value: toml::Value,
+    file: &str,
+) -> Result<(), SweepError> {
+    let bad = |reason: String| SweepError::File {
+        file: file.to_string(),
+        reason: format!("{what} {key}: {reason}"),
+    };
+    let mut tree = match toml::Value::try_from(&base.scenario) {
+        Ok(toml::Value::Table(t)) => t,
+        _ => return Err(bad("cannot write the base scenario".into())),
+    };
+    set_key(&mut tree, key, value).map_err(bad)?;
+    let text = toml::to_string(&tree).map_err(|e| bad(e.to_string()))?;
+    match toml::from_str::<Scenario>(&text) {
+        Ok(_) => Ok(()),
+        // The parser's last line says what is wrong ("unknown field `k3`, …").
+        Err(e) => {
+            let msg = e.to_string();
+            let last = msg.trim_end().lines().last().unwrap_or("").to_string();
+            Err(bad(last))
+        }
+    }
+}
+
+/// Every combination of the axes' values, the first axis slowest.
+fn cartesian(axes: &[(String, Vec<toml::Value>)]) -> Vec<Vec<(String, toml::Value)>> {
+    let mut cells = vec![Vec::new()];
+    for (key, values) in axes {
+        cells = cells
+            .into_iter()
+            .flat_map(|c| {
+                values.iter().map(move |v| {
+                    let mut c = c.clone();
+                    c.push((key.clone(), v.clone()));
+                    c
+                })
+            })
+            .collect();
+    }
+    cells
+}
+
+/// The plan of one run: the base scenario for `law`, the `set` values,
+/// the cell's values and seed base + s, validated against the robot.
+fn resolve(
+    base: &Plan,
+    spec: &SweepFile,
+    cell: &[(String, toml::Value)],
+    law: LawName,
+    s: u64,
+    dir: &Path,
+    file: &str,
+) -> Result<Plan, SweepError> {
+    let mut scenario = base.scenario.clone();
+    scenario.controller = scenario.controller.for_law(law);
+    scenario.seed = base.scenario.seed.wrapping_add(s);
+    let cannot = |e: String| SweepError::File {
+        file: file.to_string(),
+        reason: format!("cannot write the base scenario: {e}"),
+    };
+    let mut tree = match toml::Value::try_from(&scenario).map_err(|e| cannot(e.to_string()))? {
+        toml::Value::Table(t) => t,
+        _ => return Err(cannot("not a table".into())),
+    };
+    let sets = spec.set.iter().map(|(k, v)| (k.clone(), v.clone()));
+    let what = |key: &str, reason: String| SweepError::File {
+        file: file.to_string(),
+        reason: format!("{key}: {reason}"),
+    };
+    for (key, value) in sets.chain(cell.iter().cloned()) {
+        set_key(&mut tree, &key, value).map_err(|r| what(&key, r))?;
+    }
+    let label = format!("{file} ({law}, seed {})", scenario.seed);
+    let toml_text = toml::to_string(&tree).map_err(|e| what("scenario", e.to_string()))?;
+    let scenario =
+        Scenario::from_toml_str(&toml_text, &label).map_err(|cause| SweepError::Scenario {
+            file: file.to_string(),
+            cause,
+        })?;
+    let robot = match &scenario.robot {
+        Some(r) if scenario.robot != base.scenario.robot => {
+            RobotSource::from_file(&dir.join(r), &scenario.plant.lock)
+        }
+        _ => base.robot.relocked(&scenario.plant.lock),
+    }
+    .map_err(|cause| SweepError::Scenario {
+        file: file.to_string(),
+        cause,
+    })?;
+    scenario::plan(scenario, label, toml_text, robot).map_err(|cause| SweepError::Scenario {
+        file: file.to_string(),
+        cause,
+    })
+}
+
+/// A run's identity: SHA-256 of its resolved scenario and its URDF.
+fn run_key(plan: &Plan) -> Result<String, SweepError> {
+    let mut s = plan.scenario.clone();
+    s.robot = None;
+    let text = toml::to_string(&s).map_err(|e| SweepError::File {
+        file: plan.source.clone(),
+        reason: format!("cannot write the scenario: {e}"),
+    })?;
+    let mut h = Sha256::new();
+    h.update(text.as_bytes());
+    h.update(b"\0urdf\0");
+    h.update(plan.robot.urdf.as_bytes());
+    let digest = h.finalize();
+    Ok(digest.iter().take(8).map(|b| format!("{b:02x}")).collect())
+}
+
+/// A cell's values as JSON, for result lines and reports.
+pub fn cell_json(cell: &[(String, toml::Value)]) -> serde_json::Map<String, serde_json::Value> {
+    cell.iter()
+        .map(|(k, v)| {
+            let j = serde_json::to_value(v).unwrap_or(serde_json::Value::Null);
+            (k.clone(), j)
+        })
+        .collect()
+}
+
+/// What the manifest records of one run.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct ManifestRun {
+    /// Position in the sweep.
+    pub index: usize,
+    /// Its key.
+    pub key: String,
+    /// Its law.
+    pub law: LawName,
+    /// Its seed.
+    pub seed: u64,
+    /// Its cell.
+    pub cell: serde_json::Map<String, serde_json::Value>,
+}
