@@ -1,8 +1,9 @@
-//! `testbed compare` on the paper scenario with one seed: on every core
-//! and on one, so that the ratio shows the cores are used.
+//! `testbed compare` on the paper scenario with one seed, and a sweep of
+//! 16 runs: each on every core and on one, so that the ratio shows the
+//! cores are used.
 //!
 //! `cargo bench -p launch --bench compare` (each sample is a whole
-//! comparison of 8 laws × 20 s, about 4 s on two cores).
+//! comparison of 8 laws × 20 s, about 4 s on two cores, or a whole sweep).
 
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
@@ -28,5 +29,40 @@ fn paper_compare(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, paper_compare);
+/// 16 runs of 5 s (2 × 2 gains × 4 seeds of sensor noise) into a fresh
+/// results folder per iteration: the sweep's throughput.
+fn sweep_throughput(c: &mut Criterion) {
+    let root = tempfile::tempdir().unwrap();
+    let file = root.path().join("bench.toml");
+    std::fs::write(
+        &file,
+        "seeds = 4\n[set]\nduration_s = 5.0\n\"plant.sensor.q_noise_std\" = 0.001\n\
+         [[axis]]\nkey = \"controller.k1\"\nvalues = [10.0, 20.0]\n\
+         [[axis]]\nkey = \"controller.k2\"\nvalues = [10.0, 15.0]\n",
+    )
+    .unwrap();
+    let sweep = launch::sweep::file::load(&file).unwrap();
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let mut group = c.benchmark_group("sweep_16_runs");
+    group.sample_size(10);
+    let mut k = 0;
+    for threads in [cores, 1] {
+        let opts = launch::sweep::RunOptions {
+            threads: Some(threads),
+            share: None,
+            progress: false,
+        };
+        group.bench_function(format!("{threads}_threads"), |b| {
+            b.iter(|| {
+                k += 1;
+                let dir = root.path().join(format!("r{k}"));
+                launch::sweep::run(&sweep, &dir, &opts, &stop).unwrap()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, paper_compare, sweep_throughput);
 criterion_main!(benches);

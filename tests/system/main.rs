@@ -9,4 +9,6 @@ mod robots;
 mod run_cli;
 mod scenarios;
 mod sim_cli;
+mod slurm;
+mod sweep;
 mod util;

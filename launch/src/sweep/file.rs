@@ -282,7 +282,7 @@ fn base_plan(spec: &SweepFile, dir: &Path, file: &str) -> Result<Plan, SweepErro
     };
     scenario::load(scenario.as_deref(), &overrides).map_err(|cause| SweepError::Scenario {
         file: file.to_string(),
-        cause,
+        cause: Box::new(cause),
     })
 }
 
@@ -369,7 +369,7 @@ fn resolve(
     let scenario =
         Scenario::from_toml_str(&toml_text, &label).map_err(|cause| SweepError::Scenario {
             file: file.to_string(),
-            cause,
+            cause: Box::new(cause),
         })?;
     let robot = match &scenario.robot {
         Some(r) if scenario.robot != base.scenario.robot => {
@@ -379,11 +379,11 @@ fn resolve(
     }
     .map_err(|cause| SweepError::Scenario {
         file: file.to_string(),
-        cause,
+        cause: Box::new(cause),
     })?;
     scenario::plan(scenario, label, toml_text, robot).map_err(|cause| SweepError::Scenario {
         file: file.to_string(),
-        cause,
+        cause: Box::new(cause),
     })
 }
 

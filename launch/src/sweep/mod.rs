@@ -45,7 +45,7 @@ pub enum SweepError {
         /// The sweep file.
         file: String,
         /// The cause.
-        cause: scenario::ScenarioError,
+        cause: Box<scenario::ScenarioError>,
     },
     /// A results folder cannot be used.
     #[error("{dir}: {reason}")]

@@ -206,12 +206,14 @@ fn heatmap<DB: DrawingBackend>(
             .map_err(err)?;
         for c in r.cells.iter().filter(|c| &c.law == law) {
             let (Some(x), Some(y)) = (
-                c.cell
-                    .get(&r.axes[0])
-                    .and_then(|v| xs.iter().position(|s| *s == v.to_string())),
-                c.cell
-                    .get(&r.axes[1])
-                    .and_then(|v| ys.iter().position(|s| *s == v.to_string())),
+                c.cell.get(&r.axes[0]).and_then(|v| {
+                    let v = v.to_string();
+                    xs.iter().position(|s| *s == v)
+                }),
+                c.cell.get(&r.axes[1]).and_then(|v| {
+                    let v = v.to_string();
+                    ys.iter().position(|s| *s == v)
+                }),
             ) else {
                 continue;
             };

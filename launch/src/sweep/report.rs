@@ -78,19 +78,19 @@ pub struct SweepReport {
     pub cells: Vec<CellReport>,
 }
 
+/// A cell's values and its runs' results (None: not done yet).
+type Group<'a> = (
+    serde_json::Map<String, serde_json::Value>,
+    Vec<Option<&'a ResultLine>>,
+);
+
 /// Reads the folder `dir` and aggregates it.
 pub fn report(dir: &Path) -> Result<SweepReport, SweepError> {
     let manifest = read_manifest(dir)?;
     let (results, bad) = read_results(dir)?;
     // Cells in the order of their first run.
     let mut order: Vec<(String, String)> = Vec::new();
-    let mut groups: BTreeMap<
-        (String, String),
-        (
-            serde_json::Map<String, serde_json::Value>,
-            Vec<Option<&ResultLine>>,
-        ),
-    > = BTreeMap::new();
+    let mut groups: BTreeMap<(String, String), Group<'_>> = BTreeMap::new();
     for run in &manifest.runs {
         let id = (
             serde_json::Value::Object(run.cell.clone()).to_string(),
