@@ -114,6 +114,13 @@ pub(super) fn joint_info(
     }
     let limits = limits(j, kind, &field)?;
     let effort = finite(format!("{field} limit effort"), j.limit.effort)?;
+    if effort < 0.0 {
+        return Err(ModelError::InvalidConfig {
+            key: format!("{field} limit effort"),
+            value: effort.to_string(),
+            need: "≥ 0 (0 or absent: no effort limit)".into(),
+        });
+    }
     let (damping, friction) = dynamics(j, &field)?;
     Ok(JointInfo {
         name: j.name.clone(),
@@ -142,8 +149,17 @@ fn limits(
 ) -> Result<Option<(f64, f64)>, ModelError> {
     let lower = finite(format!("{field} limit lower"), j.limit.lower)?;
     let upper = finite(format!("{field} limit upper"), j.limit.upper)?;
-    // A revolute or prismatic joint without a usable <limit> (lower = upper,
-    // as urdf-rs fills a missing one) moves freely rather than being locked.
+    // A revolute joint without a usable <limit> (lower = upper, as urdf-rs
+    // fills a missing one) turns freely rather than being locked. A sliding
+    // one has no scale to choose a posture or an envelope from, and URDF
+    // requires the limit: refused.
+    if kind == JointKind::Prismatic && lower == upper {
+        return Err(ModelError::InvalidConfig {
+            key: format!("{field} <limit>"),
+            value: format!("lower = upper = {lower}"),
+            need: "lower < upper (URDF requires a <limit> on a prismatic joint)".into(),
+        });
+    }
     Ok(match kind {
         JointKind::Revolute | JointKind::Prismatic if lower < upper => Some((lower, upper)),
         JointKind::Revolute | JointKind::Prismatic if lower > upper => {

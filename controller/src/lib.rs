@@ -52,7 +52,7 @@ pub use law::{Controller, ControllerInput, barrier_lyapunov};
 pub use law_name::LawName;
 pub use laws::Law;
 pub use machine::ControllerMachine;
-pub use params::{BarrierMode, ControllerParams, Integrator, RbfLayout};
+pub use params::{BarrierMode, ControllerParams, Integrator, MAX_NEURONS, RbfLayout};
 pub use ppc::{Ppc, XI_LIMIT};
 pub use rbf::Rbf;
 pub use shifting::shifting;

@@ -132,6 +132,11 @@ impl Default for ControllerParams {
     }
 }
 
+/// The most neurons a network may have: checked before anything is
+/// allocated (the paper uses 10; the per-input layout has this many per
+/// input, 4n inputs for the actor).
+pub const MAX_NEURONS: usize = 1000;
+
 /// What a value must satisfy; written so that NaN fails every check.
 enum Bound {
     Positive,
@@ -186,11 +191,11 @@ impl ControllerParams {
                 });
             }
         }
-        if self.neurons == 0 {
+        if !(1..=MAX_NEURONS).contains(&self.neurons) {
             return Err(ControllerError::InvalidParameter {
                 key: "controller.neurons".into(),
-                value: "0".into(),
-                need: "at least 1".into(),
+                value: self.neurons.to_string(),
+                need: format!("from 1 to {MAX_NEURONS}"),
             });
         }
         self.check_keys_belong()?;
@@ -402,15 +407,16 @@ mod tests {
                 .to_string()
                 .contains("controller.center_min")
         );
-        let p = ControllerParams {
-            neurons: 0,
-            ..Default::default()
-        };
-        assert!(
-            p.validate()
-                .unwrap_err()
-                .to_string()
-                .contains("controller.neurons")
-        );
+        for neurons in [0, MAX_NEURONS + 1, usize::MAX] {
+            let p = ControllerParams {
+                neurons,
+                ..Default::default()
+            };
+            let e = p.validate().unwrap_err().to_string();
+            assert!(
+                e.contains("controller.neurons") && e.contains("from 1 to 1000"),
+                "{e}"
+            );
+        }
     }
 }

@@ -65,7 +65,7 @@ pub fn read_log(
     mut on_message: Option<OnMessage<'_>>,
 ) -> Result<LogContents, LogError> {
     let p = path.display().to_string();
-    let buf = std::fs::read(path).map_err(|cause| LogError::Io {
+    let buf = wire::read_regular_file(path, None).map_err(|cause| LogError::Io {
         path: p.clone(),
         cause,
     })?;

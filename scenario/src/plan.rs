@@ -84,9 +84,11 @@ pub struct Overrides {
 pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, ScenarioError> {
     let (toml_text, source, base) = match path {
         Some(p) => {
-            let text = std::fs::read_to_string(p).map_err(|cause| ScenarioError::Io {
-                file: p.display().to_string(),
-                cause,
+            let text = wire::read_text_file(p, wire::MAX_TEXT_FILE_BYTES).map_err(|cause| {
+                ScenarioError::Io {
+                    file: p.display().to_string(),
+                    cause,
+                }
             })?;
             let base = p.parent().map(Path::to_path_buf).unwrap_or_default();
             (text, p.display().to_string(), Some(base))
@@ -212,6 +214,14 @@ pub fn plan(
         None => period_ns,
     };
     let steps = (scenario.duration_s * 1e9 / period_ns as f64).round() as u64;
+    if steps == 0 {
+        return Err(ScenarioError::Invalid {
+            file: source.clone(),
+            key: "duration_s".into(),
+            value: scenario.duration_s.to_string(),
+            need: format!("at least one control period ({} s)", period_ns as f64 / 1e9),
+        });
+    }
     Ok(Plan {
         scenario,
         source,

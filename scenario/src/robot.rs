@@ -29,9 +29,11 @@ impl RobotSource {
     /// Loads and checks a URDF file with the joints in `locks` held.
     pub fn from_file(path: &Path, locks: &Locks) -> Result<Self, ScenarioError> {
         let file = path.display().to_string();
-        let urdf = std::fs::read_to_string(path).map_err(|cause| ScenarioError::Io {
-            file: file.clone(),
-            cause,
+        let urdf = wire::read_text_file(path, wire::MAX_URDF_BYTES).map_err(|cause| {
+            ScenarioError::Io {
+                file: file.clone(),
+                cause,
+            }
         })?;
         let model =
             ArmModel::from_urdf_str_locked(&urdf, locks).map_err(|cause| ScenarioError::Plant {

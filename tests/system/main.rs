@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod compare;
+mod hardening;
 mod log_replay;
 mod replace_nodes;
 mod robots;

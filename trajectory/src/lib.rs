@@ -97,7 +97,8 @@ pub enum TrajectoryError {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceConfig {
-    /// q_d,i(t) per joint (rad or m).
+    /// q_d,i(t) per joint (rad or m; default: the paper's two).
+    #[serde(default = "paper_reference_joints")]
     pub joints: Vec<Sinusoid>,
     /// Rate at which the trajectory publishes samples, Hz (default: unset,
     /// the control rate). The controller uses the newest sample not later
@@ -129,12 +130,22 @@ impl ReferenceConfig {
     }
 }
 
+/// A table that leaves `joints` out takes the paper's (every key is optional).
+fn paper_reference_joints() -> Vec<Sinusoid> {
+    ReferenceConfig::paper().joints
+}
+
+fn paper_envelope_joints() -> Vec<Sinusoid> {
+    EnvelopeConfig::paper().joints
+}
+
 /// The constraint envelope on the tracking error, |Z1_i| < k_c,i(t) for t ≥ T_c.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvelopeConfig {
-    /// k_c,i(t) per joint (rad or m); must stay positive. Ignored with `from_limits`.
-    #[serde(default)]
+    /// k_c,i(t) per joint (rad or m; default: the paper's two); must stay
+    /// positive. Ignored with `from_limits`.
+    #[serde(default = "paper_envelope_joints")]
     pub joints: Vec<Sinusoid>,
     /// Take the envelope from the robot's joint limits, as in the paper's
     /// Section III: k_c,i(t) = min(upper_i − q_d,i(t), q_d,i(t) − lower_i)

@@ -174,6 +174,10 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     if dof > MAX_DOF {
         return Err(RunError::TooManyJoints { dof });
     }
+    // An unwritable CSV is refused before the run, not after it.
+    if let Some(path) = &opts.csv {
+        File::create(path).map_err(|e| RunError::Output(path.display().to_string(), e))?;
+    }
     let files = RunFiles::write(&opts)?;
     let prefix = RunPrefix::unique();
     // Domains that killed launchers left behind.

@@ -74,16 +74,7 @@ pub(crate) fn read_limited(path: &Path) -> Result<String, SweepError> {
         path: path.display().to_string(),
         cause,
     };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() || meta.len() > MAX_FILE_BYTES {
-        return Err(SweepError::Io {
-            path: path.display().to_string(),
-            cause: std::io::Error::other(format!(
-                "not a regular file of at most {MAX_FILE_BYTES} bytes"
-            )),
-        });
-    }
-    std::fs::read_to_string(path).map_err(io)
+    wire::read_text_file(path, MAX_FILE_BYTES).map_err(io)
 }
 
 /// Which runs this process does and how.

@@ -1,0 +1,148 @@
+//! Rows of the hardening issue (#18) fixed so far: each input gets a named
+//! error before anything runs, or runs as documented.
+
+use std::process::Command;
+
+use crate::util::{fails, ok, testbed};
+
+fn scenario(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Row 3 and the neurons part of row 4: no panic, no huge allocation.
+#[test]
+fn a_huge_network_is_refused_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    for n in ["18446744073709551615", "1000000000", "1001"] {
+        let f = scenario(
+            dir.path(),
+            "n.toml",
+            &format!("[controller]\nneurons = {n}\n"),
+        );
+        let e = fails(testbed().arg("sim").arg("--scenario").arg(&f));
+        assert!(
+            e.contains(&format!("controller.neurons = {n} is invalid")),
+            "{e}"
+        );
+        let out = testbed()
+            .arg("sim")
+            .arg("--scenario")
+            .arg(&f)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{n}");
+    }
+}
+
+/// Row 7: every key is optional, in a partial table too.
+#[test]
+fn partial_reference_and_envelope_tables_take_the_papers_values() {
+    let dir = tempfile::tempdir().unwrap();
+    for text in [
+        "[reference]\nrate_hz = 500.0\n",
+        "[envelope]\n",
+        "[envelope]\nfrom_limits = false\n",
+    ] {
+        let f = scenario(dir.path(), "p.toml", text);
+        ok(testbed()
+            .args(["sim", "--duration", "0.2", "--scenario"])
+            .arg(&f));
+    }
+}
+
+/// Row 12: a duration shorter than one period is refused, not run as 0 steps.
+#[test]
+fn a_run_of_no_steps_is_refused() {
+    let e = fails(testbed().args(["sim", "--duration", "1e-9"]));
+    assert!(
+        e.contains("duration_s = 0.000000001 is invalid: it must be at least one control period"),
+        "{e}"
+    );
+    let e = fails(testbed().args(["run", "--mode", "lockstep", "--duration", "1e-9"]));
+    assert!(e.contains("duration_s"), "{e}");
+}
+
+/// Row 10: an unwritable CSV fails `run` before any node starts.
+#[test]
+fn run_refuses_an_unwritable_csv_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let e = fails(
+        testbed()
+            .args([
+                "run",
+                "--mode",
+                "lockstep",
+                "--csv",
+                "/proc/x.csv",
+                "--runs-dir",
+            ])
+            .arg(dir.path()),
+    );
+    assert!(e.contains("/proc/x.csv"), "{e}");
+    // Nothing was started: no run folder.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+/// Row 8: a prismatic joint without `<limit>` and a negative effort are
+/// named, with the file and the joint.
+#[test]
+fn prismatic_without_limit_and_negative_effort_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = |limit: &str| {
+        format!(
+            r#"<robot name="p"><link name="base"/><link name="a"><inertial><mass value="1"/>
+<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+<joint name="j1" type="prismatic"><parent link="base"/><child link="a"/><axis xyz="1 0 0"/>{limit}</joint></robot>"#
+        )
+    };
+    let cases = [
+        ("", "joint 'j1' <limit> = lower = upper = 0 is invalid"),
+        (
+            r#"<limit lower="-1" upper="1" effort="-5" velocity="1"/>"#,
+            "joint 'j1' limit effort = -5 is invalid",
+        ),
+    ];
+    for (limit, want) in cases {
+        let f = scenario(dir.path(), "p.urdf", &urdf(limit));
+        for cmd in [vec!["robot"], vec!["sim", "--robot"]] {
+            let e = fails(testbed().args(&cmd).arg(&f));
+            assert!(e.contains("p.urdf") && e.contains(want), "{cmd:?}: {e}");
+        }
+    }
+    let f = scenario(
+        dir.path(),
+        "ok.urdf",
+        &urdf(r#"<limit lower="-0.5" upper="0.5" effort="50" velocity="1"/>"#),
+    );
+    ok(testbed()
+        .args(["sim", "--duration", "0.2", "--robot"])
+        .arg(&f));
+}
+
+/// Row 4, files: a device or a FIFO is refused at once, never read or waited on.
+#[test]
+fn special_files_are_refused_without_reading_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = scenario(dir.path(), "zero.toml", "robot = \"/dev/zero\"\n");
+    let fifo = dir.path().join("fifo");
+    assert!(
+        Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let cases: Vec<Vec<std::ffi::OsString>> = vec![
+        vec!["sim".into(), "--scenario".into(), "/dev/zero".into()],
+        vec!["sim".into(), "--scenario".into(), robot.into()],
+        vec!["sim".into(), "--robot".into(), "/dev/zero".into()],
+        vec!["replay".into(), "/dev/zero".into()],
+        vec!["replay".into(), fifo.clone().into()],
+    ];
+    for args in cases {
+        let e = fails(testbed().args(&args));
+        assert!(e.contains("not a regular file"), "{args:?}: {e}");
+    }
+}

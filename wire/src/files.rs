@@ -1,0 +1,74 @@
+//! Reading files that come from outside: only regular files, and only up
+//! to a size, checked before a byte is read (a device, a FIFO or a huge
+//! file is refused rather than read or waited on).
+
+use std::io::Read;
+use std::path::Path;
+
+/// Largest scenario or sweep file read, bytes.
+pub const MAX_TEXT_FILE_BYTES: u64 = 16 << 20;
+/// Largest URDF read, bytes (real arms are well under 1 MB).
+pub const MAX_URDF_BYTES: u64 = 64 << 20;
+
+/// The bytes of the regular file at `path`, at most `max_bytes` of them
+/// (`None`: no limit).
+pub fn read_regular_file(path: &Path, max_bytes: Option<u64>) -> std::io::Result<Vec<u8>> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a device, FIFO or folder is not read)",
+        ));
+    }
+    let too_big = |len: u64, max: u64| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("{len} bytes is larger than the {max} bytes read"),
+        )
+    };
+    if let Some(max) = max_bytes
+        && meta.len() > max
+    {
+        return Err(too_big(meta.len(), max));
+    }
+    let mut buf = Vec::with_capacity(meta.len() as usize);
+    let file = std::fs::File::open(path)?;
+    match max_bytes {
+        // The file may grow after the check: read one byte past the limit.
+        Some(max) => file.take(max + 1).read_to_end(&mut buf)?,
+        None => (&file).read_to_end(&mut buf)?,
+    };
+    if let Some(max) = max_bytes
+        && buf.len() as u64 > max
+    {
+        return Err(too_big(buf.len() as u64, max));
+    }
+    Ok(buf)
+}
+
+/// [`read_regular_file`] as UTF-8 text.
+pub fn read_text_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
+    String::from_utf8(read_regular_file(path, Some(max_bytes))?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    #[test]
+    fn devices_folders_and_big_files_are_refused() {
+        assert!(read_regular_file(Path::new("/dev/zero"), None).is_err());
+        assert!(read_regular_file(Path::new("/tmp"), None).is_err());
+        let dir = std::env::temp_dir().join(format!("wire-files-{}", std::process::id()));
+        std::fs::write(&dir, b"0123456789").unwrap();
+        assert_eq!(read_text_file(&dir, 10).unwrap(), "0123456789");
+        let e = read_text_file(&dir, 9).unwrap_err().to_string();
+        assert!(
+            e.contains("10 bytes is larger than the 9 bytes read"),
+            "{e}"
+        );
+        std::fs::remove_file(&dir).unwrap();
+    }
+}
