@@ -17,6 +17,7 @@
 mod json;
 pub mod node;
 mod reader;
+mod scan;
 mod writer;
 
 pub use json::{DecodeError, Fields, LogMessage};

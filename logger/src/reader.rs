@@ -80,12 +80,13 @@ pub fn read_log(
         ..LogContents::default()
     };
     let mut topics: HashMap<u16, String> = HashMap::new();
-    let records = ChunkFlattener::new_with_options(&buf, Options::IgnoreEndMagic.into()).map_err(
-        |cause| LogError::Mcap {
+    // Only the soundly framed part goes to the reader (see `scan`).
+    let (end, damaged) = crate::scan::sound_prefix(&buf);
+    let records = ChunkFlattener::new_with_options(&buf[..end], Options::IgnoreEndMagic.into())
+        .map_err(|cause| LogError::Mcap {
             path: p.clone(),
             cause,
-        },
-    )?;
+        })?;
     for record in records {
         let record = match record {
             Ok(r) => r,
@@ -116,6 +117,11 @@ pub fn read_log(
             Record::Footer(_) => out.complete = true,
             _ => {}
         }
+    }
+    if let Some(why) = damaged
+        && out.cut_short.is_none()
+    {
+        out.cut_short = Some(why);
     }
     if out.run.is_empty() {
         return Err(LogError::NotATestbedLog {

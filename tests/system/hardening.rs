@@ -146,3 +146,54 @@ fn special_files_are_refused_without_reading_them() {
         assert!(e.contains("not a regular file"), "{args:?}: {e}");
     }
 }
+
+/// A fresh lockstep log of 0.3 s.
+fn a_log(dir: &std::path::Path) -> std::path::PathBuf {
+    let out = ok(testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--duration",
+            "0.3",
+            "--json",
+            "--runs-dir",
+        ])
+        .arg(dir));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    std::path::PathBuf::from(v["log"].as_str().unwrap())
+}
+
+/// Rows 3 and 4, logs: a Header claiming u64::MAX bytes and a chunk asking
+/// for 4.28 GB are named, never a panic or a huge allocation.
+#[test]
+fn damaged_record_lengths_in_a_log_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = a_log(dir.path());
+    let good = std::fs::read(&log).unwrap();
+    // The Header record: opcode at byte 8, its length at 9..17.
+    let mut bad = good.clone();
+    bad[9..17].copy_from_slice(&u64::MAX.to_le_bytes());
+    let f = dir.path().join("header.mcap");
+    std::fs::write(&f, &bad).unwrap();
+    let out = testbed().arg("replay").arg(&f).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("header.mcap") && e.contains("testbed.run metadata"),
+        "{e}"
+    );
+    // The first chunk's uncompressed size: walk the records to it.
+    let mut at = 8;
+    while good[at] != 0x06 {
+        at += 9 + u64::from_le_bytes(good[at + 1..at + 9].try_into().unwrap()) as usize;
+    }
+    let mut bad = good.clone();
+    bad[at + 9 + 16..at + 9 + 24].copy_from_slice(&4_280_000_000u64.to_le_bytes());
+    let f = dir.path().join("chunk.mcap");
+    std::fs::write(&f, &bad).unwrap();
+    let out = testbed().arg("replay").arg(&f).output().unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(matches!(out.status.code(), Some(0 | 1)), "{e}");
+    assert!(e.contains("4280000000 bytes uncompressed"), "{e}");
+}
