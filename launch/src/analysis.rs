@@ -138,10 +138,16 @@ pub struct LogAnalysis {
 }
 
 impl LogAnalysis {
-    /// A warning for a log that was read only in part, or None.
+    /// A warning for a log that was read only in part, or of a run that
+    /// did not finish, or None.
     pub fn warning(&self) -> Option<String> {
         let rows = self.summary.steps;
-        let why = self.contents.cut_short.as_ref()?;
+        let ended = self.contents.run_end().filter(|e| *e != "finished");
+        let why = match (&self.contents.cut_short, ended) {
+            (Some(cut), _) => cut.clone(),
+            (None, Some(end)) => format!("the run did not finish ({end})"),
+            (None, None) => return None,
+        };
         Some(format!(
             "{}: {why}; recovered {rows} of {} steps ({:.3} s of {:.3} s)",
             self.contents.path.display(),

@@ -64,9 +64,12 @@ pub struct Report {
     /// `replay --verify`: steps compared.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub verified_steps: Option<u64>,
-    /// Set when the log was read only in part.
+    /// Set when the log was read only in part or the run did not finish.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub warning: Option<String>,
+    /// How a logged run ended ("finished", "interrupted", "lost the plant", …).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub run_end: Option<String>,
 }
 
 /// The gains and joint roles of a plan, for the report.
@@ -130,6 +133,7 @@ impl Report {
             max_abs_torque_diff: None,
             verified_steps: None,
             warning: None,
+            run_end: None,
         }
     }
 
@@ -162,6 +166,7 @@ impl Report {
             max_abs_torque_diff: a.verify.map(|v| v.0),
             verified_steps: a.verify.map(|v| v.1),
             warning,
+            run_end: a.contents.run_end().map(String::from),
             summary: a.summary,
         }
     }

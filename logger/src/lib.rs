@@ -28,6 +28,9 @@ pub use writer::{LogWriter, RunMetadata};
 pub const RUN_METADATA: &str = "testbed.run";
 /// Name of the metadata record with the logger's counts.
 pub const STATS_METADATA: &str = "testbed.log_stats";
+/// The key of [`STATS_METADATA`] that says how the run ended
+/// ("finished", "interrupted", "lost the plant", …).
+pub const RUN_END: &str = "run_end";
 /// Name of the URDF attachment.
 pub const URDF_ATTACHMENT: &str = "robot.urdf";
 

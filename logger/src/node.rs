@@ -14,7 +14,7 @@ use wire::{
     Topic, TopicSubscriber,
 };
 
-use crate::{LogError, LogMessage, LogWriter, RunMetadata};
+use crate::{LogError, LogMessage, LogWriter, RUN_END, RunMetadata};
 
 /// What the launcher hands the logger node.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -120,6 +120,19 @@ impl Subs {
     }
 }
 
+/// How the run ended, as the log's stats record it (`replay` warns on
+/// anything but "finished").
+fn run_end(link: &NodeLink, result: &Result<(), LoggerNodeError>) -> String {
+    match (link.run_end(), result) {
+        (Some(end), _) => end.describe(),
+        (None, Err(LoggerNodeError::Node(NodeError::ParentGone(pid)))) => {
+            format!("the launcher (pid {pid}) vanished")
+        }
+        (None, Err(e)) => format!("the logger stopped: {e}"),
+        (None, Ok(())) => "unknown".into(),
+    }
+}
+
 /// Runs the logger node to the end of the run.
 pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerNodeError> {
     let mut subs = Subs {
@@ -159,7 +172,8 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
     // STOP, a signal or a vanished launcher: in every case take what is
     // still buffered and finish the file properly.
     subs.drain(&mut log)?;
-    let stats = subs.stats();
+    let mut stats = subs.stats();
+    stats.insert(RUN_END.into(), run_end(link, &result));
     log.finish(stats)?;
     match result {
         Err(LoggerNodeError::Node(NodeError::Stopped)) => Ok(()),

@@ -28,6 +28,12 @@ pub struct LogContents {
 }
 
 impl LogContents {
+    /// How the run ended, as the logger recorded it (None: the logger
+    /// never finished the file, or the log predates the record).
+    pub fn run_end(&self) -> Option<&str> {
+        self.stats.as_ref()?.get(crate::RUN_END).map(String::as_str)
+    }
+
     /// Samples the logger could not take, summed over topics (None if the
     /// logger never finished the file).
     pub fn logger_dropped(&self) -> Option<u64> {

@@ -197,3 +197,18 @@ fn damaged_record_lengths_in_a_log_are_named() {
     assert!(matches!(out.status.code(), Some(0 | 1)), "{e}");
     assert!(e.contains("4280000000 bytes uncompressed"), "{e}");
 }
+
+/// Row 5: a finished run's log says so and replays without a warning.
+#[test]
+fn a_finished_run_is_recorded_as_finished() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = a_log(dir.path());
+    let s: serde_json::Value =
+        serde_json::from_slice(&ok(testbed().arg("replay").arg("--json").arg(&log)).stdout)
+            .unwrap();
+    assert!(s.get("warning").is_none(), "{s}");
+    assert_eq!(s["run_end"], "finished");
+    let text = std::fs::read(&log).unwrap();
+    let needle = b"run_end";
+    assert!(text.windows(needle.len()).any(|w| w == needle));
+}

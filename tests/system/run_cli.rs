@@ -123,6 +123,16 @@ fn killing_any_node_fails_the_run_cleanly() {
             Vec::<String>::new(),
             "{victim}: shared memory left"
         );
+        if victim != "logger" {
+            // The log says the run did not finish, and which node it lost.
+            let log = newest_log(dir.path());
+            let s = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
+            let w = s["warning"].as_str().unwrap_or_default();
+            assert!(
+                w.contains(&format!("the run did not finish (lost the {victim})")),
+                "{victim}: {s}"
+            );
+        }
         if victim == "logger" {
             // The unfinished log keeps what was flushed before the kill.
             let log = newest_log(dir.path());
@@ -162,6 +172,10 @@ fn ctrl_c_stops_everything() {
     assert_eq!(status.code(), Some(130));
     assert!(nodes_of(launcher.id()).is_empty());
     assert_eq!(shm_files(&nodes[0].2), Vec::<String>::new());
+    let log = newest_log(dir.path());
+    let s = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
+    let w = s["warning"].as_str().unwrap_or_default();
+    assert!(w.contains("the run did not finish (interrupted)"), "{s}");
 }
 
 /// A node whose launcher disappears exits by itself.
@@ -179,15 +193,24 @@ fn nodes_exit_when_the_launcher_is_killed() {
     wait_for_nodes(pid);
     kill(Pid::from_raw(pid as i32), Signal::SIGKILL).unwrap();
     wait_bounded(&mut launcher, 5);
-    for _ in 0..500 {
-        if nodes_of(pid).is_empty() {
-            return;
-        }
+    let deadline = std::time::Instant::now() + Duration::from_secs(10);
+    while !nodes_of(pid).is_empty() {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "nodes of killed launcher still running: {:?}",
+            nodes_of(pid)
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
-    panic!(
-        "nodes of killed launcher still running: {:?}",
-        nodes_of(pid)
+    // The logger finished the file and says the launcher vanished.
+    let log = newest_log(dir.path());
+    let s = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
+    let w = s["warning"].as_str().unwrap_or_default();
+    assert!(
+        w.contains(&format!(
+            "the run did not finish (the launcher (pid {pid}) vanished)"
+        )),
+        "{s}"
     );
 }
 

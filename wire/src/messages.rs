@@ -204,17 +204,65 @@ pub const CONTROL_START: u32 = 1;
 /// [`Control::command`]: stop and exit.
 pub const CONTROL_STOP: u32 = 2;
 
+/// How a run ended, as the launcher tells the nodes with STOP and the log
+/// records it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunEnd {
+    /// Every step was made.
+    Finished,
+    /// Ctrl-C or SIGTERM of the launcher.
+    Interrupted,
+    /// The run failed otherwise (a stall, a start-up timeout, the bus).
+    Failed,
+    /// A node died or failed.
+    LostNode(NodeKind),
+}
+
+impl RunEnd {
+    /// The code carried in [`Control::outcome`].
+    pub fn code(self) -> u32 {
+        match self {
+            RunEnd::Finished => 0,
+            RunEnd::Interrupted => 1,
+            RunEnd::Failed => 2,
+            RunEnd::LostNode(k) => 10 + k as u32,
+        }
+    }
+
+    /// The outcome of a code (unknown codes read as a failure).
+    pub fn from_code(code: u32) -> Self {
+        match code {
+            0 => RunEnd::Finished,
+            1 => RunEnd::Interrupted,
+            c => NodeKind::ALL
+                .into_iter()
+                .find(|k| 10 + *k as u32 == c)
+                .map_or(RunEnd::Failed, RunEnd::LostNode),
+        }
+    }
+
+    /// What the log says: "finished", "interrupted", "failed", "lost the plant".
+    pub fn describe(self) -> String {
+        match self {
+            RunEnd::Finished => "finished".into(),
+            RunEnd::Interrupted => "interrupted".into(),
+            RunEnd::Failed => "failed".into(),
+            RunEnd::LostNode(k) => format!("lost the {}", k.name()),
+        }
+    }
+}
+
 /// From the launcher to every node.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("testbed.Control.v1")]
+#[type_name("testbed.Control.v2")]
 pub struct Control {
     /// seq counts control messages.
     pub header: Header,
     /// [`CONTROL_START`] or [`CONTROL_STOP`].
     pub command: u32,
-    /// Padding.
-    pub reserved: u32,
+    /// With STOP: how the run ended, [`RunEnd::code`].
+    pub outcome: u32,
     /// CLOCK_MONOTONIC time of step 0, ns (with START).
     pub epoch_wall_ns: u64,
 }

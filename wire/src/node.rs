@@ -82,6 +82,7 @@ pub struct NodeLink {
     parent_pid: Option<u32>,
     status_seq: u64,
     stop_seen: bool,
+    stop_outcome: Option<u32>,
 }
 
 impl NodeLink {
@@ -103,6 +104,7 @@ impl NodeLink {
             parent_pid,
             status_seq: 0,
             stop_seen: false,
+            stop_outcome: None,
         })
     }
 
@@ -137,12 +139,18 @@ impl NodeLink {
         while let Some(c) = self.control.receive()? {
             if c.command == CONTROL_STOP {
                 self.stop_seen = true;
+                self.stop_outcome = Some(c.outcome);
             }
         }
         if self.stop_seen {
             return Err(NodeError::Stopped);
         }
         Ok(())
+    }
+
+    /// How the launcher said the run ended, once STOP arrived.
+    pub fn run_end(&self) -> Option<crate::RunEnd> {
+        self.stop_outcome.map(crate::RunEnd::from_code)
     }
 
     /// Reports READY and blocks until START; returns the epoch of step 0.
@@ -158,7 +166,10 @@ impl NodeLink {
                         self.report(NODE_RUNNING, 0)?;
                         return Ok(c.epoch_wall_ns);
                     }
-                    CONTROL_STOP => return Err(NodeError::Stopped),
+                    CONTROL_STOP => {
+                        self.stop_outcome = Some(c.outcome);
+                        return Err(NodeError::Stopped);
+                    }
                     other => {
                         return Err(NodeError::Protocol(format!(
                             "unknown control command {other}"

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use scenario::Plan;
 use wire::{
     Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, MAX_DOF, NODE_DONE, NODE_FAILED,
-    NODE_READY, NodeKind, NodeStatus, RunPrefix, Topic, WireError, monotonic_ns,
+    NODE_READY, NodeKind, NodeStatus, RunEnd, RunPrefix, Topic, WireError, monotonic_ns,
 };
 
 use crate::analysis::{AnalyseOptions, AnalysisError, LogAnalysis, analyse};
@@ -197,7 +197,18 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let peak_rss_kb = children.peak_rss_kb();
     // Whatever happened: STOP (the logger then finishes the file), grace,
     // SIGTERM, SIGKILL, reap.
-    let _ = control.send(control_msg(CONTROL_STOP, 0));
+    let end = match &result {
+        Ok(_) => RunEnd::Finished,
+        Err(RunError::Interrupted) => RunEnd::Interrupted,
+        Err(RunError::NodeFailed { node, .. }) => NodeKind::ALL
+            .into_iter()
+            .find(|k| k.name() == *node)
+            .map_or(RunEnd::Failed, RunEnd::LostNode),
+        Err(_) => RunEnd::Failed,
+    };
+    let mut stop = control_msg(CONTROL_STOP, 0);
+    stop.outcome = end.code();
+    let _ = control.send(stop);
     children.stop(STOP_GRACE);
     let logger_exit = children.exit_of(NodeKind::Logger);
     // Close every port of this process, then remove what is left of the
@@ -336,7 +347,7 @@ fn control_msg(command: u32, epoch_wall_ns: u64) -> Control {
             wall_ns: monotonic_ns(),
         },
         command,
-        reserved: 0,
+        outcome: 0,
         epoch_wall_ns,
     }
 }
