@@ -32,6 +32,9 @@ use std::collections::BTreeMap;
 pub use error::ModelError;
 pub use inertia::iso;
 
+/// The most links (and joints) a URDF may have: real arms have tens.
+pub const MAX_LINKS: usize = 1000;
+
 /// The paper's two-link arm (SPEC §1), embedded so the default scenario
 /// needs no files.
 pub const TWO_LINK_URDF: &str = include_str!("../../robots/two_link.urdf");

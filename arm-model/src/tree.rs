@@ -15,6 +15,14 @@ use crate::ModelError;
 
 /// Parses, checks and simplifies a URDF robot.
 pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, ModelError> {
+    let size = robot.links.len().max(robot.joints.len());
+    if size > crate::MAX_LINKS {
+        return Err(ModelError::InvalidConfig {
+            key: "the URDF's links and joints".into(),
+            value: format!("{} links, {} joints", robot.links.len(), robot.joints.len()),
+            need: format!("at most {} of each (an arm, not a scene)", crate::MAX_LINKS),
+        });
+    }
     let mut index = HashMap::new();
     let mut links = Vec::with_capacity(robot.links.len());
     for (i, l) in robot.links.iter().enumerate() {
@@ -70,9 +78,18 @@ fn find_root(links: &[LinkInfo], joints: &[JointInfo]) -> Result<usize, ModelErr
     match roots.as_slice() {
         [r] => Ok(*r),
         [] => Err(ModelError::NoRoot),
-        many => Err(ModelError::ManyRoots(
-            many.iter().map(|&i| links[i].name.clone()).collect(),
-        )),
+        many => {
+            // A message names a few, not thousands.
+            let mut names: Vec<String> = many
+                .iter()
+                .take(8)
+                .map(|&i| links[i].name.clone())
+                .collect();
+            if many.len() > 8 {
+                names.push(format!("and {} more", many.len() - 8));
+            }
+            Err(ModelError::ManyRoots(names))
+        }
     }
 }
 

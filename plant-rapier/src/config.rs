@@ -118,25 +118,37 @@ impl PerJoint {
 
     /// Checks that every entry is finite and not negative, without the arm.
     fn check(&self, key: &str) -> Result<(), PlantError> {
-        self.check_with(key, |x| x.is_finite() && x >= 0.0, "a finite number ≥ 0")
+        self.check_with(
+            key,
+            |x| (0.0..=MAX_MAGNITUDE).contains(&x),
+            "a number from 0 to 1e9",
+        )
     }
 
     /// Checks that every entry is finite, without the arm.
     fn check_signed(&self, key: &str) -> Result<(), PlantError> {
-        self.check_with(key, f64::is_finite, "a finite number")
+        self.check_with(
+            key,
+            |x| (-MAX_MAGNITUDE..=MAX_MAGNITUDE).contains(&x),
+            "a number from -1e9 to 1e9",
+        )
     }
 
     fn check_with(&self, key: &str, ok: fn(f64) -> bool, need: &str) -> Result<(), PlantError> {
         match self {
-            Self::All(x) if !ok(*x) => Err(invalid(key, x, need)),
+            Self::All(x) if !ok(*x) => Err(invalid(key, short(*x), need)),
             Self::Each(v) => match v.iter().position(|x| !ok(*x)) {
-                Some(i) => Err(invalid(&format!("{key}[{i}]"), v[i], need)),
+                Some(i) => Err(invalid(&format!("{key}[{i}]"), short(v[i]), need)),
                 None => Ok(()),
             },
             Self::All(_) => Ok(()),
         }
     }
 }
+
+/// The largest per-joint setting taken (torques, noise, friction): far past
+/// anything physical, far below where sums and squares overflow.
+pub const MAX_MAGNITUDE: f64 = 1e9;
 
 /// Viscous plus Coulomb friction at each joint:
 /// τ_f = −(b q̇ + F_c tanh(q̇ / v_s)), smoothed near zero velocity so that
@@ -249,6 +261,15 @@ pub struct ActuationConfig {
     /// Probability that a command is lost; the motors then hold the last
     /// one received (default: 0).
     pub drop_probability: f64,
+}
+
+/// A number as a message shows it: 1e308, not its 309 digits.
+fn short(x: f64) -> String {
+    if x.is_finite() && x.abs() >= 1e15 {
+        format!("{x:e}")
+    } else {
+        x.to_string()
+    }
 }
 
 fn invalid(key: &str, value: impl ToString, need: impl ToString) -> PlantError {

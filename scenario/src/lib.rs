@@ -184,6 +184,15 @@ impl Scenario {
             value: value.to_string(),
             need: need.to_string(),
         };
+        // The name reaches terminals, file names and logs: printable text only.
+        if self.name.chars().any(char::is_control) || self.name.chars().count() > 200 {
+            return Err(ScenarioError::Invalid {
+                file: file.to_string(),
+                key: "name".into(),
+                value: format!("{:?}", self.name.chars().take(60).collect::<String>()),
+                need: "at most 200 characters, none of them control characters".into(),
+            });
+        }
         if !(self.duration_s.is_finite() && self.duration_s > 0.0 && self.duration_s <= 1e6) {
             return Err(invalid(
                 "duration_s",

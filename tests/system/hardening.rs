@@ -212,3 +212,58 @@ fn a_finished_run_is_recorded_as_finished() {
     let needle = b"run_end";
     assert!(text.windows(needle.len()).any(|w| w == needle));
 }
+
+/// Row 9: a value that would overflow the run is refused up front, shortly.
+#[test]
+fn an_overflowing_setting_is_refused_before_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    for (table, key) in [
+        ("plant.sensor", "q_noise_std"),
+        ("plant.disturbance", "noise_std"),
+    ] {
+        let f = scenario(
+            dir.path(),
+            "big.toml",
+            &format!("[{table}]\n{key} = 1e308\n"),
+        );
+        let e = fails(testbed().arg("sim").arg("--scenario").arg(&f));
+        assert!(
+            e.contains(&format!(
+                "{table}.{key} = 1e308 is invalid: it must be a number from 0 to 1e9"
+            )),
+            "{e}"
+        );
+    }
+}
+
+/// Row 12: control characters in the name never reach the terminal.
+#[test]
+fn a_name_with_escape_codes_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = scenario(dir.path(), "ansi.toml", "name = \"a\\u001b[31mred\"\n");
+    let e = fails(testbed().arg("sim").arg("--scenario").arg(&f));
+    assert!(
+        e.contains("name = \"a\\u{1b}[31mred\" is invalid") && !e.contains('\u{1b}'),
+        "{e}"
+    );
+}
+
+/// Row 13: a URDF the size of a scene is refused at once, in a short message.
+#[test]
+fn a_urdf_of_thousands_of_links_is_refused_quickly() {
+    let dir = tempfile::tempdir().unwrap();
+    let links: String = (0..5000)
+        .map(|i| format!("<link name=\"l{i}\"/>"))
+        .collect();
+    let f = scenario(
+        dir.path(),
+        "scene.urdf",
+        &format!("<robot name=\"s\">{links}</robot>"),
+    );
+    let e = fails(testbed().arg("robot").arg(&f));
+    assert!(
+        e.contains("5000 links, 0 joints is invalid: it must be at most 1000"),
+        "{e}"
+    );
+    assert!(e.len() < 500, "{} bytes of error", e.len());
+}

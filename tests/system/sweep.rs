@@ -208,6 +208,10 @@ fn sweep_errors_name_the_file_and_key_and_run_nothing() {
         ("seeds = 0\n", "seeds = 0"),
         ("laws = [\"lqr\"]\n", "unknown variant `lqr`"),
         ("axes = []\n", "unknown field `axes`"),
+        (
+            "name = \"../escape\"\n",
+            "name = \"../escape\": use up to 100 letters",
+        ),
     ];
     for (i, (text, want)) in cases.iter().enumerate() {
         let file = dir.path().join(format!("bad{i}.toml"));

@@ -7,8 +7,9 @@ use std::path::Path;
 
 /// Largest scenario or sweep file read, bytes.
 pub const MAX_TEXT_FILE_BYTES: u64 = 16 << 20;
-/// Largest URDF read, bytes (real arms are well under 1 MB).
-pub const MAX_URDF_BYTES: u64 = 64 << 20;
+/// Largest URDF read, bytes (real arms without inline meshes are well
+/// under 1 MB).
+pub const MAX_URDF_BYTES: u64 = 16 << 20;
 
 /// The bytes of the regular file at `path`, at most `max_bytes` of them
 /// (`None`: no limit).

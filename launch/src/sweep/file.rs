@@ -258,6 +258,16 @@ pub fn load(path: &Path) -> Result<Sweep, SweepError> {
         path.file_stem()
             .map_or_else(|| "sweep".into(), |s| s.to_string_lossy().to_string())
     });
+    // The name becomes a folder name: letters, digits, '-', '_', '.' only.
+    let plain = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.');
+    if name.is_empty() || name.starts_with('.') || name.len() > 100 || !name.chars().all(plain) {
+        return Err(SweepError::File {
+            file,
+            reason: format!(
+                "name = {name:?}: use up to 100 letters, digits, '-', '_' or '.' (not first)"
+            ),
+        });
+    }
     Ok(Sweep {
         name,
         path: path.to_path_buf(),
