@@ -54,7 +54,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let (prefix, config, mode) = args()?;
     let config: ControllerNodeConfig = read_config(&config)?;
     let n = config.dof;
-    let mut link = NodeLink::connect(NodeKind::Controller, &prefix, None)?;
+    let mut link = NodeLink::connect(NodeKind::Controller, &prefix, None, mode)?;
     let states = link.bus.subscriber::<JointState>(Topic::JointState)?;
     let mut references = ReferenceWindow::new(&link, mode)?;
     let commands = link

@@ -153,3 +153,34 @@ fn a_replacement_trajectory_is_followed_in_lockstep_and_real_time() {
         );
     }
 }
+
+/// An external node started with the other `--mode` fails the run at
+/// START, saying why (#18 row 12), instead of running with faults.
+#[test]
+fn an_external_node_with_the_wrong_mode_fails_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut run, mut argv) = start_with_external(
+        &["run", "--mode", "lockstep", "--duration", "2", "--runs-dir"]
+            .map(String::from)
+            .iter()
+            .map(String::as_str)
+            .chain([dir.path().to_str().unwrap()])
+            .collect::<Vec<_>>(),
+        "controller",
+    );
+    let i = argv.iter().position(|a| a == "--mode").unwrap();
+    argv[i + 1] = "realtime".into();
+    let node = testbed()
+        .args(["node", "controller"])
+        .args(&argv)
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&node.stderr);
+    assert!(!node.status.success());
+    assert!(
+        said.contains("started with --mode realtime but the run is lockstep"),
+        "{said}"
+    );
+    let status = wait_bounded(&mut run, 60);
+    assert!(!status.success(), "the run went on");
+}

@@ -219,7 +219,7 @@ pub enum RunEnd {
 }
 
 impl RunEnd {
-    /// The code carried in [`Control::outcome`].
+    /// The code carried in [`Control::code`] with STOP.
     pub fn code(self) -> u32 {
         match self {
             RunEnd::Finished => 0,
@@ -261,8 +261,9 @@ pub struct Control {
     pub header: Header,
     /// [`CONTROL_START`] or [`CONTROL_STOP`].
     pub command: u32,
-    /// With STOP: how the run ended, [`RunEnd::code`].
-    pub outcome: u32,
+    /// With START: the run's mode ([`crate::Mode::code`]), which every node
+    /// checks against its own; with STOP: how the run ended ([`RunEnd::code`]).
+    pub code: u32,
     /// CLOCK_MONOTONIC time of step 0, ns (with START).
     pub epoch_wall_ns: u64,
 }

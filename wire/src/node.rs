@@ -7,9 +7,9 @@
 use std::time::Duration;
 
 use crate::{
-    Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, NODE_DONE, NODE_READY,
-    NODE_RUNNING, NodeKind, NodeStatus, RunPrefix, Topic, TopicPublisher, TopicSubscriber,
-    WireError, monotonic_ns,
+    Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, NODE_DONE, NODE_FAILED,
+    NODE_READY, NODE_RUNNING, NodeKind, NodeStatus, RunPrefix, Topic, TopicPublisher,
+    TopicSubscriber, WireError, monotonic_ns,
 };
 
 /// Timing mode of a multi-process run.
@@ -25,6 +25,14 @@ pub enum Mode {
 }
 
 impl Mode {
+    /// The code START carries ([`crate::Control::code`]).
+    pub fn code(self) -> u32 {
+        match self {
+            Mode::Realtime => 1,
+            Mode::Lockstep => 2,
+        }
+    }
+
     /// The command-line spelling.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -83,15 +91,17 @@ pub struct NodeLink {
     status_seq: u64,
     stop_seen: bool,
     stop_outcome: Option<u32>,
+    mode: Mode,
 }
 
 impl NodeLink {
-    /// Connects node `kind` to the run under `prefix`; with `parent_pid`
-    /// the node stops once that process (its launcher) is gone.
+    /// Connects node `kind` of a `mode` run to the run under `prefix`; with
+    /// `parent_pid` the node stops once that process (its launcher) is gone.
     pub fn connect(
         kind: NodeKind,
         prefix: &RunPrefix,
         parent_pid: Option<u32>,
+        mode: Mode,
     ) -> Result<Self, WireError> {
         let bus = Bus::new(prefix, kind.name())?;
         let status = bus.publisher(Topic::Status, Delivery::DropWhenFull)?;
@@ -105,6 +115,7 @@ impl NodeLink {
             status_seq: 0,
             stop_seen: false,
             stop_outcome: None,
+            mode,
         })
     }
 
@@ -139,7 +150,7 @@ impl NodeLink {
         while let Some(c) = self.control.receive()? {
             if c.command == CONTROL_STOP {
                 self.stop_seen = true;
-                self.stop_outcome = Some(c.outcome);
+                self.stop_outcome = Some(c.code);
             }
         }
         if self.stop_seen {
@@ -162,12 +173,25 @@ impl NodeLink {
             self.control.drain_events()?;
             if let Some(c) = self.control.receive()? {
                 match c.command {
+                    CONTROL_START if c.code != self.mode.code() => {
+                        // Say so, so that the launcher fails the run at once.
+                        self.report(NODE_FAILED, 0)?;
+                        return Err(NodeError::Protocol(format!(
+                            "this node was started with --mode {} but the run is {}",
+                            self.mode.as_str(),
+                            if c.code == Mode::Lockstep.code() {
+                                "lockstep"
+                            } else {
+                                "realtime"
+                            }
+                        )));
+                    }
                     CONTROL_START => {
                         self.report(NODE_RUNNING, 0)?;
                         return Ok(c.epoch_wall_ns);
                     }
                     CONTROL_STOP => {
-                        self.stop_outcome = Some(c.outcome);
+                        self.stop_outcome = Some(c.code);
                         return Err(NodeError::Stopped);
                     }
                     other => {

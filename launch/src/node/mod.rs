@@ -85,22 +85,22 @@ pub fn run(kind: NodeKind, args: &NodeArgs) -> Result<(), NodeRunError> {
     let result = match kind {
         NodeKind::Plant => {
             let config = read_config(&args.config)?;
-            let mut link = NodeLink::connect(kind, &prefix, args.parent_pid)?;
+            let mut link = NodeLink::connect(kind, &prefix, args.parent_pid, args.mode)?;
             plant_rapier::node::run(&mut link, &config, mode).map_err(NodeRunError::from)
         }
         NodeKind::Controller => {
             let config = read_config(&args.config)?;
-            let mut link = NodeLink::connect(kind, &prefix, args.parent_pid)?;
+            let mut link = NodeLink::connect(kind, &prefix, args.parent_pid, args.mode)?;
             controller::node::run(&mut link, &config, mode).map_err(NodeRunError::from)
         }
         NodeKind::Trajectory => {
             let config = read_config(&args.config)?;
-            let mut link = NodeLink::connect(kind, &prefix, args.parent_pid)?;
+            let mut link = NodeLink::connect(kind, &prefix, args.parent_pid, args.mode)?;
             trajectory::node::run(&mut link, &config, mode).map_err(NodeRunError::from)
         }
         NodeKind::Logger => {
             let config = read_config(&args.config)?;
-            let mut link = NodeLink::connect(kind, &prefix, args.parent_pid)?;
+            let mut link = NodeLink::connect(kind, &prefix, args.parent_pid, args.mode)?;
             logger::node::run(&mut link, &config).map_err(NodeRunError::from)
         }
     };

@@ -207,7 +207,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         Err(_) => RunEnd::Failed,
     };
     let mut stop = control_msg(CONTROL_STOP, 0);
-    stop.outcome = end.code();
+    stop.code = end.code();
     let _ = control.send(stop);
     children.stop(STOP_GRACE);
     let logger_exit = children.exit_of(NodeKind::Logger);
@@ -347,7 +347,7 @@ fn control_msg(command: u32, epoch_wall_ns: u64) -> Control {
             wall_ns: monotonic_ns(),
         },
         command,
-        outcome: 0,
+        code: 0,
         epoch_wall_ns,
     }
 }
@@ -391,7 +391,9 @@ fn supervise(
     // bench's timer floor runs on it too).
     let period = opts.plan.period_ns;
     let epoch = (monotonic_ns() + 20_000_000).div_ceil(period) * period;
-    control.send(control_msg(CONTROL_START, epoch))?;
+    let mut start = control_msg(CONTROL_START, epoch);
+    start.code = opts.mode.code();
+    control.send(start)?;
     let started = Instant::now();
     let bar = progress_bar(opts);
     let mut last_step = 0;
