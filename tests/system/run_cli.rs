@@ -190,7 +190,7 @@ fn nodes_exit_when_the_launcher_is_killed() {
         .spawn()
         .unwrap();
     let pid = launcher.id();
-    wait_for_nodes(pid);
+    let prefix = wait_for_nodes(pid)[0].2.clone();
     kill(Pid::from_raw(pid as i32), Signal::SIGKILL).unwrap();
     wait_bounded(&mut launcher, 5);
     let deadline = std::time::Instant::now() + Duration::from_secs(10);
@@ -211,6 +211,23 @@ fn nodes_exit_when_the_launcher_is_killed() {
             "the run did not finish (the launcher (pid {pid}) vanished)"
         )),
         "{s}"
+    );
+    // The very next run removes what the killed launcher left (#18 row 6),
+    // not only domains older than a minute.
+    ok(testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--duration",
+            "0.1",
+            "--runs-dir",
+        ])
+        .arg(dir.path()));
+    assert_eq!(
+        shm_files(&prefix),
+        Vec::<String>::new(),
+        "the killed run's shared memory is left"
     );
 }
 

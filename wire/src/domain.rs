@@ -96,7 +96,12 @@ impl RunPrefix {
                 .ok()
                 .and_then(|m| now.duration_since(m).ok())
                 .is_some_and(|age| age > STALE_AFTER);
-            if old && prefix != *except && !found.contains(&prefix) {
+            // A domain whose launcher is gone is stale at once; one whose
+            // pid is alive (maybe reused) only after STALE_AFTER.
+            let orphaned = prefix
+                .launcher_pid()
+                .is_some_and(|pid| !std::path::Path::new(&format!("/proc/{pid}")).exists());
+            if (old || orphaned) && prefix != *except && !found.contains(&prefix) {
                 found.push(prefix);
             }
         }

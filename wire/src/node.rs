@@ -237,6 +237,30 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_prefix_names_its_launcher_and_run_ends_round_trip() {
+        let p = crate::RunPrefix::unique();
+        assert_eq!(p.launcher_pid(), Some(std::process::id()));
+        assert_eq!(
+            crate::RunPrefix::parse("other").unwrap().launcher_pid(),
+            None
+        );
+        for end in [
+            crate::RunEnd::Finished,
+            crate::RunEnd::Interrupted,
+            crate::RunEnd::Failed,
+            crate::RunEnd::LostNode(crate::NodeKind::Plant),
+            crate::RunEnd::LostNode(crate::NodeKind::Logger),
+        ] {
+            assert_eq!(crate::RunEnd::from_code(end.code()), end);
+        }
+        assert_eq!(
+            crate::RunEnd::LostNode(crate::NodeKind::Plant).describe(),
+            "lost the plant"
+        );
+        assert_ne!(Mode::Lockstep.code(), Mode::Realtime.code());
+    }
+
+    #[test]
     fn modes_parse_from_their_spelling_only() {
         for m in [Mode::Realtime, Mode::Lockstep] {
             assert_eq!(m.as_str().parse::<Mode>().unwrap(), m);

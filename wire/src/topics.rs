@@ -133,6 +133,13 @@ impl RunPrefix {
         ))
     }
 
+    /// The pid of the launcher that made this prefix ([`RunPrefix::unique`]).
+    pub fn launcher_pid(&self) -> Option<u32> {
+        let rest = self.0.strip_prefix(Self::STEM)?;
+        let (pid, _) = rest.split_once('x')?;
+        u32::from_str_radix(pid, 16).ok()
+    }
+
     /// Checks a prefix given on a command line.
     pub fn parse(s: &str) -> Result<Self, WireError> {
         let ok = !s.is_empty()
