@@ -445,3 +445,41 @@ fn refused_realtime_scheduling_is_said_and_the_run_goes_on() {
     assert!(stderr.contains("Operation not permitted"), "{stderr}");
     assert_eq!(json(&out)["steps"], 500);
 }
+
+/// Ctrl-Z then `fg` (every process stopped, then continued) is survived in
+/// real time: the run goes on and the gap shows as late wake-ups (#18 row 2).
+#[test]
+fn a_stopped_and_continued_realtime_run_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut launcher = testbed()
+        .args(["run", "--duration", "6", "--json", "--runs-dir"])
+        .arg(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let nodes = wait_for_nodes(launcher.id());
+    let mut pids: Vec<i32> = nodes.iter().map(|n| n.1 as i32).collect();
+    pids.push(launcher.id() as i32);
+    // Five pauses: one lands inside a listener's wait, which a stop and
+    // continue interrupts (EINTR). The sleeps are the stimulus, not waits.
+    for _ in 0..5 {
+        for p in &pids {
+            kill(Pid::from_raw(*p), Signal::SIGSTOP).unwrap();
+        }
+        std::thread::sleep(Duration::from_millis(300));
+        for p in &pids {
+            kill(Pid::from_raw(*p), Signal::SIGCONT).unwrap();
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    let status = wait_bounded(&mut launcher, 60);
+    let mut out = String::new();
+    std::io::Read::read_to_string(&mut launcher.stdout.take().unwrap(), &mut out).unwrap();
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(status.success(), "{err}");
+    let s: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(s["run_end"], "finished");
+    assert!(s["timing"]["late_wakeups"].as_u64().unwrap() > 0, "{s}");
+}

@@ -4,8 +4,9 @@
 use std::fmt::Debug;
 use std::time::Duration;
 
+use iceoryx2::node::NodeWaitFailure;
 use iceoryx2::port::BackpressureAction;
-use iceoryx2::port::listener::Listener;
+use iceoryx2::port::listener::{Listener, ListenerWaitError};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
@@ -221,7 +222,17 @@ impl Bus {
 
     /// Sleeps up to `timeout`; `Err(Terminated)` once SIGINT or SIGTERM arrived.
     pub fn wait(&self, timeout: Duration) -> Result<(), WireError> {
-        self.node.wait(timeout).map_err(|_| WireError::Terminated)
+        match self.node.wait(timeout) {
+            Ok(()) => Ok(()),
+            Err(NodeWaitFailure::TerminationRequest) => Err(WireError::Terminated),
+            // A signal cut the sleep short: Ctrl-C shows as a termination
+            // request on a second, zero wait; anything else (SIGCONT after
+            // Ctrl-Z and `fg`, a paused VM) is only an early wake-up.
+            Err(NodeWaitFailure::Interrupt) => match self.node.wait(Duration::ZERO) {
+                Err(NodeWaitFailure::TerminationRequest) => Err(WireError::Terminated),
+                _ => Ok(()),
+            },
+        }
     }
 
     fn service<T: Debug + ZeroCopySend + Copy + 'static>(
@@ -404,9 +415,12 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
         match &self.listener {
             Some(l) => {
                 let mut woken = false;
-                l.timed_wait(|_| woken = true, timeout)
-                    .map_err(|e| ipc("listener", self.topic.name())(format!("{e:?}")))?;
-                Ok(woken)
+                match l.timed_wait(|_| woken = true, timeout) {
+                    // A signal woke the wait (Ctrl-Z then `fg`): an early
+                    // wake-up; termination is the caller's `check` to see.
+                    Ok(_) | Err(ListenerWaitError::InterruptSignal) => Ok(woken),
+                    Err(e) => Err(ipc("listener", self.topic.name())(format!("{e:?}"))),
+                }
             }
             None => {
                 std::thread::sleep(timeout);
