@@ -483,3 +483,53 @@ fn a_stopped_and_continued_realtime_run_goes_on() {
     assert_eq!(s["run_end"], "finished");
     assert!(s["timing"]["late_wakeups"].as_u64().unwrap() > 0, "{s}");
 }
+
+/// A controller stopped (SIGSTOP) in a real-time run is detected and named
+/// once the plant has finished, instead of hanging the run (#18 row 1); the
+/// log is kept and says which node was lost.
+#[test]
+fn a_stopped_controller_in_a_realtime_run_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut launcher = testbed()
+        .args(["run", "--duration", "3", "--runs-dir"])
+        .arg(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let nodes = wait_for_nodes(launcher.id());
+    let (_, pid, prefix) = nodes.iter().find(|n| n.0 == "controller").unwrap().clone();
+    // Running: the log grows past what it holds before START (its first
+    // chunk of messages). Watchdog: 60 s.
+    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    let size = || {
+        std::fs::read_dir(dir.path())
+            .unwrap()
+            .flatten()
+            .map(|e| e.path().join("run.mcap"))
+            .filter_map(|p| std::fs::metadata(p).ok())
+            .map(|m| m.len())
+            .max()
+    };
+    while size().is_none_or(|n| n < 64 * 1024) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the run did not start"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    kill(Pid::from_raw(pid as i32), Signal::SIGSTOP).unwrap();
+    let status = wait_bounded(&mut launcher, 60);
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(!status.success());
+    assert!(
+        err.contains("the controller node did not finish within 5 s"),
+        "{err}"
+    );
+    assert!(nodes_of(launcher.id()).is_empty(), "nodes left running");
+    assert_eq!(shm_files(&prefix), Vec::<String>::new());
+    let log = newest_log(dir.path());
+    let s = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
+    assert_eq!(s["run_end"], "lost the controller", "{s}");
+}

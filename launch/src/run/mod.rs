@@ -37,6 +37,9 @@ const START_TIMEOUT: Duration = Duration::from_secs(30);
 const EXTERNAL_START_TIMEOUT: Duration = Duration::from_secs(300);
 /// A run whose row count does not move for this long is declared stuck.
 const STALL_TIMEOUT: Duration = Duration::from_secs(20);
+/// Once the plant has made its last step, the other producers must finish
+/// within this: one that does not is stopped, spinning or deadlocked.
+const FINISH_TIMEOUT: Duration = Duration::from_secs(5);
 /// Grace period between STOP, SIGTERM and SIGKILL.
 const STOP_GRACE: Duration = Duration::from_secs(2);
 /// How often the launcher wakes to drain topics and check its children.
@@ -124,6 +127,17 @@ pub enum RunError {
         /// The limit.
         secs: u64,
     },
+    /// Nodes that did not finish after the plant's last step.
+    #[error(
+        "the {} node did not finish within {secs} s of the plant's last step: it is stopped, \
+         spinning or deadlocked", .nodes.join(" and the ")
+    )]
+    NotFinished {
+        /// The nodes.
+        nodes: Vec<&'static str>,
+        /// The limit.
+        secs: u64,
+    },
     /// Ctrl-C or SIGTERM.
     #[error("interrupted; all nodes stopped")]
     Interrupted,
@@ -203,6 +217,10 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         Err(RunError::NodeFailed { node, .. }) => NodeKind::ALL
             .into_iter()
             .find(|k| k.name() == *node)
+            .map_or(RunEnd::Failed, RunEnd::LostNode),
+        Err(RunError::NotFinished { nodes, .. }) => NodeKind::ALL
+            .into_iter()
+            .find(|k| nodes.first() == Some(&k.name()))
             .map_or(RunEnd::Failed, RunEnd::LostNode),
         Err(_) => RunEnd::Failed,
     };
@@ -404,6 +422,18 @@ fn supervise(
         nodes.read(status)?;
         if nodes.done.contains(&NodeKind::Plant) && wall.is_none() {
             wall = Some(started.elapsed().as_secs_f64());
+        }
+        if let Some(w) = wall
+            && started.elapsed().as_secs_f64() - w > FINISH_TIMEOUT.as_secs_f64()
+        {
+            return Err(RunError::NotFinished {
+                nodes: PRODUCERS
+                    .iter()
+                    .filter(|k| !nodes.done.contains(k))
+                    .map(|k| k.name())
+                    .collect(),
+                secs: FINISH_TIMEOUT.as_secs(),
+            });
         }
         check_children(children)?;
         if let Some(b) = &bar {
