@@ -533,3 +533,44 @@ fn a_stopped_controller_in_a_realtime_run_is_named() {
     let s = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
     assert_eq!(s["run_end"], "lost the controller", "{s}");
 }
+
+/// A logger stopped (SIGSTOP) during a real-time run is blamed for what it
+/// is, not as "killed by signal 9" by the launcher's own kill (#18 row 11).
+#[test]
+fn a_stopped_logger_in_a_realtime_run_is_blamed_correctly() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut launcher = testbed()
+        .args(["run", "--duration", "2", "--runs-dir"])
+        .arg(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let nodes = wait_for_nodes(launcher.id());
+    let (_, pid, _) = nodes.iter().find(|n| n.0 == "logger").unwrap().clone();
+    // Running: the log has its first chunk of messages. Watchdog: 60 s.
+    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    while std::fs::read_dir(dir.path())
+        .unwrap()
+        .flatten()
+        .filter_map(|e| std::fs::metadata(e.path().join("run.mcap")).ok())
+        .all(|m| m.len() < 64 * 1024)
+    {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the run did not start"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    kill(Pid::from_raw(pid as i32), Signal::SIGSTOP).unwrap();
+    let status = wait_bounded(&mut launcher, 60);
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(!status.success());
+    assert!(
+        err.contains("the logger node did not finish its log within 2 s of STOP (stopped or hung)"),
+        "{err}"
+    );
+    assert!(!err.contains("killed by signal 9"), "{err}");
+    assert!(nodes_of(launcher.id()).is_empty(), "nodes left running");
+}

@@ -227,7 +227,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let mut stop = control_msg(CONTROL_STOP, 0);
     stop.code = end.code();
     let _ = control.send(stop);
-    children.stop(STOP_GRACE);
+    let forced = children.stop(STOP_GRACE);
     let logger_exit = children.exit_of(NodeKind::Logger);
     // Close every port of this process, then remove what is left of the
     // run's domain (including what a killed node left behind).
@@ -235,9 +235,18 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let _ = prefix.remove_domain_if_unused();
     let wall_time_s = result?;
     if let Some((status, stderr)) = logger_exit.filter(|(s, _)| !s.success()) {
+        // Killed by the launcher itself after STOP: say so, not "signal 9".
+        let how = match forced.iter().rev().find(|(k, _)| *k == NodeKind::Logger) {
+            Some((_, sig)) => format!(
+                "did not finish its log within {} s of STOP (stopped or hung), so the launcher \
+                 sent it {sig}",
+                STOP_GRACE.as_secs()
+            ),
+            None => describe(status),
+        };
         return Err(RunError::NodeFailed {
             node: NodeKind::Logger.name(),
-            how: describe(status),
+            how,
             stderr,
         });
     }
