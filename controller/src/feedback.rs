@@ -5,8 +5,8 @@
 use arm_model::ArmModel;
 use arm_model::dynamics::Dynamics;
 
-use crate::law::{check_input, publish_fault};
-use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Fault, LawName};
+use crate::law::{begin_plain_step, end_plain_step};
+use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, LawName};
 
 /// `pd`, `pd-gravity` or `ctc` for n joints.
 #[derive(Debug, Clone)]
@@ -54,16 +54,9 @@ impl Feedback {
 
     /// One step: τ into `out.tau` and the errors into `out`.
     pub fn step(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
-        out.t = input.t;
-        out.fault = None;
-        out.barrier_breached = false;
-        if let Some(fault) = check_input(input, self.n) {
-            publish_fault(out, fault);
+        if !begin_plain_step(input, self.n, out) {
             return;
         }
-        // No shift: these laws see the constraint as on (γ = 1) and ignore it.
-        out.gamma = 1.0;
-        out.gamma_dot = 0.0;
         for i in 0..self.n {
             let e = input.q[i] - input.q_d[i];
             let ed = input.qd[i] - input.qd_d[i];
@@ -84,10 +77,7 @@ impl Feedback {
             }
         }
         self.model_terms(input, out);
-        (out.j_hat, out.delta, out.r, out.wc_norm) = (0.0, 0.0, 0.0, 0.0);
-        if out.tau.iter().any(|x| !x.is_finite()) {
-            publish_fault(out, Fault::NonFiniteOutput);
-        }
+        end_plain_step(out);
     }
 
     /// τ from the feedback and the model: G(q) for `pd-gravity`; for `ctc`

@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used)]
 
 use super::*;
+use crate::Fault;
 use arm_model::TWO_LINK_URDF;
 
 const Q: [f64; 2] = [0.5, -0.5];

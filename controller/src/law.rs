@@ -354,6 +354,34 @@ impl Controller {
     }
 }
 
+/// The start of a step of a law with no shift and no networks (the
+/// baselines): resets the flags and checks the input (false: a fault was
+/// published, stop here); γ = 1, γ̇ = 0, as the constraint is simply on.
+pub(crate) fn begin_plain_step(
+    input: &ControllerInput<'_>,
+    n: usize,
+    out: &mut Diagnostics,
+) -> bool {
+    out.t = input.t;
+    out.fault = None;
+    out.barrier_breached = false;
+    if let Some(fault) = check_input(input, n) {
+        publish_fault(out, fault);
+        return false;
+    }
+    out.gamma = 1.0;
+    out.gamma_dot = 0.0;
+    true
+}
+
+/// The end of such a step: no critic, and a non-finite torque becomes a fault.
+pub(crate) fn end_plain_step(out: &mut Diagnostics) {
+    (out.j_hat, out.delta, out.r, out.wc_norm) = (0.0, 0.0, 0.0, 0.0);
+    if out.tau.iter().any(|x| !x.is_finite()) {
+        publish_fault(out, Fault::NonFiniteOutput);
+    }
+}
+
 /// A step that publishes zero torque because of `fault` (SPEC §10).
 pub(crate) fn publish_fault(out: &mut Diagnostics, fault: Fault) {
     out.fault = Some(fault);

@@ -3,8 +3,8 @@
 //! the run's envelope k_c by about T_c, so that it competes with the
 //! deferred constraint on the same task.
 
-use crate::law::{check_input, publish_fault};
-use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Fault};
+use crate::law::{begin_plain_step, end_plain_step};
+use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics};
 
 /// ξ is clamped to ±(1 − this) where the law is undefined (|ξ| ≥ 1).
 pub const XI_LIMIT: f64 = 1e-6;
@@ -38,15 +38,9 @@ impl Ppc {
     /// One step. The position funnel ρ1 goes in `out.kc`, ρ1² − e² in
     /// `out.d`, and a clamped ξ sets `out.barrier_breached` (a funnel breach).
     pub fn step(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
-        out.t = input.t;
-        out.fault = None;
-        out.barrier_breached = false;
-        if let Some(fault) = check_input(input, self.n) {
-            publish_fault(out, fault);
+        if !begin_plain_step(input, self.n, out) {
             return;
         }
-        out.gamma = 1.0;
-        out.gamma_dot = 0.0;
         let (t0, rho1_0, rho2_0) = self.start.get_or_insert_with(|| {
             let rho1_0: Vec<f64> = (0..input.q.len())
                 .map(|i| (input.q[i] - input.q_d[i]).abs() + input.kc[i])
@@ -82,10 +76,7 @@ impl Ppc {
             out.wa_norm[i] = 0.0;
         }
         out.barrier_breached = breached;
-        (out.j_hat, out.delta, out.r, out.wc_norm) = (0.0, 0.0, 0.0, 0.0);
-        if out.tau.iter().any(|x| !x.is_finite()) {
-            publish_fault(out, Fault::NonFiniteOutput);
-        }
+        end_plain_step(out);
     }
 }
 

@@ -9,7 +9,7 @@ use plotters::style::FontStyle;
 use scenario::Plan;
 
 use crate::compare::{Comparison, LawRow};
-use crate::plots::{COLORS, FAMILY, FONT, Line, Panel, PlotError, RED, err, save};
+use crate::plots::{COLORS, FAMILY, FONT, Line, Panel, PlotError, RED, category, err, save};
 
 /// Writes `compare_errors` and `compare_bars` (PNG and SVG) into `dir`;
 /// returns how many figures.
@@ -145,14 +145,7 @@ fn bar_panel<DB: DrawingBackend>(
         .configure_mesh()
         .disable_x_mesh()
         .x_labels(n)
-        .x_label_formatter(&|x| {
-            let i = x.round();
-            if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
-                names[i as usize].clone()
-            } else {
-                String::new()
-            }
-        })
+        .x_label_formatter(&|x| category(&names, *x))
         .label_style((FAMILY, 12))
         .draw()
         .map_err(err)?;

@@ -499,25 +499,7 @@ fn a_stopped_controller_in_a_realtime_run_is_named() {
         .unwrap();
     let nodes = wait_for_nodes(launcher.id());
     let (_, pid, prefix) = nodes.iter().find(|n| n.0 == "controller").unwrap().clone();
-    // Running: the log grows past what it holds before START (its first
-    // chunk of messages). Watchdog: 60 s.
-    let deadline = std::time::Instant::now() + Duration::from_secs(60);
-    let size = || {
-        std::fs::read_dir(dir.path())
-            .unwrap()
-            .flatten()
-            .map(|e| e.path().join("run.mcap"))
-            .filter_map(|p| std::fs::metadata(p).ok())
-            .map(|m| m.len())
-            .max()
-    };
-    while size().is_none_or(|n| n < 64 * 1024) {
-        assert!(
-            std::time::Instant::now() < deadline,
-            "the run did not start"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    wait_until_running(dir.path());
     kill(Pid::from_raw(pid as i32), Signal::SIGSTOP).unwrap();
     let status = wait_bounded(&mut launcher, 60);
     let mut err = String::new();
@@ -548,20 +530,7 @@ fn a_stopped_logger_in_a_realtime_run_is_blamed_correctly() {
         .unwrap();
     let nodes = wait_for_nodes(launcher.id());
     let (_, pid, _) = nodes.iter().find(|n| n.0 == "logger").unwrap().clone();
-    // Running: the log has its first chunk of messages. Watchdog: 60 s.
-    let deadline = std::time::Instant::now() + Duration::from_secs(60);
-    while std::fs::read_dir(dir.path())
-        .unwrap()
-        .flatten()
-        .filter_map(|e| std::fs::metadata(e.path().join("run.mcap")).ok())
-        .all(|m| m.len() < 64 * 1024)
-    {
-        assert!(
-            std::time::Instant::now() < deadline,
-            "the run did not start"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    wait_until_running(dir.path());
     kill(Pid::from_raw(pid as i32), Signal::SIGSTOP).unwrap();
     let status = wait_bounded(&mut launcher, 60);
     let mut err = String::new();
@@ -573,4 +542,25 @@ fn a_stopped_logger_in_a_realtime_run_is_blamed_correctly() {
     );
     assert!(!err.contains("killed by signal 9"), "{err}");
     assert!(nodes_of(launcher.id()).is_empty(), "nodes left running");
+}
+
+/// Waits (watchdog: 60 s) until a run under `runs` is under way: its log
+/// has grown past what it holds before START (its first chunk of messages).
+fn wait_until_running(runs: &std::path::Path) {
+    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    let size = || {
+        std::fs::read_dir(runs)
+            .unwrap()
+            .flatten()
+            .filter_map(|e| std::fs::metadata(e.path().join("run.mcap")).ok())
+            .map(|m| m.len())
+            .max()
+    };
+    while size().is_none_or(|n| n < 64 * 1024) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the run did not start"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
 }

@@ -1,8 +1,11 @@
 //! `testbed run`: the launcher. It turns a validated plan into running
 //! processes, starts them together, watches them, and stops them in order.
 
+mod error;
 pub mod spawn;
 pub mod timing;
+
+pub use error::RunError;
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -15,7 +18,7 @@ use wire::{
     NODE_READY, NodeKind, NodeStatus, RunEnd, RunPrefix, Topic, WireError, monotonic_ns,
 };
 
-use crate::analysis::{AnalyseOptions, AnalysisError, LogAnalysis, analyse};
+use crate::analysis::{AnalyseOptions, LogAnalysis, analyse};
 use crate::mode::Mode;
 use spawn::{Children, describe};
 
@@ -82,76 +85,6 @@ pub struct RunOutcome {
     pub peak_rss_kb: Vec<(NodeKind, u64)>,
 }
 
-/// Why a run failed.
-#[derive(Debug, thiserror::Error)]
-pub enum RunError {
-    /// The bus failed.
-    #[error(transparent)]
-    Wire(#[from] WireError),
-    /// A file could not be written.
-    #[error("{0}: {1}")]
-    Output(String, std::io::Error),
-    /// A node could not be started.
-    #[error("cannot start the {node} node: {cause}")]
-    Spawn {
-        /// Which node.
-        node: &'static str,
-        /// The cause.
-        cause: std::io::Error,
-    },
-    /// A node died or exited before the run was over.
-    #[error("the {node} node {how}{}", if .stderr.is_empty() { String::new() } else { format!("; its last words:\n{}", .stderr) })]
-    NodeFailed {
-        /// Which node.
-        node: &'static str,
-        /// How it ended.
-        how: String,
-        /// The last lines it wrote to stderr.
-        stderr: String,
-    },
-    /// Nodes did not connect in time.
-    #[error("nodes did not report ready within {secs} s: {}", .missing.join(", "))]
-    StartTimeout {
-        /// The nodes that did not connect.
-        missing: Vec<&'static str>,
-        /// The limit.
-        secs: u64,
-    },
-    /// No progress for too long.
-    #[error("the run stalled at step {step} of {steps} (nothing for {secs} s)")]
-    Stalled {
-        /// Rows done.
-        step: u64,
-        /// Rows expected.
-        steps: u64,
-        /// The limit.
-        secs: u64,
-    },
-    /// Nodes that did not finish after the plant's last step.
-    #[error(
-        "the {} node did not finish within {secs} s of the plant's last step: it is stopped, \
-         spinning or deadlocked", .nodes.join(" and the ")
-    )]
-    NotFinished {
-        /// The nodes.
-        nodes: Vec<&'static str>,
-        /// The limit.
-        secs: u64,
-    },
-    /// Ctrl-C or SIGTERM.
-    #[error("interrupted; all nodes stopped")]
-    Interrupted,
-    /// The log could not be analysed.
-    #[error(transparent)]
-    Analysis(#[from] AnalysisError),
-    /// The arm has more joints than the wire carries.
-    #[error("the robot has {dof} actuated joints; the wire carries at most {MAX_DOF}")]
-    TooManyJoints {
-        /// Joints of the arm.
-        dof: usize,
-    },
-}
-
 /// A fresh folder name for a run: UTC-free, sortable, unique on this machine.
 fn run_id() -> String {
     let secs = std::time::SystemTime::now()
@@ -211,19 +144,9 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let peak_rss_kb = children.peak_rss_kb();
     // Whatever happened: STOP (the logger then finishes the file), grace,
     // SIGTERM, SIGKILL, reap.
-    let end = match &result {
-        Ok(_) => RunEnd::Finished,
-        Err(RunError::Interrupted) => RunEnd::Interrupted,
-        Err(RunError::NodeFailed { node, .. }) => NodeKind::ALL
-            .into_iter()
-            .find(|k| k.name() == *node)
-            .map_or(RunEnd::Failed, RunEnd::LostNode),
-        Err(RunError::NotFinished { nodes, .. }) => NodeKind::ALL
-            .into_iter()
-            .find(|k| nodes.first() == Some(&k.name()))
-            .map_or(RunEnd::Failed, RunEnd::LostNode),
-        Err(_) => RunEnd::Failed,
-    };
+    let end = result
+        .as_ref()
+        .map_or_else(RunError::run_end, |_| RunEnd::Finished);
     let mut stop = control_msg(CONTROL_STOP, 0);
     stop.code = end.code();
     let _ = control.send(stop);

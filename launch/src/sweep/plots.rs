@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 
 use super::report::{CellReport, SweepReport, quantile};
-use crate::plots::{COLORS, FAMILY, FONT, PlotError, err};
+use crate::plots::{COLORS, FAMILY, FONT, PlotError, category, err};
 
 /// The metrics drawn as box plots.
 const BOXED: [(&str, &str); 2] = [
@@ -103,14 +103,7 @@ fn box_panel<DB: DrawingBackend>(
         .configure_mesh()
         .disable_x_mesh()
         .x_labels(n.min(24))
-        .x_label_formatter(&|x| {
-            let i = x.round();
-            if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
-                names[i as usize].clone()
-            } else {
-                String::new()
-            }
-        })
+        .x_label_formatter(&|x| category(&names, *x))
         .label_style((FAMILY, 11))
         .draw()
         .map_err(err)?;

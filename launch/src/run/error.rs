@@ -1,0 +1,93 @@
+//! Why a run failed, and how the log records each failure.
+
+use wire::{MAX_DOF, NodeKind, RunEnd, WireError};
+
+use crate::analysis::AnalysisError;
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The bus failed.
+    #[error(transparent)]
+    Wire(#[from] WireError),
+    /// A file could not be written.
+    #[error("{0}: {1}")]
+    Output(String, std::io::Error),
+    /// A node could not be started.
+    #[error("cannot start the {node} node: {cause}")]
+    Spawn {
+        /// Which node.
+        node: &'static str,
+        /// The cause.
+        cause: std::io::Error,
+    },
+    /// A node died or exited before the run was over.
+    #[error("the {node} node {how}{}", if .stderr.is_empty() { String::new() } else { format!("; its last words:\n{}", .stderr) })]
+    NodeFailed {
+        /// Which node.
+        node: &'static str,
+        /// How it ended.
+        how: String,
+        /// The last lines it wrote to stderr.
+        stderr: String,
+    },
+    /// Nodes did not connect in time.
+    #[error("nodes did not report ready within {secs} s: {}", .missing.join(", "))]
+    StartTimeout {
+        /// The nodes that did not connect.
+        missing: Vec<&'static str>,
+        /// The limit.
+        secs: u64,
+    },
+    /// No progress for too long.
+    #[error("the run stalled at step {step} of {steps} (nothing for {secs} s)")]
+    Stalled {
+        /// Rows done.
+        step: u64,
+        /// Rows expected.
+        steps: u64,
+        /// The limit.
+        secs: u64,
+    },
+    /// Nodes that did not finish after the plant's last step.
+    #[error(
+        "the {} node did not finish within {secs} s of the plant's last step: it is stopped, \
+         spinning or deadlocked", .nodes.join(" and the ")
+    )]
+    NotFinished {
+        /// The nodes.
+        nodes: Vec<&'static str>,
+        /// The limit.
+        secs: u64,
+    },
+    /// Ctrl-C or SIGTERM.
+    #[error("interrupted; all nodes stopped")]
+    Interrupted,
+    /// The log could not be analysed.
+    #[error(transparent)]
+    Analysis(#[from] AnalysisError),
+    /// The arm has more joints than the wire carries.
+    #[error("the robot has {dof} actuated joints; the wire carries at most {MAX_DOF}")]
+    TooManyJoints {
+        /// Joints of the arm.
+        dof: usize,
+    },
+}
+
+impl RunError {
+    /// How the run ended, for STOP and the log: the node it lost if one is to blame.
+    pub fn run_end(&self) -> RunEnd {
+        let lost = |name: Option<&&str>| {
+            NodeKind::ALL
+                .into_iter()
+                .find(|k| name == Some(&k.name()))
+                .map_or(RunEnd::Failed, RunEnd::LostNode)
+        };
+        match self {
+            RunError::Interrupted => RunEnd::Interrupted,
+            RunError::NodeFailed { node, .. } => lost(Some(node)),
+            RunError::NotFinished { nodes, .. } => lost(nodes.first()),
+            _ => RunEnd::Failed,
+        }
+    }
+}
