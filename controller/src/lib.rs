@@ -106,6 +106,26 @@ pub enum Fault {
 }
 
 impl Fault {
+    /// Every fault.
+    pub const ALL: [Fault; 5] = [
+        Fault::NonFiniteInput,
+        Fault::WrongLength,
+        Fault::EnvelopeNotPositive,
+        Fault::NonFiniteOutput,
+        Fault::NoReference,
+    ];
+
+    /// The name other languages' bindings give it (`NON_FINITE_INPUT`).
+    pub fn constant_name(self) -> &'static str {
+        match self {
+            Fault::NonFiniteInput => "NON_FINITE_INPUT",
+            Fault::WrongLength => "WRONG_LENGTH",
+            Fault::EnvelopeNotPositive => "ENVELOPE_NOT_POSITIVE",
+            Fault::NonFiniteOutput => "NON_FINITE_OUTPUT",
+            Fault::NoReference => "NO_REFERENCE",
+        }
+    }
+
     /// A stable numeric code for the wire and logs (0 means no fault).
     pub fn code(self) -> u32 {
         match self {

@@ -270,6 +270,7 @@ fn stack(plan: &Plan, mode: Mode, opts: &BenchOptions) -> Result<run::RunOutcome
         progress: false,
         realtime_setup: opts.realtime_setup,
         verbose: false,
+        controller_cmd: None,
     })?)
 }
 

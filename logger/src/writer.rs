@@ -58,6 +58,10 @@ pub struct RunMetadata {
     pub model_based: bool,
     /// The law's parameters as `key=value` pairs.
     pub law_parameters: String,
+    /// The user's command that ran as the controller node (`testbed run
+    /// --controller-cmd`); empty for the testbed's own controller.
+    #[serde(default)]
+    pub controller_cmd: String,
 }
 
 impl RunMetadata {
@@ -80,6 +84,7 @@ impl RunMetadata {
             ("law".into(), self.law.clone()),
             ("model_based".into(), self.model_based.to_string()),
             ("law_parameters".into(), self.law_parameters.clone()),
+            ("controller_cmd".into(), self.controller_cmd.clone()),
             (
                 "start_time_unix_ns".into(),
                 self.start_time_unix_ns.to_string(),

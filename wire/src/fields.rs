@@ -45,12 +45,15 @@ pub trait MessageFields: Sized + Copy + Default {
 }
 
 /// Defines a wire message (`#[repr(C)]`, `Copy`, zero-copy) and its field
-/// list in one place. Each field names its kind: `U32`, `U64`, `I64`,
+/// list in one place: the log's codec ([`MessageFields`]) and its memory
+/// layout for other languages ([`crate::WireLayout`]) come from it. Doc
+/// comments come first, then `#[type_name("…")]`. Each field names its kind: `U32`, `U64`, `I64`,
 /// `F64`, `J` (per-joint, trimmed to `dof`) or `Pad` (layout only).
 #[macro_export]
 macro_rules! data_message {
     (
-        $(#[$meta:meta])*
+        $(#[doc = $doc:literal])*
+        #[type_name($type_name:literal)]
         pub struct $name:ident {
             $(#[$hmeta:meta])* header: Header,
             $( $(#[$fmeta:meta])* $field:ident : $ty:ty => $kind:ident ),* $(,)?
@@ -58,11 +61,28 @@ macro_rules! data_message {
     ) => {
         #[repr(C)]
         #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-        $(#[$meta])*
+        $(#[doc = $doc])*
+        #[type_name($type_name)]
         pub struct $name {
             $(#[$hmeta])*
             pub header: $crate::Header,
             $( $(#[$fmeta])* pub $field: $ty, )*
+        }
+
+        impl $crate::WireLayout for $name {
+            const TYPE_NAME: &'static str = $type_name;
+            fn fields() -> Vec<$crate::FieldLayout> {
+                vec![
+                    $crate::FieldLayout::of::<$crate::Header>(
+                        "header",
+                        ::core::mem::offset_of!($name, header),
+                    ),
+                    $( $crate::FieldLayout::of::<$ty>(
+                        stringify!($field),
+                        ::core::mem::offset_of!($name, $field),
+                    ), )*
+                ]
+            }
         }
 
         impl $crate::MessageFields for $name {

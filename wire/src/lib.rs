@@ -23,13 +23,15 @@
 //! which the launcher hands each node its part of the plan
 //! ([`write_config`], [`read_config`]), each data message's field list
 //! ([`data_message!`], [`MessageFields`]) from which the log's codec is made,
-//! and absolute-deadline sleeping ([`clock`]).
+//! each type's memory layout ([`all_layouts`]) from which other languages'
+//! bindings are generated, and absolute-deadline sleeping ([`clock`]).
 
 pub mod clock;
 mod config;
 mod domain;
 mod fields;
 mod files;
+mod layout;
 mod messages;
 mod node;
 mod reference;
@@ -38,13 +40,16 @@ mod topics;
 pub use config::{ConfigError, read_config, write_config};
 pub use domain::DomainNodes;
 pub use fields::{FieldRef, FieldSource, MessageFields};
+pub use layout::{
+    FieldLayout, FieldType, TypeLayout, WireField, WireLayout, all_layouts, field_size,
+};
 pub use files::{MAX_TEXT_FILE_BYTES, MAX_URDF_BYTES, read_regular_file, read_text_file};
 pub use iceoryx2::prelude::ZeroCopySend;
 pub use messages::*;
 pub use node::{Mode, NodeError, NodeLink, ns_to_s};
 pub use reference::ReferenceWindow;
 pub use topics::{
-    Bus, Delivery, RunPrefix, SUBSCRIBER_BUFFER, Topic, TopicPublisher, TopicSubscriber, WireError,
+    Bus, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix, SUBSCRIBER_BUFFER, Topic, TopicPublisher, TopicSubscriber, WireError,
     monotonic_ns,
 };
 

@@ -252,20 +252,20 @@ impl RunEnd {
     }
 }
 
-/// From the launcher to every node.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("testbed.Control.v2")]
-pub struct Control {
-    /// seq counts control messages.
-    pub header: Header,
-    /// [`CONTROL_START`] or [`CONTROL_STOP`].
-    pub command: u32,
-    /// With START: the run's mode ([`crate::Mode::code`]), which every node
-    /// checks against its own; with STOP: how the run ended ([`RunEnd::code`]).
-    pub code: u32,
-    /// CLOCK_MONOTONIC time of step 0, ns (with START).
-    pub epoch_wall_ns: u64,
+crate::data_message! {
+    /// From the launcher to every node.
+    #[type_name("testbed.Control.v2")]
+    pub struct Control {
+        /// seq counts control messages.
+        header: Header,
+        /// [`CONTROL_START`] or [`CONTROL_STOP`].
+        command: u32 => U32,
+        /// With START: the run's mode ([`crate::Mode::code`]), which every node
+        /// checks against its own; with STOP: how the run ended ([`RunEnd::code`]).
+        code: u32 => U32,
+        /// CLOCK_MONOTONIC time of step 0, ns (with START).
+        epoch_wall_ns: u64 => U64,
+    }
 }
 
 /// Which process a [`NodeStatus`] is from.
@@ -316,21 +316,21 @@ pub const NODE_DONE: u32 = 3;
 /// [`NodeStatus::state`]: failed; `code` says why.
 pub const NODE_FAILED: u32 = 4;
 
-/// From every node to the launcher.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
-#[type_name("testbed.NodeStatus.v1")]
-pub struct NodeStatus {
-    /// seq counts this node's status messages.
-    pub header: Header,
-    /// [`NodeKind`] as u32.
-    pub node: u32,
-    /// NODE_READY, NODE_RUNNING, NODE_DONE or NODE_FAILED.
-    pub state: u32,
-    /// The node's process id.
-    pub pid: u32,
-    /// Padding.
-    pub reserved: u32,
-    /// Steps the node has handled.
-    pub step: u64,
+crate::data_message! {
+    /// From every node to the launcher.
+    #[type_name("testbed.NodeStatus.v1")]
+    pub struct NodeStatus {
+        /// seq counts this node's status messages.
+        header: Header,
+        /// [`NodeKind`] as u32.
+        node: u32 => U32,
+        /// NODE_READY, NODE_RUNNING, NODE_DONE or NODE_FAILED.
+        state: u32 => U32,
+        /// The node's process id.
+        pid: u32 => U32,
+        /// Padding.
+        reserved: u32 => Pad,
+        /// Steps the node has handled.
+        step: u64 => U64,
+    }
 }

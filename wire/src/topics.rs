@@ -32,6 +32,17 @@ pub enum Topic {
 }
 
 impl Topic {
+    /// Every topic.
+    pub const ALL: [Topic; 7] = [
+        Topic::JointState,
+        Topic::Reference,
+        Topic::Command,
+        Topic::Diagnostics,
+        Topic::Timing,
+        Topic::Control,
+        Topic::Status,
+    ];
+
     /// Service name (under the run prefix).
     pub fn name(self) -> &'static str {
         match self {
@@ -56,11 +67,16 @@ impl Topic {
     }
 
     /// Status has one publisher per node; every other topic has one owner.
-    fn max_publishers(self) -> usize {
+    pub fn max_publishers(self) -> usize {
         match self {
             Topic::Status => 8,
             _ => 1,
         }
+    }
+
+    /// Notifiers the paired event service allows.
+    pub fn max_notifiers(self) -> usize {
+        self.max_publishers().max(2)
     }
 }
 
@@ -70,11 +86,11 @@ impl Topic {
 pub const SUBSCRIBER_BUFFER: usize = 2048;
 /// Subscribers per topic: the process that uses it, the logger, the
 /// launcher, and one spare for a debugging tool.
-const MAX_SUBSCRIBERS: usize = 4;
+pub const MAX_SUBSCRIBERS: usize = 4;
 /// Nodes that may open one service: four processes, the launcher, spares.
-const MAX_NODES: usize = 10;
+pub const MAX_NODES: usize = 10;
 /// How long a lossless publisher waits for a full subscriber before giving up.
-const LOSSLESS_TIMEOUT: Duration = Duration::from_secs(10);
+pub const LOSSLESS_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// What a publisher does when a subscriber's buffer is full.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -272,7 +288,7 @@ impl Bus {
         self.node
             .service_builder(&name)
             .event()
-            .max_notifiers(topic.max_publishers().max(2))
+            .max_notifiers(topic.max_notifiers())
             .max_listeners(MAX_SUBSCRIBERS)
             .max_nodes(MAX_NODES)
             .open_or_create()

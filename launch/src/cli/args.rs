@@ -59,6 +59,22 @@ pub(crate) struct RunArgs {
     /// time no SCHED_FIFO and no locked memory.
     #[arg(long)]
     pub(crate) no_realtime_setup: bool,
+    /// Run this command as the controller node instead of the testbed's
+    /// (for example "python3 my_controller.py"; see python/). The launcher
+    /// appends the node arguments and supervises it like any node.
+    #[arg(long, value_name = "CMD", conflicts_with = "external")]
+    pub(crate) controller_cmd: Option<String>,
+}
+
+/// The words of a `--controller-cmd`, split as a POSIX shell would
+/// (quotes kept together), with no shell in between.
+pub(crate) fn command_words(cmd: &str) -> anyhow::Result<Vec<String>> {
+    let words = shell_words::split(cmd)
+        .map_err(|e| anyhow::anyhow!("--controller-cmd {cmd:?} cannot be split into words: {e}"))?;
+    if words.is_empty() {
+        anyhow::bail!("--controller-cmd is empty: give the program to run");
+    }
+    Ok(words)
 }
 
 #[derive(Debug, Args)]

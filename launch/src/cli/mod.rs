@@ -62,6 +62,16 @@ enum Command {
     Sweep(sweep::SweepCommand),
     /// List the shipped scenarios and what each one demonstrates.
     Scenarios,
+    /// Write the wire contract for another language, generated from the
+    /// Rust types (today: Python ctypes structures for the package in python/).
+    Bindings {
+        /// The language.
+        #[arg(value_enum)]
+        lang: BindingsLang,
+        /// Write here instead of to standard output.
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
     /// Run one node of a stack (the launcher starts these; start one by hand
     /// with `testbed run --external <node>` to debug or replace it).
     Node {
@@ -71,6 +81,11 @@ enum Command {
         #[command(flatten)]
         args: NodeArgs,
     },
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum BindingsLang {
+    Python,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -106,6 +121,16 @@ pub fn run() -> Result<ExitCode> {
         Command::Bench(args) => bench::bench(args),
         Command::Compare(args) => compare::compare(args),
         Command::Sweep(cmd) => sweep::sweep(cmd),
+        Command::Bindings { lang, out } => {
+            let BindingsLang::Python = lang;
+            let text = launch::bindings::python();
+            match out {
+                Some(path) => std::fs::write(&path, text)
+                    .with_context(|| format!("writing {}", path.display()))?,
+                None => print!("{text}"),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Scenarios => {
             print!("{}", scenarios::scenario_list());
             Ok(ExitCode::SUCCESS)

@@ -22,6 +22,11 @@ pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
         progress: std::io::stderr().is_terminal(),
         realtime_setup: !args.no_realtime_setup,
         verbose,
+        controller_cmd: args
+            .controller_cmd
+            .as_deref()
+            .map(super::args::command_words)
+            .transpose()?,
     };
     let outcome = match run::run(opts) {
         Ok(o) => o,

@@ -58,11 +58,20 @@ pub fn trajectory(plan: &Plan) -> TrajectoryNodeConfig {
     }
 }
 
-/// The logger's part: where to write and what the log says about the run.
-pub fn logger(plan: &Plan, mode: Mode, out: &Path, toml: &str) -> LoggerNodeConfig {
+/// The logger's part: where to write and what the log says about the run
+/// (`controller_cmd`: the user's command that replaces the controller node).
+pub fn logger(
+    plan: &Plan,
+    mode: Mode,
+    out: &Path,
+    toml: &str,
+    controller_cmd: Option<&str>,
+) -> LoggerNodeConfig {
+    let mut metadata = metadata(plan, mode, out, toml);
+    metadata.controller_cmd = controller_cmd.unwrap_or_default().to_string();
     LoggerNodeConfig {
         out: out.to_path_buf(),
-        metadata: metadata(plan, mode, out, toml),
+        metadata,
         urdf: plan.robot.urdf.clone(),
     }
 }
@@ -103,6 +112,7 @@ pub fn metadata(plan: &Plan, mode: Mode, out: &Path, toml: &str) -> RunMetadata 
         mimic_joints: mimic,
         urdf_dynamics: plan.scenario.plant.urdf_dynamics,
         start_time_unix_ns: 0,
+        controller_cmd: String::new(),
     }
 }
 
@@ -140,6 +150,7 @@ pub fn write_all(
     mode: Mode,
     log: &Path,
     toml: &str,
+    controller_cmd: Option<&str>,
 ) -> Result<Vec<(NodeKind, PathBuf)>, ConfigError> {
     std::fs::create_dir_all(dir).map_err(|cause| ConfigError::Io {
         path: dir.display().to_string(),
@@ -152,7 +163,7 @@ pub fn write_all(
             NodeKind::Plant => write_config(&path, &plant(plan))?,
             NodeKind::Controller => write_config(&path, &controller(plan))?,
             NodeKind::Trajectory => write_config(&path, &trajectory(plan))?,
-            NodeKind::Logger => write_config(&path, &logger(plan, mode, log, toml))?,
+            NodeKind::Logger => write_config(&path, &logger(plan, mode, log, toml, controller_cmd))?,
         }
         out.push((kind, path));
     }

@@ -68,6 +68,9 @@ pub struct RunOptions {
     pub realtime_setup: bool,
     /// Let the nodes print iceoryx2's own messages.
     pub verbose: bool,
+    /// Run this command (program and arguments) as the controller node
+    /// instead of `testbed node controller`; the node arguments are appended.
+    pub controller_cmd: Option<Vec<String>>,
 }
 
 /// What a finished run produced.
@@ -210,11 +213,16 @@ impl RunFiles {
         })?;
         std::fs::write(&scenario_file, &toml).map_err(out(&scenario_file))?;
         let log = run_dir.join("run.mcap");
-        let configs =
-            crate::node::configs::write_all(&run_dir.join("nodes"), plan, opts.mode, &log, &toml)
-                .map_err(|e| {
-                RunError::Output(run_dir.display().to_string(), std::io::Error::other(e))
-            })?;
+        let command = opts.controller_cmd.as_ref().map(|c| shell_words::join(c));
+        let configs = crate::node::configs::write_all(
+            &run_dir.join("nodes"),
+            plan,
+            opts.mode,
+            &log,
+            &toml,
+            command.as_deref(),
+        )
+        .map_err(|e| RunError::Output(run_dir.display().to_string(), std::io::Error::other(e)))?;
         Ok(Self {
             run_dir,
             log,
@@ -258,7 +266,11 @@ fn spawn_nodes(
             );
             continue;
         }
-        let child = spawn::spawn(&exe, kind, &args).map_err(|cause| RunError::Spawn {
+        let child = match (&opts.controller_cmd, kind) {
+            (Some(command), NodeKind::Controller) => spawn::spawn_command(command, kind, &args),
+            _ => spawn::spawn(&exe, kind, &args),
+        }
+        .map_err(|cause| RunError::Spawn {
             node: kind.name(),
             cause,
         })?;

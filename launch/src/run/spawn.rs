@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use nix::sys::signal::{Signal, kill};
+use nix::sys::signal::Signal;
 use nix::unistd::Pid;
 use wire::NodeKind;
 
@@ -47,6 +47,12 @@ impl Child {
         lines.unwrap_or_default().join("\n")
     }
 
+    /// Signals the node's process group: a node is a group leader, and a
+    /// user's command (`--controller-cmd`) may have started helpers of its own.
+    fn signal_group(&self, sig: Signal) {
+        let _ = nix::sys::signal::killpg(Pid::from_raw(self.pid() as i32), sig);
+    }
+
     fn poll(&mut self) -> Option<ExitStatus> {
         if self.exited.is_none() {
             self.exited = self.process.try_wait().ok().flatten();
@@ -63,10 +69,32 @@ impl Child {
 
 /// Spawns `testbed node <kind> <args…>` from the running executable.
 pub fn spawn(exe: &Path, kind: NodeKind, args: &[String]) -> std::io::Result<Child> {
-    let mut process = std::process::Command::new(exe)
-        .arg("node")
-        .arg(kind.name())
-        .args(args)
+    let mut argv = vec!["node".to_string(), kind.name().to_string()];
+    argv.extend_from_slice(args);
+    spawn_program(exe.as_os_str(), &argv, kind)
+}
+
+/// Spawns a user's command as node `kind` (`--controller-cmd`): its own
+/// words, then the node arguments the launcher gives every node.
+pub fn spawn_command(command: &[String], kind: NodeKind, args: &[String]) -> std::io::Result<Child> {
+    let Some((program, words)) = command.split_first() else {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "the command is empty",
+        ));
+    };
+    let mut argv = words.to_vec();
+    argv.extend_from_slice(args);
+    spawn_program(program.as_ref(), &argv, kind)
+}
+
+fn spawn_program(
+    program: &std::ffi::OsStr,
+    argv: &[String],
+    kind: NodeKind,
+) -> std::io::Result<Child> {
+    let mut process = std::process::Command::new(program)
+        .args(argv)
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -154,13 +182,14 @@ impl Children {
         if !self.wait_all(grace) {
             for c in &mut self.0 {
                 if c.poll().is_none() {
-                    let _ = kill(Pid::from_raw(c.pid() as i32), Signal::SIGTERM);
+                    c.signal_group(Signal::SIGTERM);
                     forced.push((c.kind, "SIGTERM"));
                 }
             }
             if !self.wait_all(grace) {
                 for c in &mut self.0 {
                     if c.poll().is_none() {
+                        c.signal_group(Signal::SIGKILL);
                         let _ = c.process.kill();
                         let _ = c.process.wait();
                         forced.push((c.kind, "SIGKILL"));
@@ -193,6 +222,7 @@ impl Drop for Children {
     fn drop(&mut self) {
         for c in &mut self.0 {
             if c.poll().is_none() {
+                c.signal_group(Signal::SIGKILL);
                 let _ = c.process.kill();
             }
             let _ = c.process.wait();
