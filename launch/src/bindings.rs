@@ -76,8 +76,16 @@ fn constants(out: &mut String) {
         wire::STATE_FINAL.to_string(),
         "JointState.flags: the last state, no command expected",
     );
-    c("CONTROL_START", wire::CONTROL_START.to_string(), "Control.command");
-    c("CONTROL_STOP", wire::CONTROL_STOP.to_string(), "Control.command");
+    c(
+        "CONTROL_START",
+        wire::CONTROL_START.to_string(),
+        "Control.command",
+    );
+    c(
+        "CONTROL_STOP",
+        wire::CONTROL_STOP.to_string(),
+        "Control.command",
+    );
     for (name, v) in [
         ("NODE_READY", wire::NODE_READY),
         ("NODE_RUNNING", wire::NODE_RUNNING),

@@ -32,6 +32,11 @@ pub struct Report {
     pub mimic_joints: Vec<String>,
     /// The control law, whether it is model-based, and its parameters.
     pub law: LawInfo,
+    /// The user's command that ran as the controller node (`run
+    /// --controller-cmd`): it, not the testbed, computed the torques, with
+    /// the scenario's law parameters as its configuration.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controller_cmd: Option<String>,
     /// Controller compute time per step, µs (in process: timed around each
     /// step; a logged run: as the controller node measured it).
     pub compute_us: Percentiles,
@@ -134,6 +139,7 @@ impl Report {
             verified_steps: None,
             warning: None,
             run_end: None,
+            controller_cmd: None,
         }
     }
 
@@ -167,6 +173,7 @@ impl Report {
             verified_steps: a.verify.map(|v| v.1),
             warning,
             run_end: a.contents.run_end().map(String::from),
+            controller_cmd: Some(meta("controller_cmd")).filter(|c| !c.is_empty()),
             summary: a.summary,
         }
     }
@@ -219,6 +226,13 @@ fn heading(out: &mut String, r: &Report) {
             .join(", ")
     };
     let _ = writeln!(out, "law {}", r.law.label());
+    if let Some(cmd) = &r.controller_cmd {
+        let _ = writeln!(
+            out,
+            "controller: `{cmd}` (the user's command computed the torques; the law's \
+             parameters were its configuration)"
+        );
+    }
     let _ = writeln!(out, "gains: K1 = [{}], K2 = [{}]", fmt(&r.k1), fmt(&r.k2));
     if !r.k2_below_analysis.is_empty() {
         let _ = writeln!(

@@ -5,6 +5,7 @@
 mod compare;
 mod hardening;
 mod log_replay;
+mod python;
 mod replace_nodes;
 mod robots;
 mod run_cli;

@@ -546,7 +546,7 @@ fn a_stopped_logger_in_a_realtime_run_is_blamed_correctly() {
 
 /// Waits (watchdog: 60 s) until a run under `runs` is under way: its log
 /// has grown past what it holds before START (its first chunk of messages).
-fn wait_until_running(runs: &std::path::Path) {
+pub(crate) fn wait_until_running(runs: &std::path::Path) {
     let deadline = std::time::Instant::now() + Duration::from_secs(60);
     let size = || {
         std::fs::read_dir(runs)

@@ -40,17 +40,17 @@ mod topics;
 pub use config::{ConfigError, read_config, write_config};
 pub use domain::DomainNodes;
 pub use fields::{FieldRef, FieldSource, MessageFields};
+pub use files::{MAX_TEXT_FILE_BYTES, MAX_URDF_BYTES, read_regular_file, read_text_file};
+pub use iceoryx2::prelude::ZeroCopySend;
 pub use layout::{
     FieldLayout, FieldType, TypeLayout, WireField, WireLayout, all_layouts, field_size,
 };
-pub use files::{MAX_TEXT_FILE_BYTES, MAX_URDF_BYTES, read_regular_file, read_text_file};
-pub use iceoryx2::prelude::ZeroCopySend;
 pub use messages::*;
 pub use node::{Mode, NodeError, NodeLink, ns_to_s};
 pub use reference::ReferenceWindow;
 pub use topics::{
-    Bus, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix, SUBSCRIBER_BUFFER, Topic, TopicPublisher, TopicSubscriber, WireError,
-    monotonic_ns,
+    Bus, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix, SUBSCRIBER_BUFFER,
+    Topic, TopicPublisher, TopicSubscriber, WireError, monotonic_ns,
 };
 
 /// iceoryx2's own messages on stderr: only its errors unless `verbose`

@@ -14,10 +14,12 @@ pub enum RunError {
     #[error("{0}: {1}")]
     Output(String, std::io::Error),
     /// A node could not be started.
-    #[error("cannot start the {node} node: {cause}")]
+    #[error("cannot start the {node} node{}: {cause}", if .command.is_empty() { String::new() } else { format!(" (`{}`)", .command) })]
     Spawn {
         /// Which node.
         node: &'static str,
+        /// The user's command that was to run as the node (empty: `testbed node`).
+        command: String,
         /// The cause.
         cause: std::io::Error,
     },
@@ -88,6 +90,24 @@ impl RunError {
             RunError::NodeFailed { node, .. } => lost(Some(node)),
             RunError::NotFinished { nodes, .. } => lost(nodes.first()),
             _ => RunEnd::Failed,
+        }
+    }
+}
+
+impl RunError {
+    /// A node that reported a failure has usually exited by the time every
+    /// node was stopped: its last stderr lines say why.
+    pub(crate) fn with_stderr_of(self, children: &mut super::spawn::Children) -> Self {
+        match self {
+            RunError::NodeFailed { node, how, stderr } if stderr.is_empty() => {
+                let kind = NodeKind::ALL.into_iter().find(|k| k.name() == node);
+                let stderr = kind
+                    .and_then(|k| children.exit_of(k))
+                    .map(|(_, tail)| tail)
+                    .unwrap_or_default();
+                RunError::NodeFailed { node, how, stderr }
+            }
+            other => other,
         }
     }
 }

@@ -128,6 +128,14 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     if let Some(path) = &opts.csv {
         File::create(path).map_err(|e| RunError::Output(path.display().to_string(), e))?;
     }
+    // A controller command that cannot start is refused before any node does.
+    if let Some(command) = &opts.controller_cmd {
+        spawn::check_program(command).map_err(|cause| RunError::Spawn {
+            node: NodeKind::Controller.name(),
+            command: shell_words::join(command),
+            cause,
+        })?;
+    }
     let files = RunFiles::write(&opts)?;
     let prefix = RunPrefix::unique();
     // Domains that killed launchers left behind.
@@ -141,9 +149,11 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     let _off_loop = opts
         .realtime_setup
         .then(|| crate::node::placement::OffLoopCpu::enter(cpus));
-    let mut children = spawn_nodes(&opts, &prefix, &files.configs, cpus)?;
-
-    let result = supervise(&opts, &bus, &status, &control, &mut children);
+    // A node that cannot be started ends the run like any other failure:
+    // the ones already started get STOP, and the domain is removed.
+    let mut children = Children::default();
+    let result = spawn_nodes(&opts, &prefix, &files.configs, cpus, &mut children)
+        .and_then(|()| supervise(&opts, &bus, &status, &control, &mut children));
     let peak_rss_kb = children.peak_rss_kb();
     // Whatever happened: STOP (the logger then finishes the file), grace,
     // SIGTERM, SIGKILL, reap.
@@ -154,6 +164,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     stop.code = end.code();
     let _ = control.send(stop);
     let forced = children.stop(STOP_GRACE);
+    let result = result.map_err(|e| e.with_stderr_of(&mut children));
     let logger_exit = children.exit_of(NodeKind::Logger);
     // Close every port of this process, then remove what is left of the
     // run's domain (including what a killed node left behind).
@@ -213,7 +224,7 @@ impl RunFiles {
         })?;
         std::fs::write(&scenario_file, &toml).map_err(out(&scenario_file))?;
         let log = run_dir.join("run.mcap");
-        let command = opts.controller_cmd.as_ref().map(|c| shell_words::join(c));
+        let command = opts.controller_cmd.as_ref().map(shell_words::join);
         let configs = crate::node::configs::write_all(
             &run_dir.join("nodes"),
             plan,
@@ -237,12 +248,13 @@ fn spawn_nodes(
     prefix: &RunPrefix,
     configs: &[(NodeKind, PathBuf)],
     cpus: usize,
-) -> Result<Children, RunError> {
+    children: &mut Children,
+) -> Result<(), RunError> {
     let exe = std::env::current_exe().map_err(|cause| RunError::Spawn {
         node: "plant",
+        command: String::new(),
         cause,
     })?;
-    let mut children = Children::default();
     let me = Some(std::process::id());
     for kind in NODES {
         let external = opts.external.contains(&kind);
@@ -272,11 +284,15 @@ fn spawn_nodes(
         }
         .map_err(|cause| RunError::Spawn {
             node: kind.name(),
+            command: match (&opts.controller_cmd, kind) {
+                (Some(c), NodeKind::Controller) => shell_words::join(c),
+                _ => String::new(),
+            },
             cause,
         })?;
         children.push(child);
     }
-    Ok(children)
+    Ok(())
 }
 
 /// The run's figures from its log, with one CSV row per step if asked.

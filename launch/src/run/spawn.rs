@@ -76,7 +76,11 @@ pub fn spawn(exe: &Path, kind: NodeKind, args: &[String]) -> std::io::Result<Chi
 
 /// Spawns a user's command as node `kind` (`--controller-cmd`): its own
 /// words, then the node arguments the launcher gives every node.
-pub fn spawn_command(command: &[String], kind: NodeKind, args: &[String]) -> std::io::Result<Child> {
+pub fn spawn_command(
+    command: &[String],
+    kind: NodeKind,
+    args: &[String],
+) -> std::io::Result<Child> {
     let Some((program, words)) = command.split_first() else {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
@@ -86,6 +90,31 @@ pub fn spawn_command(command: &[String], kind: NodeKind, args: &[String]) -> std
     let mut argv = words.to_vec();
     argv.extend_from_slice(args);
     spawn_program(program.as_ref(), &argv, kind)
+}
+
+/// Whether `command`'s program can be run: an executable file at its path
+/// or, for a bare name, on `PATH` (what the spawn would find).
+pub fn check_program(command: &[String]) -> std::io::Result<()> {
+    use std::os::unix::fs::PermissionsExt;
+    let program = command.first().map(String::as_str).unwrap_or_default();
+    let runnable = |p: &Path| {
+        p.metadata()
+            .is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+    };
+    let found = if program.contains('/') {
+        runnable(Path::new(program))
+    } else {
+        let path = std::env::var_os("PATH").unwrap_or_default();
+        std::env::split_paths(&path).any(|dir| runnable(&dir.join(program)))
+    };
+    if found {
+        Ok(())
+    } else {
+        Err(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            format!("no executable program '{program}' (a path, or a name on PATH)"),
+        ))
+    }
 }
 
 fn spawn_program(

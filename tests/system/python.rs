@@ -1,0 +1,265 @@
+//! Controllers written in Python (`python/`): the package's own tests, its
+//! PD equal to the Rust `pd` law bit for bit, the numpy paper law against
+//! the Rust law, a real-time run, and supervision of a Python node that
+//! crashes, is killed or cannot start.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::OnceLock;
+
+use crate::util::{fails, json, ok, repo_root, shm_files, testbed, wait_bounded};
+
+/// The virtual environment's python, set up once (python/setup-venv.sh
+/// installs the iceoryx2 wheel, numpy and the package; it locks against
+/// the other test processes doing the same).
+fn python() -> &'static str {
+    static PYTHON: OnceLock<String> = OnceLock::new();
+    PYTHON.get_or_init(|| {
+        let out = Command::new("bash")
+            .arg(repo_root().join("python/setup-venv.sh"))
+            .output()
+            .expect("run python/setup-venv.sh");
+        assert!(
+            out.status.success(),
+            "python/setup-venv.sh failed:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).trim().to_string()
+    })
+}
+
+fn example(name: &str) -> String {
+    format!("{} python/examples/{name}", python())
+}
+
+/// Every `tau{i}` column of two CSV files: the largest difference.
+fn max_torque_difference(a: &Path, b: &Path) -> f64 {
+    let read = |p: &Path| {
+        let text = std::fs::read_to_string(p).unwrap();
+        let mut lines = text.lines();
+        let head: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+        let cols: Vec<usize> = (0..head.len())
+            .filter(|&i| head[i].starts_with("tau"))
+            .collect();
+        assert!(!cols.is_empty(), "{} has no torque column", p.display());
+        lines
+            .map(|l| {
+                let f: Vec<&str> = l.split(',').collect();
+                cols.iter().map(|&i| f[i].parse::<f64>().unwrap()).collect()
+            })
+            .collect::<Vec<Vec<f64>>>()
+    };
+    let (a, b) = (read(a), read(b));
+    assert_eq!(a.len(), b.len(), "both runs have every step");
+    a.iter()
+        .flatten()
+        .zip(b.iter().flatten())
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+fn lockstep(dir: &Path, extra: &[&str], csv: &str) -> serde_json::Value {
+    let mut cmd = testbed();
+    cmd.args(["run", "--mode", "lockstep", "--json", "--runs-dir"])
+        .arg(dir)
+        .arg("--csv")
+        .arg(dir.join(csv))
+        .args(extra);
+    json(&ok(&mut cmd))
+}
+
+fn verify(log: &str) -> serde_json::Value {
+    json(&ok(testbed().args(["replay", "--json", "--verify", log])))
+}
+
+#[test]
+fn the_python_packages_own_tests_pass() {
+    let out = Command::new(python())
+        .args(["-m", "unittest", "discover", "-s", "tests"])
+        .current_dir(repo_root().join("python"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "python unit tests failed:\n{err}");
+    assert!(err.trim_end().ends_with("OK"), "{err}");
+}
+
+/// The Python PD computes what the Rust `pd` law computes, in the same
+/// order: a lockstep run gives the same torques to the last bit.
+#[test]
+fn a_python_pd_equals_the_rust_pd_law_in_lockstep() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["--law", "pd", "--duration", "3"];
+    let py_cmd = example("pd.py");
+    let mut py_args = args.to_vec();
+    py_args.extend(["--controller-cmd", py_cmd.as_str()]);
+    let py = lockstep(dir.path(), &py_args, "py.csv");
+    let rs = lockstep(dir.path(), &args, "rs.csv");
+    let diff = max_torque_difference(&dir.path().join("py.csv"), &dir.path().join("rs.csv"));
+    assert!(diff <= 1e-12, "Python PD differs from Rust pd by {diff}");
+    assert_eq!(py["controller_cmd"].as_str(), Some(py_cmd.as_str()));
+    assert!(rs.get("controller_cmd").is_none());
+    assert_eq!(py["fault_steps"], 0);
+    let v = verify(py["log"].as_str().unwrap());
+    assert_eq!(v["verified_steps"], 3000);
+    assert!(v["max_abs_torque_diff"].as_f64().unwrap() <= 1e-12, "{v}");
+}
+
+/// The paper's law written in numpy from SPEC keeps the paper scenario's
+/// envelope, and the Rust law re-driven on its logged states gives its
+/// torques to 1e-9; a Rust run of the whole scenario agrees with it too.
+#[test]
+fn the_numpy_paper_law_keeps_the_envelope_and_matches_the_rust_law() {
+    let dir = tempfile::tempdir().unwrap();
+    let py_cmd = example("nac.py");
+    let py = lockstep(dir.path(), &["--controller-cmd", &py_cmd], "py.csv");
+    assert_eq!(py["constraint_satisfied_after_tc"], true, "{py}");
+    assert_eq!(py["fault_steps"], 0);
+    assert_eq!(py["barrier_breached_steps"], 0);
+    let v = verify(py["log"].as_str().unwrap());
+    assert_eq!(v["verified_steps"], 20000);
+    let step_diff = v["max_abs_torque_diff"].as_f64().unwrap();
+    assert!(
+        step_diff <= 1e-9,
+        "Rust law on the numpy run's states: {step_diff}"
+    );
+    lockstep(dir.path(), &[], "rs.csv");
+    let run_diff = max_torque_difference(&dir.path().join("py.csv"), &dir.path().join("rs.csv"));
+    assert!(run_diff <= 1e-9, "whole runs differ by {run_diff}");
+}
+
+/// A 10 s real-time run at 1 kHz with the Python PD completes and reports
+/// its timing (how many deadlines it missed is the machine's to say).
+#[test]
+fn a_python_pd_runs_in_real_time_at_1khz() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = example("pd.py");
+    let r = json(&ok(testbed()
+        .args([
+            "run",
+            "--json",
+            "--law",
+            "pd",
+            "--duration",
+            "10",
+            "--rate",
+            "1000",
+        ])
+        .args(["--controller-cmd", &cmd, "--runs-dir"])
+        .arg(dir.path())));
+    let t = &r["timing"];
+    assert_eq!(t["cycles"], 10000, "{t}");
+    assert!(t["round_trip_us"]["p50"].as_f64().unwrap() > 0.0, "{t}");
+    assert!(t["deadline_misses"].as_u64().is_some(), "{t}");
+    assert_eq!(r["run_end"], "finished");
+}
+
+fn crash_script(dir: &Path) -> PathBuf {
+    let path = dir.join("crash.py");
+    std::fs::write(
+        &path,
+        "import numpy as np\nimport testbed_controller as tc\n\n\
+         class Crash(tc.Controller):\n    def step(self, state, ref):\n        \
+         if state.seq == 100:\n            raise RuntimeError('boom at step 100')\n        \
+         return np.zeros(2)\n\ntc.run(Crash())\n",
+    )
+    .unwrap();
+    path
+}
+
+/// The run stops, names the controller and shows its traceback, and no
+/// shared memory of the run is left.
+#[test]
+fn a_crashing_python_controller_stops_the_run_with_its_last_words() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = format!("{} {}", python(), crash_script(dir.path()).display());
+    let mut child = testbed()
+        .args(["run", "--mode", "lockstep", "--duration", "5", "--runs-dir"])
+        .arg(dir.path())
+        .args(["--controller-cmd", &cmd])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let status = wait_bounded(&mut child, 120);
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(!status.success());
+    assert!(err.contains("the controller node"), "{err}");
+    assert!(err.contains("RuntimeError: boom at step 100"), "{err}");
+    assert!(shm_files(&format!("tbrun{pid:x}x")).is_empty());
+}
+
+/// The Python controller of a run started by launcher `launcher`, once it runs.
+fn python_controller_of(launcher: u32) -> u32 {
+    for _ in 0..3000 {
+        for e in std::fs::read_dir("/proc").unwrap().flatten() {
+            let Ok(pid) = e.file_name().to_string_lossy().parse::<u32>() else {
+                continue;
+            };
+            let cmdline = std::fs::read(e.path().join("cmdline")).unwrap_or_default();
+            let text = String::from_utf8_lossy(&cmdline).replace('\0', " ");
+            if text.contains("pd.py") && text.contains(&format!("--parent-pid {launcher}")) {
+                return pid;
+            }
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    panic!("launcher {launcher} started no Python controller");
+}
+
+/// kill -9 of the Python node mid-run: named, nothing left behind.
+#[test]
+fn kill_9_of_a_python_controller_is_named_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = example("pd.py");
+    let mut child = testbed()
+        .args(["run", "--law", "pd", "--duration", "30", "--runs-dir"])
+        .arg(dir.path())
+        .args(["--controller-cmd", &cmd])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let launcher = child.id();
+    let controller = python_controller_of(launcher);
+    // Let it run (a watchdog-bounded poll for its first log bytes).
+    crate::run_cli::wait_until_running(dir.path());
+    nix::sys::signal::kill(
+        nix::unistd::Pid::from_raw(controller as i32),
+        nix::sys::signal::Signal::SIGKILL,
+    )
+    .unwrap();
+    let status = wait_bounded(&mut child, 120);
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(!status.success());
+    assert!(
+        err.contains("the controller node was killed by signal 9"),
+        "{err}"
+    );
+    assert!(shm_files(&format!("tbrun{launcher:x}x")).is_empty());
+}
+
+#[test]
+fn a_controller_command_that_cannot_start_is_refused_before_any_node() {
+    let dir = tempfile::tempdir().unwrap();
+    let err = fails(
+        testbed()
+            .args(["run", "--mode", "lockstep", "--runs-dir"])
+            .arg(dir.path())
+            .args(["--controller-cmd", "/no/such/python3 my_controller.py"]),
+    );
+    assert!(
+        err.contains("cannot start the controller node (`/no/such/python3 my_controller.py`)"),
+        "{err}"
+    );
+    assert!(
+        err.contains("no executable program '/no/such/python3'"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    let err = fails(testbed().args(["run", "--controller-cmd", "'unclosed"]));
+    assert!(err.contains("cannot be split into words"), "{err}");
+}
