@@ -41,6 +41,8 @@ pub struct BenchOptions {
     /// real time SCHED_FIFO with locked memory); the timer floor then runs
     /// with the plant's placement, so that the two compare like for like.
     pub realtime_setup: bool,
+    /// Run this law instead of the scenarios' (None: theirs).
+    pub law: Option<controller::LawName>,
 }
 
 /// Why a bench failed.
@@ -248,19 +250,24 @@ impl FloorProbe {
     }
 }
 
-fn load(robot: Option<&Path>, opts: &BenchOptions) -> Result<Plan, BenchError> {
+pub(crate) fn load(robot: Option<&Path>, opts: &BenchOptions) -> Result<Plan, BenchError> {
     Ok(scenario::load(
         None,
         &Overrides {
             duration_s: opts.duration_s,
             rate_hz: None,
             robot: robot.map(Path::to_path_buf),
-            law: None,
+            law: opts.law,
         },
     )?)
 }
 
-fn stack(plan: &Plan, mode: Mode, opts: &BenchOptions) -> Result<run::RunOutcome, BenchError> {
+fn stack(
+    plan: &Plan,
+    mode: Mode,
+    opts: &BenchOptions,
+    controller_cmd: Option<&[String]>,
+) -> Result<run::RunOutcome, BenchError> {
     Ok(run::run(RunOptions {
         plan: plan.clone(),
         mode,
@@ -270,8 +277,41 @@ fn stack(plan: &Plan, mode: Mode, opts: &BenchOptions) -> Result<run::RunOutcome
         progress: false,
         realtime_setup: opts.realtime_setup,
         verbose: false,
-        controller_cmd: None,
+        controller_cmd: controller_cmd.map(<[String]>::to_vec),
     })?)
+}
+
+/// A real-time run of `plan` for `opts.realtime_s` with the timer floor
+/// measured beside it (same window, CPU and priority); with
+/// `controller_cmd`, that command is the controller node.
+pub(crate) fn realtime_part(
+    plan: &Plan,
+    opts: &BenchOptions,
+    controller_cmd: Option<&[String]>,
+) -> Result<(RealtimeFigures, TimerFloor, Percentiles), BenchError> {
+    let mut rt_plan = plan.clone();
+    rt_plan.steps = (opts.realtime_s * plan.scenario.rate_hz).round() as u64;
+    rt_plan.scenario.duration_s = opts.realtime_s;
+    let placement = floor_placement(opts);
+    // Start-up and shut-down take a few seconds at most; the probe keeps
+    // running until the run is over, and only the run's window counts.
+    let probe = FloorProbe::start(plan.scenario.rate_hz, opts.realtime_s + 60.0, &placement);
+    let rt = stack(&rt_plan, Mode::Realtime, opts, controller_cmd);
+    let floor = probe.finish(
+        rt.as_ref().map_or((0, 0), |r| r.analysis.wall_window_ns),
+        plan.scenario.rate_hz,
+    );
+    let rt = rt?;
+    let t = &rt.analysis.timing;
+    let figures = RealtimeFigures {
+        cycles: t.cycles,
+        deadline_misses: t.deadline_misses,
+        late_wakeups: t.late_wakeups,
+        period_jitter_us: t.period_jitter_us,
+        round_trip_us: t.round_trip_us,
+        logger_dropped: rt.analysis.contents.logger_dropped().unwrap_or(0),
+    };
+    Ok((figures, floor, t.controller_compute_us))
 }
 
 fn bench_arm(
@@ -288,7 +328,7 @@ fn bench_arm(
     )];
     for i in 0..opts.repeats {
         progress(&format!("{}: lockstep, run {}", plan.scenario.name, i + 1));
-        let out = stack(plan, Mode::Lockstep, opts)?;
+        let out = stack(plan, Mode::Lockstep, opts, None)?;
         lock_walls.push(out.wall_time_s);
         if i == 0 {
             rss.extend(
@@ -303,21 +343,7 @@ fn bench_arm(
         "{}: real time, {} s",
         plan.scenario.name, opts.realtime_s
     ));
-    let mut rt_plan = plan.clone();
-    rt_plan.steps = (opts.realtime_s * plan.scenario.rate_hz).round() as u64;
-    rt_plan.scenario.duration_s = opts.realtime_s;
-    let placement = floor_placement(opts);
-    // Start-up and shut-down take a few seconds at most; the probe keeps
-    // running until the run is over, and only the run's window counts.
-    let probe = FloorProbe::start(plan.scenario.rate_hz, opts.realtime_s + 60.0, &placement);
-    let rt = stack(&rt_plan, Mode::Realtime, opts);
-    let floor = probe.finish(
-        rt.as_ref().map_or((0, 0), |r| r.analysis.wall_window_ns),
-        plan.scenario.rate_hz,
-    );
-    let rt = rt?;
-    let t = &rt.analysis.timing;
-    let dropped = rt.analysis.contents.logger_dropped().unwrap_or(0);
+    let (realtime, floor, _) = realtime_part(plan, opts, None)?;
     Ok(ArmBench {
         scenario: plan.scenario.name.clone(),
         dof: plan.robot.model.dof(),
@@ -328,14 +354,7 @@ fn bench_arm(
         lockstep_to_inprocess_ratio: lockstep / inprocess.max(1e-9),
         controller_step_us: median_us(&costs.controller_ns),
         plant_step_us: median_us(&costs.plant_ns),
-        realtime: RealtimeFigures {
-            cycles: t.cycles,
-            deadline_misses: t.deadline_misses,
-            late_wakeups: t.late_wakeups,
-            period_jitter_us: t.period_jitter_us,
-            round_trip_us: t.round_trip_us,
-            logger_dropped: dropped,
-        },
+        realtime,
         timer_floor: floor,
         peak_rss_kb: rss,
     })

@@ -12,6 +12,7 @@
 pub mod analysis;
 pub mod assemble;
 pub mod bench;
+pub mod bench_controller;
 pub mod bindings;
 pub mod compare;
 pub mod compare_plots;

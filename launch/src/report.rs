@@ -183,7 +183,7 @@ fn opt(v: Option<f64>, prec: usize) -> String {
     v.map_or_else(|| "n/a".into(), |x| format!("{x:.prec$}"))
 }
 
-fn percentiles(p: &Percentiles) -> String {
+pub(crate) fn percentiles(p: &Percentiles) -> String {
     format!("p50 {:8.1}  p99 {:8.1}  max {:8.1}", p.p50, p.p99, p.max)
 }
 

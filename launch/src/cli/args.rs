@@ -102,6 +102,15 @@ pub(crate) struct BenchArgs {
     /// Measure without pinning, SCHED_FIFO or locked memory.
     #[arg(long)]
     pub(crate) no_realtime_setup: bool,
+    /// Run this law instead of the scenarios' (with --controller-cmd: the
+    /// law the testbed's controller runs, whose parameters the command gets).
+    #[arg(long, value_name = "LAW")]
+    pub(crate) law: Option<controller::LawName>,
+    /// Measure only this controller command against the testbed's own
+    /// controller: real-time runs of the paper scenario at its rate, in
+    /// --repeats pairs, each beside the timer floor.
+    #[arg(long, value_name = "CMD")]
+    pub(crate) controller_cmd: Option<String>,
 }
 
 #[derive(Debug, Args)]

@@ -1,11 +1,13 @@
 //! `testbed bench`: speed and timing on this machine.
 
+use std::fmt::Write;
 use std::process::ExitCode;
 
 use anyhow::Result;
+use launch::bench_controller::ControllerBench;
 
 use super::args::BenchArgs;
-use crate::report;
+use crate::report::{self, percentiles};
 
 pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
     if !(args.realtime_s.is_finite() && args.realtime_s > 0.0) {
@@ -17,6 +19,11 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
     if args.repeats == 0 {
         anyhow::bail!("--repeats 0 is invalid: it must be at least 1");
     }
+    let command = args
+        .controller_cmd
+        .as_deref()
+        .map(super::args::command_words)
+        .transpose()?;
     let opts = launch::bench::BenchOptions {
         realtime_s: args.realtime_s,
         repeats: args.repeats,
@@ -24,12 +31,67 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
         duration_s: args.duration,
         large_arm: args.large_arm,
         realtime_setup: !args.no_realtime_setup,
+        law: args.law,
     };
-    let report = launch::bench::run(&opts, |what| eprintln!("testbed bench: {what}"))?;
+    let progress = |what: &str| eprintln!("testbed bench: {what}");
+    if let Some(command) = command {
+        let report = launch::bench_controller::run(&opts, &command, progress)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&report)?);
+        } else {
+            print!("{}", controller_table(&report));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let report = launch::bench::run(&opts, progress)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         print!("{}", report::bench_table(&report));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The two controllers' figures, pair by pair.
+fn controller_table(b: &ControllerBench) -> String {
+    let mut out = String::new();
+    let m = &b.machine;
+    let _ = writeln!(
+        out,
+        "machine: {} ({} CPUs), kernel {}\n{} with law {} in real time at {} Hz, {} pair(s) of {} s runs",
+        m.cpu, m.cores, m.kernel, b.scenario, b.law, b.rate_hz, b.pairs, b.realtime_s
+    );
+    for (i, pair) in b.testbed.iter().zip(&b.command).enumerate() {
+        let _ = writeln!(out, "\npair {}:", i + 1);
+        for c in [pair.0, pair.1] {
+            let r = &c.realtime;
+            let _ = writeln!(
+                out,
+                "  {}\n    {} cycles, {} deadline misses, {} wake-ups late by a period \
+                 (timer floor beside it: {} late)",
+                c.controller,
+                r.cycles,
+                r.deadline_misses,
+                r.late_wakeups,
+                c.timer_floor.deadline_misses
+            );
+            let _ = writeln!(
+                out,
+                "    round trip us     {}",
+                percentiles(&r.round_trip_us)
+            );
+            let _ = writeln!(out, "    compute us        {}", percentiles(&c.compute_us));
+            let _ = writeln!(
+                out,
+                "    period jitter us  {}",
+                percentiles(&r.period_jitter_us)
+            );
+            let _ = writeln!(
+                out,
+                "    floor jitter us   {}",
+                percentiles(&c.timer_floor.period_jitter_us)
+            );
+        }
+    }
+    out
 }

@@ -172,9 +172,28 @@ pub fn for_node(kind: NodeKind, mode: Mode, cpus: usize) -> Placement {
     }
 }
 
+/// A user's controller (`run --controller-cmd`) runs just below the plant
+/// on the loop's CPU: a controller slower than the testbed's must not hold
+/// the clock back; its lateness then shows as its own deadline misses.
+pub fn below_the_plant(p: Placement) -> Placement {
+    let plant = for_node(NodeKind::Plant, Mode::Realtime, 2).fifo;
+    Placement {
+        fifo: p.fifo.and(plant.map(|f| f - 1)),
+        ..p
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_users_controller_runs_below_the_plant_on_the_loop_cpu() {
+        let c = below_the_plant(for_node(NodeKind::Controller, Mode::Realtime, 2));
+        assert_eq!((c.cpus.as_slice(), c.fifo), (&[1][..], Some(78)));
+        let lockstep = below_the_plant(for_node(NodeKind::Controller, Mode::Lockstep, 2));
+        assert_eq!(lockstep.fifo, None);
+    }
 
     #[test]
     fn the_loop_shares_one_cpu_and_the_rest_get_the_others() {

@@ -267,7 +267,11 @@ fn spawn_nodes(
             args.push("--verbose".into());
         }
         if opts.realtime_setup {
-            args.extend(crate::node::placement::for_node(kind, opts.mode, cpus).to_args());
+            let mut placement = crate::node::placement::for_node(kind, opts.mode, cpus);
+            if kind == NodeKind::Controller && opts.controller_cmd.is_some() {
+                placement = crate::node::placement::below_the_plant(placement);
+            }
+            args.extend(placement.to_args());
         }
         if external {
             eprintln!(
