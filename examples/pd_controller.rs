@@ -102,6 +102,11 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             })?;
             diagnostics.send(d)?;
             handled += 1;
+            // The launcher and STOP are checked every 256 states and on a
+            // timeout: the check also sends the heartbeat the launcher expects.
+            if handled % 256 == 0 {
+                link.check()?;
+            }
         }
         if !states.wait_event(Duration::from_millis(100))? {
             link.check()?;

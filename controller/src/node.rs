@@ -114,12 +114,17 @@ pub fn run(
             commands.send(cmd)?;
             diagnostics.send(diag)?;
             handled += 1;
+            // Checked every 256 states (and on a timeout), not on every
+            // wake-up; here, so that a loop that always finds the next
+            // state waiting still checks in (and sends its heartbeat).
+            if handled.is_multiple_of(256) {
+                link.check()?;
+            }
         }
         if finished {
             break;
         }
-        // Checked on a timeout and every 256 states, not on every wake-up.
-        if !states.wait_event(Duration::from_millis(100))? || handled.is_multiple_of(256) {
+        if !states.wait_event(Duration::from_millis(100))? {
             link.check()?;
         }
         states.drain_events()?;

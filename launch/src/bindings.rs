@@ -67,6 +67,16 @@ fn constants(out: &mut String) {
         "a lockstep publisher gives up on a full reader after this",
     );
     c(
+        "HEARTBEAT_NS",
+        wire::HEARTBEAT.as_nanos().to_string(),
+        "a node repeats its status at least this often while it runs",
+    );
+    c(
+        "SILENT_AFTER_S",
+        wire::SILENT_AFTER.as_secs().to_string(),
+        "the launcher names a node not heard from for this long",
+    );
+    c(
         "RUN_PREFIX_STEM",
         format!("{:?}", wire::RunPrefix::STEM),
         "every run's shared-memory prefix starts so",

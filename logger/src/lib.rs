@@ -82,3 +82,22 @@ pub enum LogError {
         reason: String,
     },
 }
+
+impl LogError {
+    /// An error of the mcap library about `path`. Its I/O errors (a full
+    /// disk among them) are shown as such: the library's own text for them
+    /// ("I/O error from writing, or reading a compression stream") hides
+    /// the cause.
+    pub fn mcap(path: &str, cause: mcap::McapError) -> Self {
+        match cause {
+            mcap::McapError::Io(cause) => LogError::Io {
+                path: path.to_string(),
+                cause,
+            },
+            cause => LogError::Mcap {
+                path: path.to_string(),
+                cause,
+            },
+        }
+    }
+}

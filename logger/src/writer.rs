@@ -19,7 +19,7 @@ const FLUSH_EVERY: Duration = Duration::from_millis(500);
 const CHUNK_BYTES: u64 = 1 << 20;
 
 /// What the `testbed.run` metadata record says.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunMetadata {
     /// Run id (the run folder's name).
@@ -113,10 +113,7 @@ impl LogWriter {
             path: p.clone(),
             cause,
         })?;
-        let mcap_err = |cause| LogError::Mcap {
-            path: p.clone(),
-            cause,
-        };
+        let mcap_err = |cause| LogError::mcap(&p, cause);
         let mut writer = WriteOptions::new()
             .compression(Some(Compression::Zstd))
             .chunk_size(Some(CHUNK_BYTES))
@@ -148,10 +145,7 @@ impl LogWriter {
     }
 
     fn err(&self) -> impl Fn(mcap::McapError) -> LogError + '_ {
-        |cause| LogError::Mcap {
-            path: self.path.display().to_string(),
-            cause,
-        }
+        |cause| LogError::mcap(&self.path.display().to_string(), cause)
     }
 
     /// Registers the channel of `M` (done on first write otherwise).
@@ -167,17 +161,11 @@ impl LogWriter {
         let schema_id = self
             .writer
             .add_schema(M::SCHEMA, "jsonschema", &schema)
-            .map_err(|cause| LogError::Mcap {
-                path: self.path.display().to_string(),
-                cause,
-            })?;
+            .map_err(self.err())?;
         let id = self
             .writer
             .add_channel(schema_id, M::TOPIC, "json", &BTreeMap::new())
-            .map_err(|cause| LogError::Mcap {
-                path: self.path.display().to_string(),
-                cause,
-            })?;
+            .map_err(self.err())?;
         self.channels.insert(M::TOPIC, (id, 0));
         Ok(id)
     }
@@ -231,5 +219,49 @@ impl LogWriter {
         let res = self.writer.finish();
         res.map_err(self.err())?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// A full disk (#18 row 12): the error says so and names the file,
+    /// whether it strikes a record written at once or a compressed chunk.
+    #[test]
+    fn a_full_disk_is_named_as_such() {
+        let full = Path::new("/dev/full");
+        let meta = RunMetadata::default();
+        // The URDF attachment goes straight to the file, past the buffer.
+        let err = LogWriter::create(full, &meta, &"x".repeat(1 << 20))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(err.contains("/dev/full"), "{err}");
+        assert!(err.contains("No space left on device"), "{err}");
+        // A chunk of messages, compressed, then flushed (if the small
+        // start fitted in the buffer).
+        let err = match LogWriter::create(full, &meta, "<robot/>") {
+            Err(e) => e.to_string(),
+            Ok(mut w) => {
+                let mut err = None;
+                for k in 0..20_000u64 {
+                    let mut s = wire::JointState::default();
+                    s.header.seq = k;
+                    s.dof = 12;
+                    s.q = [k as f64 * 1e-3; wire::MAX_DOF];
+                    let r = w
+                        .write(&s)
+                        .and_then(|()| if k % 1000 == 999 { w.flush() } else { Ok(()) });
+                    if let Err(e) = r {
+                        err = Some(e.to_string());
+                        break;
+                    }
+                }
+                err.unwrap_or_else(|| w.finish(BTreeMap::new()).err().unwrap().to_string())
+            }
+        };
+        assert!(err.contains("No space left on device"), "{err}");
     }
 }

@@ -46,11 +46,14 @@ class NodeLink:
         self.control = bus.subscriber("control")
         self.status_seq = 0
         self.stopped = False
+        self.last_report = (0, 0)
+        self.last_report_ns = 0
 
     def report(self, state: int, step: int) -> None:
+        self.last_report, self.last_report_ns = (state, step), time.monotonic_ns()
         msg = wire.NodeStatus()
         msg.header.seq = self.status_seq
-        msg.header.wall_ns = time.monotonic_ns()
+        msg.header.wall_ns = self.last_report_ns
         msg.node = wire.NODE_KIND_CONTROLLER
         msg.state = state
         msg.pid = os.getpid()
@@ -59,8 +62,11 @@ class NodeLink:
         self.status.send_copy(msg)
 
     def check(self) -> None:
-        """Raises if SIGINT/SIGTERM came, the launcher is gone, or STOP came."""
+        """Raises if SIGINT/SIGTERM came, the launcher is gone, or STOP came;
+        repeats the last status as the heartbeat the launcher listens for."""
         self.bus.wait(0.0)
+        if self.last_report_ns and time.monotonic_ns() - self.last_report_ns >= wire.HEARTBEAT_NS:
+            self.report(*self.last_report)
         if self.parent_pid is not None and os.getppid() != self.parent_pid:
             raise ProtocolError(f"the launcher (pid {self.parent_pid}) is gone")
         while (c := self.control.receive()) is not None:
@@ -153,9 +159,13 @@ class Loop:
                     continue
                 self.step(s)
                 handled += 1
+                # Inside the loop: a controller slower than the plant finds
+                # the next state waiting and never leaves it.
+                if handled % 256 == 0:
+                    self.link.check()
             if finished:
                 return handled
-            if not self.states.wait_event(0.1) or handled % 256 == 0:
+            if not self.states.wait_event(0.1):
                 self.link.check()
             self.states.drain_events()
 

@@ -4,6 +4,7 @@
 
 mod compare;
 mod hardening;
+mod liveness;
 mod log_replay;
 mod python;
 mod replace_nodes;

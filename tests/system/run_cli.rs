@@ -285,7 +285,7 @@ fn bad_run_settings_fail_before_anything_starts() {
     );
 }
 
-fn newest_log(runs: &std::path::Path) -> std::path::PathBuf {
+pub(crate) fn newest_log(runs: &std::path::Path) -> std::path::PathBuf {
     std::fs::read_dir(runs)
         .unwrap()
         .flatten()
@@ -482,66 +482,6 @@ fn a_stopped_and_continued_realtime_run_goes_on() {
     let s: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(s["run_end"], "finished");
     assert!(s["timing"]["late_wakeups"].as_u64().unwrap() > 0, "{s}");
-}
-
-/// A controller stopped (SIGSTOP) in a real-time run is detected and named
-/// once the plant has finished, instead of hanging the run (#18 row 1); the
-/// log is kept and says which node was lost.
-#[test]
-fn a_stopped_controller_in_a_realtime_run_is_named() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut launcher = testbed()
-        .args(["run", "--duration", "3", "--runs-dir"])
-        .arg(dir.path())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let nodes = wait_for_nodes(launcher.id());
-    let (_, pid, prefix) = nodes.iter().find(|n| n.0 == "controller").unwrap().clone();
-    wait_until_running(dir.path());
-    kill(Pid::from_raw(pid as i32), Signal::SIGSTOP).unwrap();
-    let status = wait_bounded(&mut launcher, 60);
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
-    assert!(!status.success());
-    assert!(
-        err.contains("the controller node did not finish within 5 s"),
-        "{err}"
-    );
-    assert!(nodes_of(launcher.id()).is_empty(), "nodes left running");
-    assert_eq!(shm_files(&prefix), Vec::<String>::new());
-    let log = newest_log(dir.path());
-    let s = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
-    assert_eq!(s["run_end"], "lost the controller", "{s}");
-}
-
-/// A logger stopped (SIGSTOP) during a real-time run is blamed for what it
-/// is, not as "killed by signal 9" by the launcher's own kill (#18 row 11).
-#[test]
-fn a_stopped_logger_in_a_realtime_run_is_blamed_correctly() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut launcher = testbed()
-        .args(["run", "--duration", "2", "--runs-dir"])
-        .arg(dir.path())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let nodes = wait_for_nodes(launcher.id());
-    let (_, pid, _) = nodes.iter().find(|n| n.0 == "logger").unwrap().clone();
-    wait_until_running(dir.path());
-    kill(Pid::from_raw(pid as i32), Signal::SIGSTOP).unwrap();
-    let status = wait_bounded(&mut launcher, 60);
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
-    assert!(!status.success());
-    assert!(
-        err.contains("the logger node did not finish its log within 2 s of STOP (stopped or hung)"),
-        "{err}"
-    );
-    assert!(!err.contains("killed by signal 9"), "{err}");
-    assert!(nodes_of(launcher.id()).is_empty(), "nodes left running");
 }
 
 /// Waits (watchdog: 60 s) until a run under `runs` is under way: its log

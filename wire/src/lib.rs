@@ -46,7 +46,7 @@ pub use layout::{
     FieldLayout, FieldType, TypeLayout, WireField, WireLayout, all_layouts, field_size,
 };
 pub use messages::*;
-pub use node::{Mode, NodeError, NodeLink, ns_to_s};
+pub use node::{HEARTBEAT, Mode, NodeError, NodeLink, SILENT_AFTER, ns_to_s};
 pub use reference::ReferenceWindow;
 pub use topics::{
     Bus, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix, SUBSCRIBER_BUFFER,

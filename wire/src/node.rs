@@ -92,7 +92,17 @@ pub struct NodeLink {
     stop_seen: bool,
     stop_outcome: Option<u32>,
     mode: Mode,
+    /// The last state and step reported, repeated as the heartbeat.
+    last_report: (u32, u64),
+    last_report_ns: u64,
 }
+
+/// How often a node says it is alive (its last status again) while it
+/// checks in: the launcher names a node silent for [`SILENT_AFTER`].
+pub const HEARTBEAT: Duration = Duration::from_millis(100);
+/// A node whose status has not been heard for this long is stopped,
+/// spinning or deadlocked: the launcher ends the run and names it.
+pub const SILENT_AFTER: Duration = Duration::from_secs(3);
 
 impl NodeLink {
     /// Connects node `kind` of a `mode` run to the run under `prefix`; with
@@ -116,16 +126,21 @@ impl NodeLink {
             stop_seen: false,
             stop_outcome: None,
             mode,
+            last_report: (0, 0),
+            last_report_ns: 0,
         })
     }
 
     /// Publishes this node's state.
     pub fn report(&mut self, state: u32, step: u64) -> Result<(), NodeError> {
+        let now = monotonic_ns();
+        self.last_report = (state, step);
+        self.last_report_ns = now;
         let msg = NodeStatus {
             header: Header {
                 seq: self.status_seq,
                 t_ns: 0,
-                wall_ns: monotonic_ns(),
+                wall_ns: now,
             },
             node: self.kind as u32,
             state,
@@ -139,9 +154,17 @@ impl NodeLink {
     }
 
     /// Errors if the launcher is gone, a termination signal arrived, or
-    /// STOP was received.
+    /// STOP was received; repeats the last status as a heartbeat when
+    /// [`HEARTBEAT`] has passed since the last one (every node calls this
+    /// in each of its waits, so a node that stops calling it is frozen).
     pub fn check(&mut self) -> Result<(), NodeError> {
         self.bus.wait(Duration::ZERO)?;
+        if self.last_report_ns > 0
+            && monotonic_ns().saturating_sub(self.last_report_ns) >= HEARTBEAT.as_nanos() as u64
+        {
+            let (state, step) = self.last_report;
+            self.report(state, step)?;
+        }
         if let Some(pid) = self.parent_pid
             && std::os::unix::process::parent_id() != pid
         {

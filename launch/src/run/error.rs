@@ -62,6 +62,21 @@ pub enum RunError {
         /// The limit.
         secs: u64,
     },
+    /// A node stopped saying it is alive while the run went on.
+    #[error(
+        "the {node} node has not been heard from for {secs} s: it is stopped, spinning or \
+         deadlocked (step {step} of {steps})"
+    )]
+    Silent {
+        /// The node heard from least recently.
+        node: &'static str,
+        /// The limit.
+        secs: u64,
+        /// The plant's last reported step.
+        step: u64,
+        /// Steps of the run.
+        steps: u64,
+    },
     /// Ctrl-C or SIGTERM.
     #[error("interrupted; all nodes stopped")]
     Interrupted,
@@ -89,6 +104,7 @@ impl RunError {
             RunError::Interrupted => RunEnd::Interrupted,
             RunError::NodeFailed { node, .. } => lost(Some(node)),
             RunError::NotFinished { nodes, .. } => lost(nodes.first()),
+            RunError::Silent { node, .. } => lost(Some(node)),
             _ => RunEnd::Failed,
         }
     }

@@ -400,6 +400,14 @@ fn supervise(
             });
         }
         check_children(children)?;
+        if let Some(node) = nodes.silent(wire::SILENT_AFTER) {
+            return Err(RunError::Silent {
+                node: node.name(),
+                secs: wire::SILENT_AFTER.as_secs(),
+                step: nodes.plant_step,
+                steps: plan.steps,
+            });
+        }
         if let Some(b) = &bar {
             b.set_position(nodes.plant_step);
         }
@@ -426,6 +434,10 @@ struct NodeStates {
     ready: Vec<NodeKind>,
     done: Vec<NodeKind>,
     plant_step: u64,
+    /// When each node was last heard from (any status: its heartbeat).
+    heard: Vec<(NodeKind, Instant)>,
+    /// When the launcher last looked, to tell its own pause from theirs.
+    looked: Option<Instant>,
 }
 
 impl NodeStates {
@@ -436,6 +448,10 @@ impl NodeStates {
             };
             if kind == NodeKind::Plant {
                 self.plant_step = self.plant_step.max(s.step);
+            }
+            match self.heard.iter_mut().find(|(k, _)| *k == kind) {
+                Some((_, at)) => *at = Instant::now(),
+                None => self.heard.push((kind, Instant::now())),
             }
             let list = match s.state {
                 NODE_READY => &mut self.ready,
@@ -455,6 +471,30 @@ impl NodeStates {
         }
         let _ = status.drain_events();
         Ok(())
+    }
+}
+
+impl NodeStates {
+    /// The node heard from least recently, if that was longer ago than
+    /// `limit`. A pause of the launcher itself (Ctrl-Z and `fg` of the whole
+    /// run, a paused VM) silences nobody: every node is then heard anew.
+    fn silent(&mut self, limit: Duration) -> Option<NodeKind> {
+        let now = Instant::now();
+        if self
+            .looked
+            .replace(now)
+            .is_some_and(|l| now - l > Duration::from_secs(1))
+        {
+            self.heard.iter_mut().for_each(|(_, at)| *at = now);
+        }
+        let (kind, at) = NODES
+            .iter()
+            .map(|k| {
+                let at = self.heard.iter().find(|(h, _)| h == k).map(|(_, at)| *at);
+                (*k, at.unwrap_or(now))
+            })
+            .min_by_key(|(_, at)| *at)?;
+        (now - at > limit).then_some(kind)
     }
 }
 
