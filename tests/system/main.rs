@@ -4,6 +4,7 @@
 
 mod compare;
 mod hardening;
+mod leftovers;
 mod liveness;
 mod log_replay;
 mod python;

@@ -32,6 +32,7 @@ mod domain;
 mod fields;
 mod files;
 mod layout;
+mod leftovers;
 mod messages;
 mod node;
 mod reference;

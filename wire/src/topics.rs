@@ -2,6 +2,8 @@
 //! names and quality of service are decided.
 
 use std::fmt::Debug;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::Duration;
 
 use iceoryx2::node::NodeWaitFailure;
@@ -219,6 +221,23 @@ pub struct TopicSubscriber<T: Debug + ZeroCopySend + Copy + 'static> {
     listener: Option<Listener<ipc::Service>>,
 }
 
+/// SIGINT or SIGTERM seen by this process, kept by a handler of our own:
+/// iceoryx2 keeps only the last signal and clears it before some calls
+/// (zeroing a new segment, a listener's wait), so a Ctrl-C during start-up
+/// could be lost. Registered once the first node exists, after iceoryx2's
+/// own handler, which is still called.
+fn terminated() -> &'static AtomicBool {
+    static FLAG: OnceLock<Arc<AtomicBool>> = OnceLock::new();
+    FLAG.get_or_init(|| {
+        let flag = Arc::new(AtomicBool::new(false));
+        for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+            // Without it only iceoryx2's flag remains: worse, not fatal.
+            let _ = signal_hook::flag::register(sig, Arc::clone(&flag));
+        }
+        flag
+    })
+}
+
 impl Bus {
     /// Creates this process's node; `name` appears in iceoryx2's node list.
     pub fn new(prefix: &RunPrefix, name: &str) -> Result<Self, WireError> {
@@ -230,6 +249,7 @@ impl Bus {
             .config(&config)
             .create::<ipc::Service>()
             .map_err(|e| ipc("create node", name)(format!("{e:?}")))?;
+        terminated();
         Ok(Self {
             node,
             prefix: prefix.clone(),
@@ -238,6 +258,9 @@ impl Bus {
 
     /// Sleeps up to `timeout`; `Err(Terminated)` once SIGINT or SIGTERM arrived.
     pub fn wait(&self, timeout: Duration) -> Result<(), WireError> {
+        if terminated().load(Ordering::Relaxed) {
+            return Err(WireError::Terminated);
+        }
         match self.node.wait(timeout) {
             Ok(()) => Ok(()),
             Err(NodeWaitFailure::TerminationRequest) => Err(WireError::Terminated),

@@ -104,6 +104,11 @@ pub fn run(kind: NodeKind, args: &NodeArgs) -> Result<(), NodeRunError> {
             logger::node::run(&mut link, &config).map_err(NodeRunError::from)
         }
     };
+    // A node started by hand may be the last of its domain (no launcher to
+    // remove it): then it removes the domain, whichever way it ended.
+    if args.parent_pid.is_none() {
+        let _ = prefix.remove_domain_if_unused();
+    }
     match result {
         Err(e) if e.is_stop() => Ok(()),
         other => other,

@@ -142,6 +142,8 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     for stale in RunPrefix::stale_domains(&prefix) {
         let _ = stale.remove_domain_if_unused();
     }
+    // And the files of nodes killed while they were being created.
+    prefix.remove_leftover_files(false);
     let bus = Bus::new(&prefix, "launcher")?;
     let status = bus.subscriber::<NodeStatus>(Topic::Status)?;
     let control = bus.publisher::<Control>(Topic::Control, Delivery::DropWhenFull)?;
@@ -170,6 +172,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     // run's domain (including what a killed node left behind).
     drop((status, control, bus));
     let _ = prefix.remove_domain_if_unused();
+    prefix.remove_leftover_files(true);
     let wall_time_s = result?;
     if let Some((status, stderr)) = logger_exit.filter(|(s, _)| !s.success()) {
         // Killed by the launcher itself after STOP: say so, not "signal 9".
