@@ -17,11 +17,12 @@
 mod json;
 pub mod node;
 mod reader;
+mod records;
 mod scan;
 mod writer;
 
 pub use json::{DecodeError, Fields, LogMessage};
-pub use reader::{LogContents, MessageError, OnMessage, read_log};
+pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes};
 pub use writer::{LogWriter, RunMetadata};
 
 /// Name of the metadata record that describes the run.

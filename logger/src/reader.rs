@@ -3,7 +3,6 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
-use mcap::read::{ChunkFlattener, Options};
 use mcap::records::Record;
 
 use super::{DecodeError, LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
@@ -66,15 +65,22 @@ pub type OnMessage<'a> = &'a mut dyn FnMut(&str, &serde_json::Value) -> Result<(
 /// Reads `path` record by record, calling `on_message(topic, json)` (if
 /// given) for every message in file order. A truncated or unfinished file is
 /// read up to its last whole record; `cut_short` then says why it ended.
-pub fn read_log(
-    path: &Path,
-    mut on_message: Option<OnMessage<'_>>,
-) -> Result<LogContents, LogError> {
+pub fn read_log(path: &Path, on_message: Option<OnMessage<'_>>) -> Result<LogContents, LogError> {
     let p = path.display().to_string();
     let buf = wire::read_regular_file(path, None).map_err(|cause| LogError::Io {
         path: p.clone(),
         cause,
     })?;
+    read_log_bytes(&buf, path, on_message)
+}
+
+/// [`read_log`] of a log already in memory (`path` names it in messages).
+pub fn read_log_bytes(
+    buf: &[u8],
+    path: &Path,
+    mut on_message: Option<OnMessage<'_>>,
+) -> Result<LogContents, LogError> {
+    let p = path.display().to_string();
     if !buf.starts_with(mcap::MAGIC) {
         return Err(LogError::NotATestbedLog {
             path: p,
@@ -87,12 +93,8 @@ pub fn read_log(
     };
     let mut topics: HashMap<u16, String> = HashMap::new();
     // Only the soundly framed part goes to the reader (see `scan`).
-    let (end, damaged) = crate::scan::sound_prefix(&buf);
-    let records = ChunkFlattener::new_with_options(&buf[..end], Options::IgnoreEndMagic.into())
-        .map_err(|cause| LogError::Mcap {
-            path: p.clone(),
-            cause,
-        })?;
+    let (end, damaged) = crate::scan::sound_prefix(buf);
+    let records = crate::records::Records::new(&buf[..end]);
     for record in records {
         let record = match record {
             Ok(r) => r,
@@ -161,5 +163,29 @@ fn deliver(
             topic: topic.to_string(),
             cause,
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// Every input the fuzzer found a crash with (fuzz/regressions/log) is
+    /// read to a named error or a cut-short log, without a huge allocation.
+    #[test]
+    fn fuzz_regressions_read_without_a_crash() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/regressions/log");
+        let mut seen = 0;
+        for e in std::fs::read_dir(&dir).unwrap().flatten() {
+            let buf = std::fs::read(e.path()).unwrap();
+            let mut count = |_: &str, _: &serde_json::Value| Ok(());
+            match read_log_bytes(&buf, &e.path(), Some(&mut count)) {
+                Ok(c) => assert!(c.cut_short.is_some(), "{}", e.path().display()),
+                Err(err) => assert!(!err.to_string().is_empty()),
+            }
+            seen += 1;
+        }
+        assert!(seen >= 2, "the regression inputs are missing from {}", dir.display());
     }
 }

@@ -1,0 +1,22 @@
+//! A log file, read and every message decoded as `replay` does: any bytes
+//! give the log's contents (perhaps cut short) or a named error.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use logger::LogMessage;
+use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
+
+fuzz_target!(|data: &[u8]| {
+    let mut decode = |topic: &str, v: &serde_json::Value| {
+        let _ = match topic {
+            t if t == JointState::TOPIC => JointState::parse(v).map(|_| ()),
+            t if t == ReferenceSample::TOPIC => ReferenceSample::parse(v).map(|_| ()),
+            t if t == Command::TOPIC => Command::parse(v).map(|_| ()),
+            t if t == ControllerDiagnostics::TOPIC => ControllerDiagnostics::parse(v).map(|_| ()),
+            t if t == Timing::TOPIC => Timing::parse(v).map(|_| ()),
+            _ => Ok(()),
+        };
+        Ok(())
+    };
+    let _ = logger::read_log_bytes(data, std::path::Path::new("fuzz.mcap"), Some(&mut decode));
+});

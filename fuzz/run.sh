@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Runs every cargo-fuzz target for a bounded time (default 60 s each):
+#   bash fuzz/run.sh [SECONDS]
+# Seeds are fuzz/seeds/<target>; new inputs go to a scratch corpus. A crash
+# stops the run non-zero and leaves its input in fuzz/artifacts/<target>/
+# (keep it as a regression test, see fuzz/README.md).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-60}"
+command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
+# cargo-fuzz passes -Z sanitizer flags; this lets the one stable toolchain
+# of this machine accept them (no nightly can be installed here).
+export RUSTC_BOOTSTRAP=1
+scratch="$(mktemp -d)"
+trap 'rm -rf "$scratch"' EXIT
+for target in scenario urdf log; do
+    mkdir -p "$scratch/$target"
+    status=0
+    cargo fuzz run --fuzz-dir fuzz "$target" "$scratch/$target" "fuzz/seeds/$target" -- \
+        -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
+        >"$scratch/$target.log" 2>&1 || status=$?
+    # libFuzzer's progress lines stay in the log; the outcome is shown.
+    grep -E "^(Done|stat::number_of_executed_units|==[0-9]+==|SUMMARY|.*panicked|.*Test unit written|error)" \
+        "$scratch/$target.log" || true
+    if [ "$status" -ne 0 ]; then
+        tail -40 "$scratch/$target.log" >&2
+        echo "fuzz: target $target failed (status $status); its input is in fuzz/artifacts/$target/" >&2
+        exit 1
+    fi
+    echo "fuzz: $target ran clean for ${seconds} s"
+done
