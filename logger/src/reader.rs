@@ -186,6 +186,10 @@ mod tests {
             }
             seen += 1;
         }
-        assert!(seen >= 2, "the regression inputs are missing from {}", dir.display());
+        assert!(
+            seen >= 2,
+            "the regression inputs are missing from {}",
+            dir.display()
+        );
     }
 }

@@ -28,9 +28,7 @@ fn stop_node(mode: &str, secs: &str, node: &str) -> (String, serde_json::Value) 
     let (_, pid, prefix) = nodes.iter().find(|n| n.0 == node).unwrap().clone();
     wait_until_running(dir.path());
     kill(Pid::from_raw(pid as i32), Signal::SIGSTOP).unwrap();
-    let status = wait_bounded(&mut launcher, 60);
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
+    let (status, _, err) = crate::util::ended(&mut launcher, 60);
     assert!(!status.success(), "{err}");
     assert!(nodes_of(launcher.id()).is_empty(), "nodes left running");
     assert_eq!(shm_files(&prefix), Vec::<String>::new());
@@ -100,11 +98,7 @@ fn a_controller_stopped_and_continued_in_real_time_shows_its_misses() {
     // The stimulus: a freeze of one second (shorter than the 3 s limit).
     std::thread::sleep(Duration::from_secs(1));
     kill(Pid::from_raw(pid as i32), Signal::SIGCONT).unwrap();
-    let status = wait_bounded(&mut launcher, 60);
-    let mut out = String::new();
-    std::io::Read::read_to_string(&mut launcher.stdout.take().unwrap(), &mut out).unwrap();
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
+    let (status, out, err) = crate::util::ended(&mut launcher, 60);
     assert!(status.success(), "{err}");
     let s: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(s["run_end"], "finished");

@@ -182,9 +182,7 @@ fn a_crashing_python_controller_stops_the_run_with_its_last_words() {
         .spawn()
         .unwrap();
     let pid = child.id();
-    let status = wait_bounded(&mut child, 120);
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    let (status, _, err) = crate::util::ended(&mut child, 120);
     assert!(!status.success());
     assert!(err.contains("the controller node"), "{err}");
     assert!(err.contains("RuntimeError: boom at step 100"), "{err}");
@@ -231,9 +229,7 @@ fn kill_9_of_a_python_controller_is_named_and_leaves_nothing() {
         nix::sys::signal::Signal::SIGKILL,
     )
     .unwrap();
-    let status = wait_bounded(&mut child, 120);
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    let (status, _, err) = crate::util::ended(&mut child, 120);
     assert!(!status.success());
     assert!(
         err.contains("the controller node was killed by signal 9"),

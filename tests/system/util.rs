@@ -58,6 +58,25 @@ pub fn wait_bounded(child: &mut std::process::Child, secs: u64) -> std::process:
     }
 }
 
+/// Waits for `child` (watchdog: `secs`) and returns how it ended with
+/// what it wrote to its piped stdout and stderr (empty if not piped).
+pub fn ended(
+    child: &mut std::process::Child,
+    secs: u64,
+) -> (std::process::ExitStatus, String, String) {
+    let status = wait_bounded(child, secs);
+    let read = |r: Option<&mut dyn std::io::Read>| {
+        let mut out = String::new();
+        if let Some(r) = r {
+            r.read_to_string(&mut out).expect("read output");
+        }
+        out
+    };
+    let out = read(child.stdout.as_mut().map(|o| o as &mut dyn std::io::Read));
+    let err = read(child.stderr.as_mut().map(|e| e as &mut dyn std::io::Read));
+    (status, out, err)
+}
+
 /// Node processes started by launcher `pid`: (node name, pid, run prefix).
 pub fn nodes_of(launcher: u32) -> Vec<(String, u32, String)> {
     let mut out = Vec::new();
