@@ -10,7 +10,7 @@ use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 
 use crate::run_cli::{newest_log, wait_until_running};
-use crate::util::{nodes_of, ok, shm_files, testbed, wait_bounded, wait_for_nodes};
+use crate::util::{nodes_of, ok, shm_files, testbed, wait_for_nodes};
 
 /// Starts a run of `secs` in `mode`, stops node `node` once it is under way,
 /// and returns the launcher's stderr once it has ended (watchdog: 60 s)

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::OnceLock;
 
-use crate::util::{fails, json, ok, repo_root, shm_files, testbed, wait_bounded};
+use crate::util::{fails, json, ok, repo_root, shm_files, testbed};
 
 /// The virtual environment's python, set up once (python/setup-venv.sh
 /// installs the iceoryx2 wheel, numpy and the package; it locks against
