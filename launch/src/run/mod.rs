@@ -2,6 +2,7 @@
 //! processes, starts them together, watches them, and stops them in order.
 
 mod error;
+mod nodes;
 pub mod spawn;
 pub mod timing;
 
@@ -14,12 +15,13 @@ use std::time::{Duration, Instant};
 
 use scenario::Plan;
 use wire::{
-    Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, MAX_DOF, NODE_DONE, NODE_FAILED,
-    NODE_READY, NodeKind, NodeStatus, RunEnd, RunPrefix, Topic, WireError, monotonic_ns,
+    Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, MAX_DOF, NodeKind, NodeStatus,
+    RunEnd, RunPrefix, Topic, WireError, monotonic_ns,
 };
 
 use crate::analysis::{AnalyseOptions, LogAnalysis, analyse};
 use crate::mode::Mode;
+use nodes::NodeStates;
 use spawn::{Children, describe};
 
 /// The nodes `testbed run` starts, in start order (the logger first, so it
@@ -120,22 +122,7 @@ pub fn node_args(
 
 /// Runs the stack to the end.
 pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
-    let dof = opts.plan.robot.model.dof();
-    if dof > MAX_DOF {
-        return Err(RunError::TooManyJoints { dof });
-    }
-    // An unwritable CSV is refused before the run, not after it.
-    if let Some(path) = &opts.csv {
-        File::create(path).map_err(|e| RunError::Output(path.display().to_string(), e))?;
-    }
-    // A controller command that cannot start is refused before any node does.
-    if let Some(command) = &opts.controller_cmd {
-        spawn::check_program(command).map_err(|cause| RunError::Spawn {
-            node: NodeKind::Controller.name(),
-            command: shell_words::join(command),
-            cause,
-        })?;
-    }
+    check_up_front(&opts)?;
     let files = RunFiles::write(&opts)?;
     let prefix = RunPrefix::unique();
     // Domains that killed launchers left behind.
@@ -199,6 +186,26 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         wall_time_s,
         peak_rss_kb,
     })
+}
+
+/// What can be refused before anything starts: too many joints, an
+/// unwritable CSV (not after the run), a controller command that cannot run.
+fn check_up_front(opts: &RunOptions) -> Result<(), RunError> {
+    let dof = opts.plan.robot.model.dof();
+    if dof > MAX_DOF {
+        return Err(RunError::TooManyJoints { dof });
+    }
+    if let Some(path) = &opts.csv {
+        File::create(path).map_err(|e| RunError::Output(path.display().to_string(), e))?;
+    }
+    if let Some(command) = &opts.controller_cmd {
+        spawn::check_program(command).map_err(|cause| RunError::Spawn {
+            node: NodeKind::Controller.name(),
+            command: shell_words::join(command),
+            cause,
+        })?;
+    }
+    Ok(())
 }
 
 /// The run's folder: the scenario it runs, each node's config, the log's path.
@@ -347,28 +354,7 @@ fn supervise(
     children: &mut Children,
 ) -> Result<f64, RunError> {
     let plan = &opts.plan;
-    let mut nodes = NodeStates::default();
-    let limit = if opts.external.is_empty() {
-        START_TIMEOUT
-    } else {
-        EXTERNAL_START_TIMEOUT
-    };
-    let start_wait = Instant::now();
-    while NODES.iter().any(|k| !nodes.ready.contains(k)) {
-        tick(bus)?;
-        nodes.read(status)?;
-        check_children(children)?;
-        if start_wait.elapsed() > limit {
-            return Err(RunError::StartTimeout {
-                missing: NODES
-                    .iter()
-                    .filter(|k| !nodes.ready.contains(k))
-                    .map(|k| k.name())
-                    .collect(),
-                secs: limit.as_secs(),
-            });
-        }
-    }
+    let mut nodes = wait_for_ready(opts, bus, status, children)?;
 
     // Step 0 a little in the future, so every node is waiting for it.
     // On a whole multiple of the period: the plant's deadlines then fall on
@@ -431,74 +417,37 @@ fn supervise(
     Ok(wall.unwrap_or_else(|| started.elapsed().as_secs_f64()))
 }
 
-/// What the status topic has said so far.
-#[derive(Default)]
-struct NodeStates {
-    ready: Vec<NodeKind>,
-    done: Vec<NodeKind>,
-    plant_step: u64,
-    /// When each node was last heard from (any status: its heartbeat).
-    heard: Vec<(NodeKind, Instant)>,
-    /// When the launcher last looked, to tell its own pause from theirs.
-    looked: Option<Instant>,
-}
-
-impl NodeStates {
-    fn read(&mut self, status: &wire::TopicSubscriber<NodeStatus>) -> Result<(), RunError> {
-        while let Some(s) = status.receive()? {
-            let Some(kind) = NodeKind::from_u32(s.node) else {
-                continue;
-            };
-            if kind == NodeKind::Plant {
-                self.plant_step = self.plant_step.max(s.step);
-            }
-            match self.heard.iter_mut().find(|(k, _)| *k == kind) {
-                Some((_, at)) => *at = Instant::now(),
-                None => self.heard.push((kind, Instant::now())),
-            }
-            let list = match s.state {
-                NODE_READY => &mut self.ready,
-                NODE_DONE => &mut self.done,
-                NODE_FAILED => {
-                    return Err(RunError::NodeFailed {
-                        node: kind.name(),
-                        how: "reported a failure".into(),
-                        stderr: String::new(),
-                    });
-                }
-                _ => continue,
-            };
-            if !list.contains(&kind) {
-                list.push(kind);
-            }
+/// Waits until every node has reported READY (or fails: a node exited,
+/// or the start-up limit passed).
+fn wait_for_ready(
+    opts: &RunOptions,
+    bus: &Bus,
+    status: &wire::TopicSubscriber<NodeStatus>,
+    children: &mut Children,
+) -> Result<NodeStates, RunError> {
+    let mut nodes = NodeStates::default();
+    let limit = if opts.external.is_empty() {
+        START_TIMEOUT
+    } else {
+        EXTERNAL_START_TIMEOUT
+    };
+    let start_wait = Instant::now();
+    while NODES.iter().any(|k| !nodes.ready.contains(k)) {
+        tick(bus)?;
+        nodes.read(status)?;
+        check_children(children)?;
+        if start_wait.elapsed() > limit {
+            return Err(RunError::StartTimeout {
+                missing: NODES
+                    .iter()
+                    .filter(|k| !nodes.ready.contains(k))
+                    .map(|k| k.name())
+                    .collect(),
+                secs: limit.as_secs(),
+            });
         }
-        let _ = status.drain_events();
-        Ok(())
     }
-}
-
-impl NodeStates {
-    /// The node heard from least recently, if that was longer ago than
-    /// `limit`. A pause of the launcher itself (Ctrl-Z and `fg` of the whole
-    /// run, a paused VM) silences nobody: every node is then heard anew.
-    fn silent(&mut self, limit: Duration) -> Option<NodeKind> {
-        let now = Instant::now();
-        if self
-            .looked
-            .replace(now)
-            .is_some_and(|l| now - l > Duration::from_secs(1))
-        {
-            self.heard.iter_mut().for_each(|(_, at)| *at = now);
-        }
-        let (kind, at) = NODES
-            .iter()
-            .map(|k| {
-                let at = self.heard.iter().find(|(h, _)| h == k).map(|(_, at)| *at);
-                (*k, at.unwrap_or(now))
-            })
-            .min_by_key(|(_, at)| *at)?;
-        (now - at > limit).then_some(kind)
-    }
+    Ok(nodes)
 }
 
 /// Sleeps one tick; a SIGINT or SIGTERM turns into `Interrupted`.
