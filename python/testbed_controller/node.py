@@ -48,6 +48,7 @@ class NodeLink:
         self.stopped = False
         self.last_report = (0, 0)
         self.last_report_ns = 0
+        self.pending_start = None
 
     def report(self, state: int, step: int) -> None:
         self.last_report, self.last_report_ns = (state, step), time.monotonic_ns()
@@ -72,6 +73,10 @@ class NodeLink:
         while (c := self.control.receive()) is not None:
             if int(c["command"]) == wire.CONTROL_STOP:
                 self.stopped = True
+            elif int(c["command"]) == wire.CONTROL_START:
+                # Kept for the wait for START: a check between its polls
+                # must not swallow it.
+                self.pending_start = c
         if self.stopped:
             raise Stopped()
 
@@ -82,7 +87,9 @@ class NodeLink:
         while True:
             self.control.wait_event(0.05)
             self.control.drain_events()
-            c = self.control.receive()
+            c, self.pending_start = self.pending_start, None
+            if c is None:
+                c = self.control.receive()
             if c is not None:
                 command, code = int(c["command"]), int(c["code"])
                 if command == wire.CONTROL_START and code != want:

@@ -92,6 +92,8 @@ pub struct NodeLink {
     stop_seen: bool,
     stop_outcome: Option<u32>,
     mode: Mode,
+    /// START seen by [`NodeLink::check`] before the node waited for it.
+    pending_start: Option<Control>,
     /// The last state and step reported, repeated as the heartbeat.
     last_report: (u32, u64),
     last_report_ns: u64,
@@ -126,6 +128,7 @@ impl NodeLink {
             stop_seen: false,
             stop_outcome: None,
             mode,
+            pending_start: None,
             last_report: (0, 0),
             last_report_ns: 0,
         })
@@ -171,9 +174,15 @@ impl NodeLink {
             return Err(NodeError::ParentGone(pid));
         }
         while let Some(c) = self.control.receive()? {
-            if c.command == CONTROL_STOP {
-                self.stop_seen = true;
-                self.stop_outcome = Some(c.code);
+            match c.command {
+                CONTROL_STOP => {
+                    self.stop_seen = true;
+                    self.stop_outcome = Some(c.code);
+                }
+                // Kept for the wait for START: a check between its polls
+                // must not swallow it (the run would stall at step 0).
+                CONTROL_START => self.pending_start = Some(c),
+                _ => {}
             }
         }
         if self.stop_seen {
@@ -194,7 +203,11 @@ impl NodeLink {
         loop {
             self.control.wait_event(Duration::from_millis(50))?;
             self.control.drain_events()?;
-            if let Some(c) = self.control.receive()? {
+            let next = match self.pending_start.take() {
+                Some(c) => Some(c),
+                None => self.control.receive()?,
+            };
+            if let Some(c) = next {
                 match c.command {
                     CONTROL_START if c.code != self.mode.code() => {
                         // Say so, so that the launcher fails the run at once.
