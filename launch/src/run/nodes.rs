@@ -55,9 +55,7 @@ impl NodeStates {
         let _ = status.drain_events();
         Ok(())
     }
-}
 
-impl NodeStates {
     /// The node heard from least recently, if that was longer ago than
     /// `limit`. A pause of the launcher itself (Ctrl-Z and `fg` of the whole
     /// run, a paused VM) silences nobody: every node is then heard anew.
