@@ -43,7 +43,7 @@ pub use arm_model::{
     MimicJoint, MimicSpec, ModelError, Origin, TWO_LINK_URDF,
 };
 pub use config::{
-    ActuationConfig, DisturbanceConfig, FrictionConfig, PayloadConfig, PerJoint, PlantConfig,
+    ActuationConfig, EngineName, DisturbanceConfig, FrictionConfig, PayloadConfig, PerJoint, PlantConfig,
     SensorConfig,
 };
 pub use effects::Effects;

@@ -44,6 +44,7 @@ fn check(urdf: &str, seed: u64) {
     };
     let config = PlantConfig {
         saturate: false,
+        substeps: std::env::var("SUBSTEPS").ok().map(|s| s.parse().unwrap()),
         ..PlantConfig::default()
     };
     // At rest the damping force grows with the velocity during the step, so

@@ -3,7 +3,7 @@
 
 use rapier3d_f64::prelude::*;
 
-use super::{Coupled, Dof, pose};
+use super::rapier::{Coupled, Dof, pose};
 use crate::{PlantConfig, PlantError};
 use arm_model::{ArmModel, JointKind};
 
@@ -88,17 +88,9 @@ pub(super) fn couple_mimics(
     Ok(coupled)
 }
 
-/// URDF damping and dry friction on every moving joint (unless the scenario
-/// turns them off) and the scenario's armature on the controlled ones.
-pub(super) fn joint_dynamics(
-    model: &ArmModel,
-    config: &PlantConfig,
-    dofs: &[Dof],
-    coupled: &[Coupled],
-    joints: &mut MultibodyJointSet,
-    multibody: MultibodyJointHandle,
-) -> Result<(), PlantError> {
-    let armature = config.armature.resolve("plant.armature", dofs.len())?;
+/// Refuses a controlled joint whose acceleration is undefined: it moves no
+/// mass and has no armature.
+pub(super) fn refuse_massless(model: &ArmModel, armature: &[f64]) -> Result<(), PlantError> {
     let massless = model.joints_moving_no_mass();
     for (i, name) in model.joint_names().iter().enumerate() {
         if massless.contains(name) && armature[i] <= 0.0 {
@@ -112,6 +104,20 @@ pub(super) fn joint_dynamics(
             });
         }
     }
+    Ok(())
+}
+
+/// URDF damping and dry friction on every moving joint (unless the scenario
+/// turns them off) and the scenario's armature on the controlled ones.
+pub(super) fn joint_dynamics(
+    model: &ArmModel,
+    config: &PlantConfig,
+    armature: &[f64],
+    dofs: &[Dof],
+    coupled: &[Coupled],
+    joints: &mut MultibodyJointSet,
+    multibody: MultibodyJointHandle,
+) -> Result<(), PlantError> {
     let (mb, _) = joints
         .get_mut(multibody)
         .ok_or_else(|| PlantError::Engine("multibody vanished".into()))?;
@@ -126,7 +132,7 @@ pub(super) fn joint_dynamics(
             mb.frictions_mut()[a] = j.friction;
         }
     }
-    for (d, arm) in dofs.iter().zip(&armature) {
+    for (d, arm) in dofs.iter().zip(armature) {
         mb.armature_mut()[d.assembly_id] = *arm;
     }
     Ok(())

@@ -1,0 +1,150 @@
+//! Dry friction and hard stops as velocity impulses at the end of a substep,
+//! solved by projected Gauss–Seidel like Rapier's joint constraints: a
+//! friction impulse is bounded by the friction torque times the substep, a
+//! stop's only pushes back, and a stop is enforced once it is passed.
+
+use super::Follow;
+use super::linalg::Cholesky;
+
+/// Which way a stop pushes.
+#[derive(Debug, Clone, Copy)]
+enum Row {
+    /// Dry friction on a coordinate: |impulse| ≤ bound.
+    Friction { coord: usize, bound: f64 },
+    /// A passed lower (push ≥ 0) or upper (push ≤ 0) stop.
+    Stop { coord: usize, upper: bool },
+}
+
+/// The constraints of one arm, with scratch space.
+#[derive(Debug, Clone)]
+pub(super) struct Impulses {
+    /// Per full coordinate.
+    friction: Vec<f64>,
+    limits: Vec<Option<(f64, f64)>>,
+    rows: Vec<Row>,
+    lambda: Vec<f64>,
+    /// M⁻¹ e_j for each controlled joint j, filled when needed.
+    inverse: Vec<f64>,
+    /// The velocity change from friction alone.
+    friction_dv: Vec<f64>,
+    n: usize,
+}
+
+/// PGS sweeps: rows couple only through M⁻¹; a few sweeps converge for arms.
+const SWEEPS: usize = 8;
+
+impl Impulses {
+    pub(super) fn new(friction: Vec<f64>, limits: Vec<Option<(f64, f64)>>, n: usize) -> Self {
+        let rows = friction.len() + limits.len();
+        Self {
+            friction,
+            limits,
+            rows: Vec::with_capacity(rows),
+            lambda: Vec::with_capacity(rows),
+            inverse: vec![0.0; n * n],
+            friction_dv: vec![0.0; n],
+            n,
+        }
+    }
+
+    /// Whether anything may need an impulse after a substep that ends at q.
+    pub(super) fn needed(&self, follow: &[Follow], q: &[f64]) -> bool {
+        self.friction.iter().any(|f| *f > 0.0) || self.passed(follow, q).next().is_some()
+    }
+
+    /// Stops passed at q: (coordinate, upper, limit).
+    fn passed<'a>(
+        &'a self,
+        follow: &'a [Follow],
+        q: &'a [f64],
+    ) -> impl Iterator<Item = (usize, bool, f64)> + 'a {
+        self.limits
+            .iter()
+            .zip(follow)
+            .enumerate()
+            .filter_map(|(k, (l, f))| {
+                let (lo, hi) = (*l)?;
+                let x = f.multiplier * q[f.leader] + f.offset;
+                if x > hi {
+                    Some((k, true, hi))
+                } else if x < lo {
+                    Some((k, false, lo))
+                } else {
+                    None
+                }
+            })
+    }
+
+    /// Applies the impulses to q̇ (and friction's share of the substep to q),
+    /// then puts every passed stop's coordinate back at the stop. `m` holds
+    /// the factored inertia at the end of the substep.
+    pub(super) fn apply(
+        &mut self,
+        follow: &[Follow],
+        m: &Cholesky,
+        q: &mut [f64],
+        qd: &mut [f64],
+        h: f64,
+    ) {
+        let n = self.n;
+        self.rows.clear();
+        for (coord, f) in self.friction.iter().enumerate() {
+            if *f > 0.0 {
+                self.rows.push(Row::Friction {
+                    coord,
+                    bound: f * h,
+                });
+            }
+        }
+        let stops: Vec<(usize, bool, f64)> = self.passed(follow, q).collect();
+        for &(coord, upper, _) in &stops {
+            self.rows.push(Row::Stop { coord, upper });
+        }
+        for j in 0..n {
+            let col = &mut self.inverse[j * n..(j + 1) * n];
+            col.iter_mut().enumerate().for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
+            m.solve(col);
+        }
+        self.lambda.clear();
+        self.lambda.resize(self.rows.len(), 0.0);
+        self.friction_dv.iter_mut().for_each(|x| *x = 0.0);
+        for _ in 0..SWEEPS {
+            for (r, row) in self.rows.iter().enumerate() {
+                let coord = match *row {
+                    Row::Friction { coord, .. } | Row::Stop { coord, .. } => coord,
+                };
+                let f = follow[coord];
+                let col = &self.inverse[f.leader * n..(f.leader + 1) * n];
+                let w = f.multiplier * f.multiplier * col[f.leader];
+                let rate = f.multiplier * qd[f.leader];
+                let old = self.lambda[r];
+                let free = old - rate / w;
+                let new = match *row {
+                    Row::Friction { bound, .. } => free.clamp(-bound, bound),
+                    Row::Stop { upper: true, .. } => free.min(0.0),
+                    Row::Stop { upper: false, .. } => free.max(0.0),
+                };
+                self.lambda[r] = new;
+                let push = f.multiplier * (new - old);
+                for i in 0..n {
+                    qd[i] += col[i] * push;
+                    if matches!(row, Row::Friction { .. }) {
+                        self.friction_dv[i] += col[i] * push;
+                    }
+                }
+            }
+        }
+        // Friction acted over the substep: half its velocity change, times h,
+        // is its effect on q (exact for a constant torque).
+        for (q, dv) in q.iter_mut().zip(&self.friction_dv) {
+            *q += 0.5 * h * dv;
+        }
+        for (coord, _, limit) in stops {
+            let f = follow[coord];
+            if f.multiplier != 0.0 {
+                let x = f.multiplier * q[f.leader] + f.offset;
+                q[f.leader] += (limit - x) / f.multiplier;
+            }
+        }
+    }
+}

@@ -1,0 +1,309 @@
+//! The arm's equations of motion in joint coordinates, integrated with RK4:
+//! M(q) q̈ + h(q, q̇) = τ, with URDF damping, dry friction and hard stops.
+//!
+//! Rapier steps a multibody through its whole pipeline (islands, constraint
+//! assembly, a first-order integrator), which for an arm without colliders
+//! costs most of a control period and needs substeps for accuracy. This
+//! engine evaluates only what a serial or branched arm needs and integrates
+//! with a fourth-order method, so one substep per millisecond is far more
+//! accurate than Rapier's six. Mimic joints are reduced into their leader's
+//! coordinate; dry friction and hard stops act as impulses at the end of a
+//! substep, as Rapier's velocity constraints do.
+
+mod constraints;
+mod linalg;
+mod spatial;
+mod tree;
+
+use nalgebra::Vector3;
+
+use crate::PlantError;
+use arm_model::ArmModel;
+use constraints::Impulses;
+use linalg::Cholesky;
+use spatial::Inertia;
+use tree::Tree;
+
+/// How one full coordinate (controlled or mimic) follows the controlled ones:
+/// q_full = multiplier · q[leader] + offset.
+#[derive(Debug, Clone, Copy)]
+struct Follow {
+    leader: usize,
+    multiplier: f64,
+    offset: f64,
+}
+
+/// The generalised torque on the controlled joints for a joint velocity:
+/// what the motors, the disturbance and the friction model add.
+pub(crate) trait Drive {
+    /// τ(q̇) into `out` (length `dof`).
+    fn torque(&self, qd: &[f64], out: &mut [f64]);
+}
+
+/// An arm in joint coordinates.
+#[derive(Debug, Clone)]
+pub(crate) struct Articulated {
+    tree: Tree,
+    follow: Vec<Follow>,
+    gravity: Vector3<f64>,
+    /// Per controlled joint.
+    armature: Vec<f64>,
+    /// Per full coordinate: URDF viscous damping.
+    damping: Vec<f64>,
+    impulses: Impulses,
+    link_inertia: Vec<Inertia>,
+    /// An upper bound on the fastest decay rate damping gives the arm,
+    /// 1/s: RK4 is stable and accurate while a substep times it stays ≤ 1.
+    damping_rate: f64,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    scratch: Scratch,
+}
+
+/// Buffers for one evaluation and the RK4 stages, allocated once.
+#[derive(Debug, Clone)]
+struct Scratch {
+    qf: Vec<f64>,
+    qdf: Vec<f64>,
+    hf: Vec<f64>,
+    mf: Vec<f64>,
+    tau: Vec<f64>,
+    chol: Cholesky,
+    q0: Vec<f64>,
+    qd0: Vec<f64>,
+    k_q: [Vec<f64>; 4],
+    k_qd: [Vec<f64>; 4],
+}
+
+/// What the engine needs from the model beyond its tree.
+pub(crate) struct Setup<'a> {
+    pub(crate) gravity: [f64; 3],
+    pub(crate) armature: &'a [f64],
+    pub(crate) urdf_dynamics: bool,
+    /// Viscous damping the plant adds per controlled joint (the friction
+    /// model's slope at rest), for the substep bound.
+    pub(crate) extra_damping: &'a [f64],
+}
+
+impl Articulated {
+    /// The arm of `model` at rest at q = 0.
+    pub(crate) fn new(model: &ArmModel, setup: &Setup) -> Result<Self, PlantError> {
+        let n = model.dof();
+        let tree = Tree::new(model);
+        let nf = tree.coords();
+        let follow: Vec<Follow> = (0..n)
+            .map(|i| Follow {
+                leader: i,
+                multiplier: 1.0,
+                offset: 0.0,
+            })
+            .chain(model.mimic.iter().map(|m| Follow {
+                leader: m.leader,
+                multiplier: m.multiplier,
+                offset: m.offset,
+            }))
+            .collect();
+        let moving: Vec<usize> = model.moving_joints().collect();
+        let of = |f: fn(&arm_model::JointInfo) -> f64| -> Vec<f64> {
+            moving
+                .iter()
+                .map(|&ji| {
+                    if setup.urdf_dynamics {
+                        f(&model.joints[ji])
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        };
+        let limits = moving.iter().map(|&ji| model.joints[ji].limits).collect();
+        let mut arm = Self {
+            impulses: Impulses::new(of(|j| j.friction), limits, n),
+            damping: of(|j| j.damping),
+            link_inertia: model.links.iter().map(tree::link_inertia).collect(),
+            tree,
+            follow,
+            gravity: Vector3::from(setup.gravity),
+            armature: setup.armature.to_vec(),
+            damping_rate: 0.0,
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            scratch: Scratch {
+                qf: vec![0.0; nf],
+                qdf: vec![0.0; nf],
+                hf: vec![0.0; nf],
+                mf: vec![0.0; nf * nf],
+                tau: vec![0.0; n],
+                chol: Cholesky::new(n),
+                q0: vec![0.0; n],
+                qd0: vec![0.0; n],
+                k_q: std::array::from_fn(|_| vec![0.0; n]),
+                k_qd: std::array::from_fn(|_| vec![0.0; n]),
+            },
+        };
+        // A singular M at the start is a model no step can integrate.
+        let (q, qd) = (arm.q.clone(), arm.qd.clone());
+        arm.factor_mass(&q, &qd)?;
+        arm.damping_rate = arm.rate_of(setup.extra_damping);
+        Ok(arm)
+    }
+
+    /// Joint positions and velocities.
+    pub(crate) fn state(&self) -> (&[f64], &[f64]) {
+        (&self.q, &self.qd)
+    }
+
+    /// Puts the arm at `q`, `qd`.
+    pub(crate) fn set_state(&mut self, q: &[f64], qd: &[f64]) {
+        self.q.copy_from_slice(q);
+        self.qd.copy_from_slice(qd);
+    }
+
+    /// Adds a point mass to link `link` at `point` (its frame), replacing
+    /// an earlier one there.
+    pub(crate) fn attach_point_mass(&mut self, link: usize, point: [f64; 3], mass: f64) -> bool {
+        let Some(base) = self.link_inertia.get(link) else {
+            return false;
+        };
+        let payload = Inertia::from_com(mass, Vector3::from(point), nalgebra::Matrix3::zeros());
+        self.tree.set_link_inertia(link, base.add(&payload));
+        true
+    }
+
+    /// Advances by `dt` in `substeps` RK4 steps with the torque `drive`.
+    pub(crate) fn step(
+        &mut self,
+        drive: &dyn Drive,
+        dt: f64,
+        substeps: u32,
+    ) -> Result<(), PlantError> {
+        // Stiff damping (a light link on a damped joint) needs more substeps
+        // than the scenario asked for: RK4 is explicit.
+        let substeps = substeps.max((dt * self.damping_rate).ceil().min(1e6) as u32);
+        let h = dt / f64::from(substeps);
+        for _ in 0..substeps {
+            self.rk4(drive, h)?;
+            self.constrain(h)?;
+        }
+        Ok(())
+    }
+
+    fn rk4(&mut self, drive: &dyn Drive, h: f64) -> Result<(), PlantError> {
+        let s = &mut self.scratch;
+        s.q0.copy_from_slice(&self.q);
+        s.qd0.copy_from_slice(&self.qd);
+        for stage in 0..4 {
+            let frac = [0.0, 0.5, 0.5, 1.0][stage];
+            let (mut q, mut qd) = (std::mem::take(&mut self.q), std::mem::take(&mut self.qd));
+            if stage > 0 {
+                let s = &self.scratch;
+                for i in 0..q.len() {
+                    q[i] = s.q0[i] + frac * h * s.k_q[stage - 1][i];
+                    qd[i] = s.qd0[i] + frac * h * s.k_qd[stage - 1][i];
+                }
+            }
+            let mut qdd = std::mem::take(&mut self.scratch.k_qd[stage]);
+            let done = self.acceleration(drive, &q, &qd, &mut qdd);
+            self.scratch.k_qd[stage] = qdd;
+            self.scratch.k_q[stage].copy_from_slice(&qd);
+            (self.q, self.qd) = (q, qd);
+            done?;
+        }
+        let s = &self.scratch;
+        for i in 0..self.armature.len() {
+            let dq = s.k_q[0][i] + 2.0 * (s.k_q[1][i] + s.k_q[2][i]) + s.k_q[3][i];
+            let dqd = s.k_qd[0][i] + 2.0 * (s.k_qd[1][i] + s.k_qd[2][i]) + s.k_qd[3][i];
+            self.q[i] = s.q0[i] + h / 6.0 * dq;
+            self.qd[i] = s.qd0[i] + h / 6.0 * dqd;
+        }
+        Ok(())
+    }
+
+    /// q̈ = M⁻¹ (τ(q̇) − h − D q̇) at (q, q̇).
+    fn acceleration(
+        &mut self,
+        drive: &dyn Drive,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &mut [f64],
+    ) -> Result<(), PlantError> {
+        self.factor_mass(q, qd)?;
+        let s = &mut self.scratch;
+        drive.torque(qd, &mut s.tau);
+        for (k, f) in self.follow.iter().enumerate() {
+            let damping = self.damping[k] * s.qdf[k];
+            s.tau[f.leader] -= f.multiplier * (s.hf[k] + damping);
+        }
+        qdd.copy_from_slice(&s.tau);
+        s.chol.solve(qdd);
+        Ok(())
+    }
+
+    /// Evaluates the tree at (q, q̇) and factors the reduced M(q) + armature.
+    fn factor_mass(&mut self, q: &[f64], qd: &[f64]) -> Result<(), PlantError> {
+        let s = &mut self.scratch;
+        for (k, f) in self.follow.iter().enumerate() {
+            s.qf[k] = f.multiplier * q[f.leader] + f.offset;
+            s.qdf[k] = f.multiplier * qd[f.leader];
+        }
+        self.tree
+            .dynamics(&s.qf, &s.qdf, self.gravity, &mut s.hf, &mut s.mf);
+        let nf = self.follow.len();
+        let m = s.chol.matrix_mut();
+        m.iter_mut().for_each(|x| *x = 0.0);
+        let n = self.armature.len();
+        for (k, fk) in self.follow.iter().enumerate() {
+            for (l, fl) in self.follow.iter().enumerate() {
+                m[fk.leader * n + fl.leader] += fk.multiplier * fl.multiplier * s.mf[k * nf + l];
+            }
+        }
+        for (i, a) in self.armature.iter().enumerate() {
+            m[i * n + i] += a;
+        }
+        s.chol.factor().map_err(|row| {
+            PlantError::Engine(format!(
+                "the joint-space inertia is singular at joint {row} (q = {q:?})"
+            ))
+        })
+    }
+
+    /// trace(M⁻¹ D) at the factored posture, D the URDF damping (mapped to
+    /// the controlled joints) plus `extra`: an upper bound on the largest
+    /// eigenvalue of M⁻¹ D, since D is positive semi-definite.
+    fn rate_of(&self, extra: &[f64]) -> f64 {
+        let n = self.armature.len();
+        let mut inverse_diagonal = vec![0.0; n];
+        let mut e = vec![0.0; n];
+        for (j, d) in inverse_diagonal.iter_mut().enumerate() {
+            e.iter_mut().enumerate().for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
+            self.scratch.chol.solve(&mut e);
+            *d = e[j];
+        }
+        let urdf: f64 = self
+            .follow
+            .iter()
+            .zip(&self.damping)
+            .map(|(f, d)| d * f.multiplier * f.multiplier * inverse_diagonal[f.leader])
+            .sum();
+        urdf + extra
+            .iter()
+            .zip(&inverse_diagonal)
+            .map(|(d, m)| d * m)
+            .sum::<f64>()
+    }
+
+    /// Dry friction and hard stops as impulses at the end of a substep.
+    fn constrain(&mut self, h: f64) -> Result<(), PlantError> {
+        if !self.impulses.needed(&self.follow, &self.q) {
+            return Ok(());
+        }
+        let (mut q, mut qd) = (std::mem::take(&mut self.q), std::mem::take(&mut self.qd));
+        let factored = self.factor_mass(&q, &qd);
+        if factored.is_ok() {
+            let chol = &self.scratch.chol;
+            self.impulses.apply(&self.follow, chol, &mut q, &mut qd, h);
+        }
+        (self.q, self.qd) = (q, qd);
+        factored
+    }
+}

@@ -1,0 +1,253 @@
+//! The arm as a Rapier multibody, stepped through Rapier's whole pipeline
+//! (`plant.engine = "rapier"`): the reference the articulated engine is
+//! checked against, and the engine to reach for when Rapier's own joint
+//! constraints are what is being studied.
+
+use rapier3d_f64::glamx::EulerRot;
+use rapier3d_f64::prelude::*;
+
+use super::articulated::Drive;
+use super::build::{
+    couple_mimics, dof_of, insert_bodies, insert_joints, joint_dynamics, settle,
+};
+use crate::{PlantConfig, PlantError};
+use arm_model::{ArmModel, Origin};
+
+/// Where one actuated joint lives inside the Rapier multibody.
+#[derive(Debug, Clone)]
+pub(super) struct Dof {
+    pub(super) link_id: usize,
+    pub(super) assembly_id: usize,
+    /// Index into the joint's 6-vector of coordinates (LinX = 0, AngX = 3).
+    pub(super) coord: usize,
+    pub(super) prismatic: bool,
+    pub(super) parent: RigidBodyHandle,
+    pub(super) child: RigidBodyHandle,
+    /// Joint axis in the parent body's frame.
+    pub(super) axis_in_parent: Vector,
+}
+
+/// A joint that follows a controlled one by `<mimic>`: where it lives and
+/// how it is coupled, to keep `set_state` consistent with the coupling.
+#[derive(Debug, Clone)]
+pub(super) struct Coupled {
+    pub(super) link_id: usize,
+    pub(super) assembly_id: usize,
+    pub(super) coord: usize,
+    pub(super) leader: usize,
+    pub(super) multiplier: f64,
+    pub(super) offset: f64,
+}
+
+/// An arm simulated by Rapier in double precision.
+pub(crate) struct RapierArm {
+    world: PhysicsWorld,
+    multibody: MultibodyJointHandle,
+    dofs: Vec<Dof>,
+    coupled: Vec<Coupled>,
+    bodies: Vec<RigidBodyHandle>,
+    /// Each link's own mass properties, before any payload.
+    link_mprops: Vec<MassProperties>,
+    /// Scratch: joint velocities and the torque Rapier is given per substep.
+    qd: Vec<f64>,
+    total: Vec<f64>,
+}
+
+pub(super) fn pose(o: &Origin) -> Pose {
+    Pose::from_parts(
+        Vector::new(o.xyz[0], o.xyz[1], o.xyz[2]),
+        Rotation::from_euler(EulerRot::ZYX, o.rpy[2], o.rpy[1], o.rpy[0]),
+    )
+}
+
+impl RapierArm {
+    /// Builds the multibody for `model` at q = 0, q̇ = 0.
+    pub(crate) fn new(
+        model: &ArmModel,
+        config: &PlantConfig,
+        armature: &[f64],
+    ) -> Result<Self, PlantError> {
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::new(config.gravity[0], config.gravity[1], config.gravity[2]);
+        // One solver pass per call; accuracy comes from stepping `substeps`
+        // times per period with the torque re-applied about the current axes.
+        world.integration_parameters.num_solver_iterations = 1;
+        let (handles, link_mprops) = insert_bodies(&mut world, model);
+        let multibody = insert_joints(&mut world, model, &handles)?;
+        let PhysicsWorld {
+            bodies,
+            multibody_joints,
+            ..
+        } = &mut world;
+        settle(bodies, multibody_joints, multibody)?;
+        let dofs = model
+            .actuated
+            .iter()
+            .map(|&ji| dof_of(model, ji, &handles, multibody_joints, multibody))
+            .collect::<Result<Vec<_>, _>>()?;
+        let coupled = couple_mimics(model, &dofs, &handles, multibody_joints, multibody)?;
+        let ndofs = multibody_joints
+            .get(multibody)
+            .map(|(mb, _)| mb.ndofs())
+            .unwrap_or(0);
+        if ndofs != dofs.len() + coupled.len() {
+            return Err(PlantError::Engine(format!(
+                "the multibody has {ndofs} degrees of freedom but the URDF {} moving joints",
+                dofs.len() + coupled.len()
+            )));
+        }
+        let parts = (&dofs[..], &coupled[..]);
+        joint_dynamics(model, config, armature, parts.0, parts.1, multibody_joints, multibody)?;
+        let n = dofs.len();
+        Ok(Self {
+            world,
+            multibody,
+            dofs,
+            coupled,
+            bodies: handles,
+            link_mprops,
+            qd: vec![0.0; n],
+            total: vec![0.0; n],
+        })
+    }
+
+    fn mb(&self) -> &Multibody {
+        // The handle was checked at construction and joints are never removed.
+        match self.world.multibody_joints.get(self.multibody) {
+            Some((mb, _)) => mb,
+            None => unreachable!("multibody handle checked at construction"),
+        }
+    }
+
+    /// Joint positions and velocities into `q` and `qd`.
+    pub(crate) fn state_into(&self, q: &mut [f64], qd: &mut [f64]) {
+        let mb = self.mb();
+        let v = mb.generalized_velocity();
+        for (i, d) in self.dofs.iter().enumerate() {
+            q[i] = mb
+                .link(d.link_id)
+                .map_or(f64::NAN, |l| l.joint().coords()[d.coord]);
+            qd[i] = v[d.assembly_id];
+        }
+    }
+
+    /// Puts the arm at `q`, `qd` (both checked by the caller).
+    pub(crate) fn set_state(&mut self, q: &[f64], qd: &[f64]) -> Result<(), PlantError> {
+        let PhysicsWorld {
+            bodies,
+            multibody_joints,
+            ..
+        } = &mut self.world;
+        let Some((mb, _)) = multibody_joints.get_mut(self.multibody) else {
+            return Err(PlantError::Engine("multibody vanished".into()));
+        };
+        let targets = self
+            .dofs
+            .iter()
+            .enumerate()
+            .map(|(i, d)| (d.link_id, d.coord, q[i]))
+            .chain(
+                self.coupled
+                    .iter()
+                    .map(|c| (c.link_id, c.coord, c.multiplier * q[c.leader] + c.offset)),
+            );
+        for (link_id, coord, target) in targets {
+            if let Some(link) = mb.link_mut(link_id) {
+                let now = link.joint().coords()[coord];
+                link.joint.apply_displacement(&[target - now]);
+            }
+        }
+        mb.forward_kinematics(bodies, false);
+        mb.update_rigid_bodies(bodies, true);
+        let mut v = mb.generalized_velocity_mut();
+        for (i, d) in self.dofs.iter().enumerate() {
+            v[d.assembly_id] = qd[i];
+        }
+        for c in &self.coupled {
+            v[c.assembly_id] = c.multiplier * qd[c.leader];
+        }
+        Ok(())
+    }
+
+    /// Advances by `dt` in `substeps` Rapier steps, the torque re-evaluated
+    /// (friction follows the velocity) and re-applied about the current axes
+    /// before each.
+    pub(crate) fn step(&mut self, drive: &dyn Drive, dt: f64, substeps: u32) {
+        self.world.integration_parameters.dt = dt / f64::from(substeps);
+        for _ in 0..substeps {
+            let mut qd = std::mem::take(&mut self.qd);
+            let v = self.mb().generalized_velocity();
+            for (x, d) in qd.iter_mut().zip(&self.dofs) {
+                *x = v[d.assembly_id];
+            }
+            let mut total = std::mem::take(&mut self.total);
+            drive.torque(&qd, &mut total);
+            self.apply_torques(&total);
+            (self.qd, self.total) = (qd, total);
+            self.world.step();
+        }
+    }
+
+    /// Fixes a point mass to link `link` at `point` in its frame, replacing
+    /// any earlier one there.
+    pub(crate) fn attach_point_mass(
+        &mut self,
+        link: usize,
+        point: [f64; 3],
+        mass: f64,
+    ) -> Result<(), PlantError> {
+        let (Some(handle), Some(base)) = (self.bodies.get(link), self.link_mprops.get(link)) else {
+            return Err(PlantError::Engine(format!("no link with index {link}")));
+        };
+        let payload = MassProperties::new(
+            Vector::new(point[0], point[1], point[2]),
+            mass,
+            Vector::ZERO,
+        );
+        let total = *base + payload;
+        let body = self
+            .world
+            .bodies
+            .get_mut(*handle)
+            .ok_or_else(|| PlantError::Engine(format!("link {link} has no body")))?;
+        body.set_additional_mass_properties(total, true);
+        Ok(())
+    }
+
+    /// Rapier has no generalized-force input for multibody joints: a joint
+    /// torque is an equal and opposite torque about the joint's current
+    /// world axis on child and parent (a force pair at one point for a
+    /// prismatic joint). User forces persist across steps, so reset first.
+    fn apply_torques(&mut self, tau: &[f64]) {
+        let bodies = &mut self.world.bodies;
+        for h in &self.bodies {
+            if let Some(b) = bodies.get_mut(*h) {
+                b.reset_forces(false);
+                b.reset_torques(false);
+            }
+        }
+        for (d, &t) in self.dofs.iter().zip(tau) {
+            let Some(parent) = bodies.get(d.parent) else {
+                continue;
+            };
+            let axis = parent.position().rotation * d.axis_in_parent;
+            if d.prismatic {
+                let Some(child) = bodies.get_mut(d.child) else {
+                    continue;
+                };
+                let point = child.center_of_mass();
+                child.add_force_at_point(axis * t, point, true);
+                if let Some(p) = bodies.get_mut(d.parent) {
+                    p.add_force_at_point(-axis * t, point, true);
+                }
+            } else {
+                if let Some(child) = bodies.get_mut(d.child) {
+                    child.add_torque(axis * t, true);
+                }
+                if let Some(p) = bodies.get_mut(d.parent) {
+                    p.add_torque(-axis * t, true);
+                }
+            }
+        }
+    }
+}
