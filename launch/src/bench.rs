@@ -57,6 +57,9 @@ pub enum BenchError {
     /// A multi-process run failed.
     #[error(transparent)]
     Run(#[from] RunError),
+    /// The Python + MuJoCo loop of `--peer` failed.
+    #[error("bench --peer: {0}")]
+    Peer(String),
 }
 
 /// The machine the bench ran on.
@@ -146,7 +149,8 @@ pub struct BenchReport {
     pub arms: Vec<ArmBench>,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+/// The median (the upper one of an even count; 0 when empty).
+pub fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
@@ -262,7 +266,7 @@ pub(crate) fn load(robot: Option<&Path>, opts: &BenchOptions) -> Result<Plan, Be
     )?)
 }
 
-fn stack(
+pub(crate) fn stack(
     plan: &Plan,
     mode: Mode,
     opts: &BenchOptions,

@@ -13,6 +13,7 @@ pub mod analysis;
 pub mod assemble;
 pub mod bench;
 pub mod bench_controller;
+pub mod bench_peer;
 pub mod bindings;
 pub mod compare;
 pub mod compare_plots;

@@ -4,7 +4,7 @@
 
 mod common;
 
-use plant_rapier::{ArmModel, Plant, PlantConfig, PlantError, TWO_LINK_URDF};
+use plant_rapier::{ArmModel, EngineName, Plant, PlantConfig, PlantError, TWO_LINK_URDF};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -12,9 +12,19 @@ use std::f64::consts::{FRAC_PI_2, PI};
 const DT: f64 = 1e-3;
 
 fn plant(urdf: &str) -> Plant {
-    let model = ArmModel::from_urdf_str(urdf).unwrap();
-    Plant::new(&model, &PlantConfig::default()).unwrap()
+    engine_plant(urdf, EngineName::default())
 }
+
+fn engine_plant(urdf: &str, engine: EngineName) -> Plant {
+    let model = ArmModel::from_urdf_str(urdf).unwrap();
+    let config = PlantConfig {
+        engine,
+        ..PlantConfig::default()
+    };
+    Plant::new(&model, &config).unwrap()
+}
+
+const ENGINES: [EngineName; 2] = [EngineName::Articulated, EngineName::Rapier];
 
 /// The same arm with continuous joints: RK4 knows no hard stops, so a long
 /// passive swing is compared on this one.
@@ -80,70 +90,76 @@ fn mass_matrix_columns_at_random_states() {
     }
 }
 
-/// At random moving states with random torques, Rapier's mean acceleration
-/// over one period matches RK4's (the exact mean acceleration of the closed
-/// form, to 1e-12). Rapier's semi-implicit Euler is first order in the
-/// substep: measured worst error 1.5e-3 of the largest acceleration at the
-/// default 6 substeps (1.2e-3 at 8, 2.3e-3 at 4, 7.5e-3 at 1). The bound
-/// 2e-3 leaves margin for other states while still catching a missing
-/// Coriolis term (which is of order 1 here, with |q̇| up to 4 rad/s).
+/// At random moving states with random torques, the plant's mean
+/// acceleration over one period matches RK4's (the exact mean acceleration
+/// of the closed form, to 1e-12). The articulated engine is RK4 itself on
+/// its own equations: measured worst error 4e-10 of the largest
+/// acceleration with one substep. Rapier's semi-implicit Euler is first
+/// order in the substep: 1.5e-3 at its default 6 (1.2e-3 at 8, 2.3e-3 at
+/// 4, 7.5e-3 at 1). A missing Coriolis term is of order 1 here (|q̇| up
+/// to 4 rad/s), so both bounds catch one.
 #[test]
 fn one_step_acceleration_at_random_states() {
-    let mut rng = ChaCha8Rng::seed_from_u64(3);
-    let mut p = plant(&continuous());
-    for _ in 0..200 {
-        let q = [rng.random_range(-PI..PI), rng.random_range(-PI..PI)];
-        let qd = [rng.random_range(-4.0..4.0), rng.random_range(-4.0..4.0)];
-        let tau = [rng.random_range(-20.0..20.0), rng.random_range(-8.0..8.0)];
-        let a = mean_accel(&mut p, q, qd, tau);
-        let (_, v) = common::rk4(q, qd, tau, DT, 100);
-        let reference = [(v[0] - qd[0]) / DT, (v[1] - qd[1]) / DT];
-        let a0 = common::accel(q, qd, tau);
-        let scale = a0[0].abs().max(a0[1].abs()).max(1.0);
-        for i in 0..2 {
-            assert!(
-                (a[i] - reference[i]).abs() < 2e-3 * scale,
-                "q = {q:?}, q̇ = {qd:?}, τ = {tau:?}: {a:?} vs {reference:?}"
-            );
+    for (engine, bound) in [(EngineName::Articulated, 1e-8), (EngineName::Rapier, 2e-3)] {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut p = engine_plant(&continuous(), engine);
+        let mut worst: f64 = 0.0;
+        for _ in 0..200 {
+            let q = [rng.random_range(-PI..PI), rng.random_range(-PI..PI)];
+            let qd = [rng.random_range(-4.0..4.0), rng.random_range(-4.0..4.0)];
+            let tau = [rng.random_range(-20.0..20.0), rng.random_range(-8.0..8.0)];
+            let a = mean_accel(&mut p, q, qd, tau);
+            let (_, v) = common::rk4(q, qd, tau, DT, 100);
+            let reference = [(v[0] - qd[0]) / DT, (v[1] - qd[1]) / DT];
+            let a0 = common::accel(q, qd, tau);
+            let scale = a0[0].abs().max(a0[1].abs()).max(1.0);
+            for i in 0..2 {
+                worst = worst.max((a[i] - reference[i]).abs() / scale);
+            }
         }
+        assert!(worst < bound, "{engine:?}: worst relative error {worst:e}");
     }
 }
 
 /// The default substeps keep a 5 s passive swing near the hanging posture
-/// within 1e-3 rad of RK4 (measured 3.9e-5 at 6 substeps, 2.9e-5 at 8; the
-/// error is first order in the substep).
+/// within 1e-4 rad of RK4 (measured 3.9e-5 for Rapier at 6 substeps, its
+/// error first order in the substep; 1e-9 for the articulated engine).
 #[test]
 fn open_loop_swing_near_hanging_tracks_rk4_for_5_s() {
-    let mut p = plant(&continuous());
     let q0 = [-FRAC_PI_2 + 0.3, 0.2];
-    p.set_state(&q0, &[0.0; 2]).unwrap();
-    for _ in 0..5000 {
-        p.step(&[0.0; 2], DT).unwrap();
-    }
-    let (q, _) = p.state();
     let (r, _) = common::rk4(q0, [0.0; 2], [0.0; 2], 5.0, 50_000);
-    assert!(
-        (q[0] - r[0]).abs() < 1e-3 && (q[1] - r[1]).abs() < 1e-3,
-        "{q:?} vs {r:?}"
-    );
+    for (engine, bound) in [(EngineName::Articulated, 1e-8), (EngineName::Rapier, 1e-4)] {
+        let mut p = engine_plant(&continuous(), engine);
+        p.set_state(&q0, &[0.0; 2]).unwrap();
+        for _ in 0..5000 {
+            p.step(&[0.0; 2], DT).unwrap();
+        }
+        let (q, _) = p.state();
+        assert!(
+            (q[0] - r[0]).abs() < bound && (q[1] - r[1]).abs() < bound,
+            "{engine:?}: {q:?} vs {r:?}"
+        );
+    }
 }
 
 /// From the paper's initial state the passive arm is chaotic, so errors
-/// grow fast; over 0.25 s the measured gap is 5.4e-4 rad at 6 substeps
-/// (4.1e-4 at 8).
+/// grow fast; over 0.25 s the measured gap is 5.4e-4 rad for Rapier at 6
+/// substeps (4.1e-4 at 8).
 #[test]
 fn open_loop_from_paper_state_tracks_rk4_briefly() {
-    let mut p = plant(&continuous());
-    p.set_state(&[0.6, 1.8], &[0.0; 2]).unwrap();
-    for _ in 0..250 {
-        p.step(&[0.0; 2], DT).unwrap();
-    }
-    let (q, _) = p.state();
     let (r, _) = common::rk4([0.6, 1.8], [0.0; 2], [0.0; 2], 0.25, 2500);
-    assert!(
-        (q[0] - r[0]).abs() < 1e-3 && (q[1] - r[1]).abs() < 1e-3,
-        "{q:?} vs {r:?}"
-    );
+    for (engine, bound) in [(EngineName::Articulated, 1e-8), (EngineName::Rapier, 1e-3)] {
+        let mut p = engine_plant(&continuous(), engine);
+        p.set_state(&[0.6, 1.8], &[0.0; 2]).unwrap();
+        for _ in 0..250 {
+            p.step(&[0.0; 2], DT).unwrap();
+        }
+        let (q, _) = p.state();
+        assert!(
+            (q[0] - r[0]).abs() < bound && (q[1] - r[1]).abs() < bound,
+            "{engine:?}: {q:?} vs {r:?}"
+        );
+    }
 }
 
 /// No hidden joint damping: a passive swing keeps its energy (semi-implicit
@@ -169,16 +185,21 @@ fn passive_swing_keeps_its_energy() {
 #[test]
 fn a_hard_stop_holds_the_joint_at_its_limit() {
     // joint2 falls toward -π from a near-folded pose and must not pass the stop.
-    let mut p = plant(TWO_LINK_URDF);
-    p.set_state(&[FRAC_PI_2, -3.0], &[0.0, -3.0]).unwrap();
-    let mut lowest = f64::INFINITY;
-    for _ in 0..500 {
-        p.step(&[0.0, -5.0], DT).unwrap();
-        lowest = lowest.min(p.state().0[1]);
-    }
     let model = ArmModel::from_urdf_str(TWO_LINK_URDF).unwrap();
     let stop = model.joints[1].limits.unwrap().0;
-    assert!(lowest > stop - 0.02, "joint2 went to {lowest}");
+    for engine in ENGINES {
+        let mut p = engine_plant(TWO_LINK_URDF, engine);
+        p.set_state(&[FRAC_PI_2, -3.0], &[0.0, -3.0]).unwrap();
+        let mut lowest = f64::INFINITY;
+        for _ in 0..500 {
+            p.step(&[0.0, -5.0], DT).unwrap();
+            lowest = lowest.min(p.state().0[1]);
+        }
+        assert!(lowest > stop - 0.02, "{engine:?}: joint2 went to {lowest}");
+        // Held there, not bouncing off.
+        let (q, qd) = p.state();
+        assert!((q[1] - stop).abs() < 0.02 && qd[1].abs() < 0.5, "{engine:?}: {q:?} {qd:?}");
+    }
 }
 
 #[test]

@@ -111,6 +111,14 @@ pub(crate) struct BenchArgs {
     /// --repeats pairs, each beside the timer floor.
     #[arg(long, value_name = "CMD")]
     pub(crate) controller_cmd: Option<String>,
+    /// Measure only the paper scenario in lockstep against the Python +
+    /// MuJoCo loop a user would write instead (python/peer/mujoco_loop.py),
+    /// in --repeats alternating pairs.
+    #[arg(long, conflicts_with = "controller_cmd")]
+    pub(crate) peer: bool,
+    /// The Python that runs the loop (set up by `bash python/setup-venv.sh --peer`).
+    #[arg(long, value_name = "CMD", default_value = "target/python-venv/bin/python3")]
+    pub(crate) peer_python: String,
 }
 
 #[derive(Debug, Args)]

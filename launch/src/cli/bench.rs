@@ -34,6 +34,16 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
         law: args.law,
     };
     let progress = |what: &str| eprintln!("testbed bench: {what}");
+    if args.peer {
+        let python = super::args::command_words(&args.peer_python)?;
+        let report = launch::bench_peer::run(&opts, &python, progress)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&report)?);
+        } else {
+            print!("{}", peer_table(&report));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     if let Some(command) = command {
         let report = launch::bench_controller::run(&opts, &command, progress)?;
         if args.json {
@@ -50,6 +60,26 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
         print!("{}", report::bench_table(&report));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The lockstep stack against the Python + MuJoCo loop, pair by pair.
+fn peer_table(b: &launch::bench_peer::PeerBench) -> String {
+    let mut s = format!(
+        "{} scenario, {:.1} s simulated; Python + MuJoCo (RK4, {} substeps) against `testbed run --mode lockstep` (logger on)\n",
+        b.scenario, b.sim_s, b.peer_substeps
+    );
+    let _ = writeln!(s, "{:<6} {:>14} {:>14} {:>8}", "pair", "lockstep, s", "Python, s", "ratio");
+    for (i, (l, p)) in b.lockstep_wall_s.iter().zip(&b.peer_wall_s).enumerate() {
+        let _ = writeln!(s, "{:<6} {l:>14.3} {p:>14.3} {:>7.1}×", i + 1, p / l);
+    }
+    let _ = writeln!(s, "median ratio: {:.1}× (lockstep {:.0}× real time)", b.speedup,
+        b.sim_s / launch::bench::median(b.lockstep_wall_s.clone()));
+    let _ = writeln!(
+        s,
+        "max |q − q_d| after T_c: testbed {:?}, Python loop {:?} rad",
+        b.testbed_max_error_after_tc, b.peer_max_error_after_tc
+    );
+    s
 }
 
 /// The two controllers' figures, pair by pair.

@@ -182,13 +182,13 @@ impl Articulated {
         let substeps = substeps.max((dt * self.damping_rate).ceil().min(1e6) as u32);
         let h = dt / f64::from(substeps);
         for _ in 0..substeps {
-            self.rk4(drive, h)?;
-            self.constrain(h)?;
+            self.rk4(drive, h);
+            self.constrain(h);
         }
         Ok(())
     }
 
-    fn rk4(&mut self, drive: &dyn Drive, h: f64) -> Result<(), PlantError> {
+    fn rk4(&mut self, drive: &dyn Drive, h: f64) {
         let s = &mut self.scratch;
         s.q0.copy_from_slice(&self.q);
         s.qd0.copy_from_slice(&self.qd);
@@ -203,11 +203,10 @@ impl Articulated {
                 }
             }
             let mut qdd = std::mem::take(&mut self.scratch.k_qd[stage]);
-            let done = self.acceleration(drive, &q, &qd, &mut qdd);
+            self.acceleration(drive, &q, &qd, &mut qdd);
             self.scratch.k_qd[stage] = qdd;
             self.scratch.k_q[stage].copy_from_slice(&qd);
             (self.q, self.qd) = (q, qd);
-            done?;
         }
         let s = &self.scratch;
         for i in 0..self.armature.len() {
@@ -216,18 +215,17 @@ impl Articulated {
             self.q[i] = s.q0[i] + h / 6.0 * dq;
             self.qd[i] = s.qd0[i] + h / 6.0 * dqd;
         }
-        Ok(())
     }
 
-    /// q̈ = M⁻¹ (τ(q̇) − h − D q̇) at (q, q̇).
-    fn acceleration(
-        &mut self,
-        drive: &dyn Drive,
-        q: &[f64],
-        qd: &[f64],
-        qdd: &mut [f64],
-    ) -> Result<(), PlantError> {
-        self.factor_mass(q, qd)?;
+    /// q̈ = M⁻¹ (τ(q̇) − h − D q̇) at (q, q̇). A state that has blown up
+    /// (the torque of a diverging law) has no inertia to factor: its
+    /// acceleration is NaN, and the run reports the non-finite state, as it
+    /// does with Rapier.
+    fn acceleration(&mut self, drive: &dyn Drive, q: &[f64], qd: &[f64], qdd: &mut [f64]) {
+        if self.factor_mass(q, qd).is_err() {
+            qdd.iter_mut().for_each(|x| *x = f64::NAN);
+            return;
+        }
         let s = &mut self.scratch;
         drive.torque(qd, &mut s.tau);
         for (k, f) in self.follow.iter().enumerate() {
@@ -236,7 +234,6 @@ impl Articulated {
         }
         qdd.copy_from_slice(&s.tau);
         s.chol.solve(qdd);
-        Ok(())
     }
 
     /// Evaluates the tree at (q, q̇) and factors the reduced M(q) + armature.
@@ -292,18 +289,17 @@ impl Articulated {
             .sum::<f64>()
     }
 
-    /// Dry friction and hard stops as impulses at the end of a substep.
-    fn constrain(&mut self, h: f64) -> Result<(), PlantError> {
+    /// Dry friction and hard stops as impulses at the end of a substep
+    /// (none on a state that has blown up).
+    fn constrain(&mut self, h: f64) {
         if !self.impulses.needed(&self.follow, &self.q) {
-            return Ok(());
+            return;
         }
         let (mut q, mut qd) = (std::mem::take(&mut self.q), std::mem::take(&mut self.qd));
-        let factored = self.factor_mass(&q, &qd);
-        if factored.is_ok() {
+        if self.factor_mass(&q, &qd).is_ok() {
             let chol = &self.scratch.chol;
             self.impulses.apply(&self.follow, chol, &mut q, &mut qd, h);
         }
         (self.q, self.qd) = (q, qd);
-        factored
     }
 }
