@@ -43,8 +43,8 @@ pub use arm_model::{
     MimicJoint, MimicSpec, ModelError, Origin, TWO_LINK_URDF,
 };
 pub use config::{
-    ActuationConfig, EngineName, DisturbanceConfig, FrictionConfig, PayloadConfig, PerJoint, PlantConfig,
-    SensorConfig,
+    ActuationConfig, DisturbanceConfig, EngineName, FrictionConfig, PayloadConfig, PerJoint,
+    PlantConfig, SensorConfig,
 };
 pub use effects::Effects;
 pub use machine::PlantMachine;

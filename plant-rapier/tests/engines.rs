@@ -11,7 +11,10 @@ use rand_chacha::ChaCha8Rng;
 
 const ARMS: [(&str, &str); 8] = [
     ("two_link", include_str!("../../robots/two_link.urdf")),
-    ("three_link_planar", include_str!("../../robots/three_link_planar.urdf")),
+    (
+        "three_link_planar",
+        include_str!("../../robots/three_link_planar.urdf"),
+    ),
     ("ur5", include_str!("../../robots/ur5.urdf")),
     ("iiwa14", include_str!("../../robots/iiwa14.urdf")),
     ("panda", include_str!("../../robots/panda.urdf")),
@@ -45,7 +48,10 @@ fn posture(model: &ArmModel, rng: &mut ChaCha8Rng) -> Vec<f64> {
 }
 
 fn gap(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
 }
 
 /// 0.2 s from rest under gravity compensation plus a push on every joint,
@@ -162,5 +168,8 @@ fn stiff_damping_stays_stable() {
         p.step(&vec![0.0; n], 1e-3).unwrap();
     }
     let (q, qd) = p.state();
-    assert!(q.iter().chain(&qd).all(|x| x.is_finite() && x.abs() < 10.0), "{q:?} {qd:?}");
+    assert!(
+        q.iter().chain(&qd).all(|x| x.is_finite() && x.abs() < 10.0),
+        "{q:?} {qd:?}"
+    );
 }

@@ -198,7 +198,10 @@ fn a_hard_stop_holds_the_joint_at_its_limit() {
         assert!(lowest > stop - 0.02, "{engine:?}: joint2 went to {lowest}");
         // Held there, not bouncing off.
         let (q, qd) = p.state();
-        assert!((q[1] - stop).abs() < 0.02 && qd[1].abs() < 0.5, "{engine:?}: {q:?} {qd:?}");
+        assert!(
+            (q[1] - stop).abs() < 0.02 && qd[1].abs() < 0.5,
+            "{engine:?}: {q:?} {qd:?}"
+        );
     }
 }
 

@@ -117,7 +117,11 @@ pub(crate) struct BenchArgs {
     #[arg(long, conflicts_with = "controller_cmd")]
     pub(crate) peer: bool,
     /// The Python that runs the loop (set up by `bash python/setup-venv.sh --peer`).
-    #[arg(long, value_name = "CMD", default_value = "target/python-venv/bin/python3")]
+    #[arg(
+        long,
+        value_name = "CMD",
+        default_value = "target/python-venv/bin/python3"
+    )]
     pub(crate) peer_python: String,
 }
 

@@ -68,12 +68,20 @@ fn peer_table(b: &launch::bench_peer::PeerBench) -> String {
         "{} scenario, {:.1} s simulated; Python + MuJoCo (RK4, {} substeps) against `testbed run --mode lockstep` (logger on)\n",
         b.scenario, b.sim_s, b.peer_substeps
     );
-    let _ = writeln!(s, "{:<6} {:>14} {:>14} {:>8}", "pair", "lockstep, s", "Python, s", "ratio");
+    let _ = writeln!(
+        s,
+        "{:<6} {:>14} {:>14} {:>8}",
+        "pair", "lockstep, s", "Python, s", "ratio"
+    );
     for (i, (l, p)) in b.lockstep_wall_s.iter().zip(&b.peer_wall_s).enumerate() {
         let _ = writeln!(s, "{:<6} {l:>14.3} {p:>14.3} {:>7.1}×", i + 1, p / l);
     }
-    let _ = writeln!(s, "median ratio: {:.1}× (lockstep {:.0}× real time)", b.speedup,
-        b.sim_s / launch::bench::median(b.lockstep_wall_s.clone()));
+    let _ = writeln!(
+        s,
+        "median ratio: {:.1}× (lockstep {:.0}× real time)",
+        b.speedup,
+        b.sim_s / launch::bench::median(b.lockstep_wall_s.clone())
+    );
     let _ = writeln!(
         s,
         "max |q − q_d| after T_c: testbed {:?}, Python loop {:?} rad",

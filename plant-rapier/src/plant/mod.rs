@@ -90,7 +90,9 @@ impl Plant {
         let engine = match config.engine {
             EngineName::Articulated => {
                 let slope: Vec<f64> = (0..n)
-                    .map(|i| friction.viscous[i] + friction.coulomb[i] / friction.smoothing_velocity)
+                    .map(|i| {
+                        friction.viscous[i] + friction.coulomb[i] / friction.smoothing_velocity
+                    })
                     .collect();
                 let setup = Setup {
                     gravity: config.gravity,

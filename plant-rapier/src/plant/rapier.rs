@@ -7,9 +7,7 @@ use rapier3d_f64::glamx::EulerRot;
 use rapier3d_f64::prelude::*;
 
 use super::articulated::Drive;
-use super::build::{
-    couple_mimics, dof_of, insert_bodies, insert_joints, joint_dynamics, settle,
-};
+use super::build::{couple_mimics, dof_of, insert_bodies, insert_joints, joint_dynamics, settle};
 use crate::{PlantConfig, PlantError};
 use arm_model::{ArmModel, Origin};
 
@@ -97,7 +95,15 @@ impl RapierArm {
             )));
         }
         let parts = (&dofs[..], &coupled[..]);
-        joint_dynamics(model, config, armature, parts.0, parts.1, multibody_joints, multibody)?;
+        joint_dynamics(
+            model,
+            config,
+            armature,
+            parts.0,
+            parts.1,
+            multibody_joints,
+            multibody,
+        )?;
         let n = dofs.len();
         Ok(Self {
             world,

@@ -102,7 +102,9 @@ impl Impulses {
         }
         for j in 0..n {
             let col = &mut self.inverse[j * n..(j + 1) * n];
-            col.iter_mut().enumerate().for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
+            col.iter_mut()
+                .enumerate()
+                .for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
             m.solve(col);
         }
         self.lambda.clear();

@@ -30,8 +30,8 @@ impl Cholesky {
             for k in 0..j {
                 d -= a[j * n + k] * a[j * n + k];
             }
-            // `!(d > 0)` also catches NaN.
-            if !(d > 0.0) {
+            // Not positive, or NaN.
+            if d.is_nan() || d <= 0.0 {
                 return Err(j);
             }
             let d = d.sqrt();
@@ -83,7 +83,8 @@ mod tests {
             let ax: f64 = (0..3).map(|k| a[i * 3 + k] * x[k]).sum();
             assert!((ax - [1.0, -2.0, 0.5][i]).abs() < 1e-14);
         }
-        c.matrix_mut().copy_from_slice(&[1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+        c.matrix_mut()
+            .copy_from_slice(&[1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
         assert_eq!(c.factor(), Err(1));
         c.matrix_mut()[0] = f64::NAN;
         assert_eq!(c.factor(), Err(0));

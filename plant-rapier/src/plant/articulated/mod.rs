@@ -272,7 +272,9 @@ impl Articulated {
         let mut inverse_diagonal = vec![0.0; n];
         let mut e = vec![0.0; n];
         for (j, d) in inverse_diagonal.iter_mut().enumerate() {
-            e.iter_mut().enumerate().for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
+            e.iter_mut()
+                .enumerate()
+                .for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
             self.scratch.chol.solve(&mut e);
             *d = e[j];
         }

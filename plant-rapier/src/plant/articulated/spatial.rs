@@ -130,7 +130,8 @@ impl Xform {
         let h = et * b.h;
         let r = self.r;
         // Σ m (|p'|² 1 − p' p'ᵀ) with p' = Eᵀ p + r, expanded.
-        let i = et * b.i * self.e + b.m * (Matrix3::identity() * r.dot(&r) - r * r.transpose())
+        let i = et * b.i * self.e
+            + b.m * (Matrix3::identity() * r.dot(&r) - r * r.transpose())
             + Matrix3::identity() * (2.0 * r.dot(&h))
             - (h * r.transpose() + r * h.transpose());
         Inertia {
@@ -223,10 +224,13 @@ mod tests {
 
     #[test]
     fn composition_applies_in_order() {
-        let (a, b) = (xf(), Xform {
-            e: *Rotation3::from_euler_angles(0.1, 0.2, -0.3).matrix(),
-            r: Vector3::new(-0.5, 0.3, 0.2),
-        });
+        let (a, b) = (
+            xf(),
+            Xform {
+                e: *Rotation3::from_euler_angles(0.1, 0.2, -0.3).matrix(),
+                r: Vector3::new(-0.5, 0.3, 0.2),
+            },
+        );
         let m = Motion {
             w: Vector3::new(0.4, -1.0, 2.0),
             v: Vector3::new(-0.3, 0.9, 0.1),
