@@ -102,11 +102,16 @@ struct Subs {
 
 impl Subs {
     fn drain(&mut self, log: &mut LogWriter) -> Result<(), LoggerNodeError> {
+        // Timing first. Drained last, it lost 19 samples right after its
+        // buffer's 2048th, in 2 of 8 lockstep runs on a loaded machine, even
+        // though its publisher is lossless (retry until delivered). The
+        // logger counted them as dropped. Drained first, no run of 32 lost
+        // any. The cause inside iceoryx2 is not found yet.
+        self.timing.drain(log)?;
         self.state.drain(log)?;
         self.reference.drain(log)?;
         self.command.drain(log)?;
-        self.diag.drain(log)?;
-        self.timing.drain(log)
+        self.diag.drain(log)
     }
 
     fn stats(&self) -> BTreeMap<String, String> {
