@@ -124,10 +124,10 @@ pub fn run(
         if finished {
             break;
         }
+        // The wait takes every pending wake-up with it: no drain after it.
         if !states.wait_event(Duration::from_millis(100))? {
             link.check()?;
         }
-        states.drain_events()?;
     }
     Ok(link.done_and_wait_for_stop(handled)?)
 }

@@ -46,6 +46,41 @@ pub trait LogMessage: MessageFields {
         Value::Object(o)
     }
 
+    /// The JSON object's text appended to `out`, the same object as
+    /// [`LogMessage::to_json`] without building it (the logger's hot path;
+    /// keys in field order instead of sorted).
+    fn encode(&self, out: &mut Vec<u8>) {
+        let h = self.header();
+        out.push(b'{');
+        key(out, "seq", true);
+        write_int(out, h.seq);
+        key(out, "t_ns", false);
+        write_int(out, h.t_ns);
+        key(out, "wall_ns", false);
+        write_int(out, h.wall_ns);
+        key(out, "t", false);
+        write_real(out, h.t_ns as f64 / 1e9);
+        self.visit(&mut |name, f| {
+            key(out, name, false);
+            match f {
+                FieldRef::U(x) => write_int(out, x),
+                FieldRef::I(x) => write_int(out, x),
+                FieldRef::F(x) => write_real(out, x),
+                FieldRef::J(xs) => {
+                    out.push(b'[');
+                    for (i, x) in xs.iter().enumerate() {
+                        if i > 0 {
+                            out.push(b',');
+                        }
+                        write_real(out, *x);
+                    }
+                    out.push(b']');
+                }
+            }
+        });
+        out.push(b'}');
+    }
+
     /// The message back from its JSON object.
     fn parse(v: &Value) -> Result<Self, DecodeError> {
         let m = Fields(
@@ -100,6 +135,33 @@ pub trait LogMessage: MessageFields {
             "required": required,
             "additionalProperties": false
         })
+    }
+}
+
+/// `"name":`, after a comma unless it is the first key. Field names are
+/// Rust identifiers: nothing to escape.
+fn key(out: &mut Vec<u8>, name: &str, first: bool) {
+    if !first {
+        out.push(b',');
+    }
+    out.push(b'"');
+    out.extend_from_slice(name.as_bytes());
+    out.extend_from_slice(b"\":");
+}
+
+/// An integer as serde_json writes it. Writing a number into a Vec cannot
+/// fail (serde_json's only errors here are the writer's).
+fn write_int(out: &mut Vec<u8>, x: impl serde::Serialize) {
+    let _ = serde_json::to_writer(&mut *out, &x);
+}
+
+/// A real as serde_json writes it: shortest round-trip digits, `null` when
+/// not finite (JSON has no NaN).
+fn write_real(out: &mut Vec<u8>, x: f64) {
+    if x.is_finite() {
+        let _ = serde_json::to_writer(&mut *out, &x);
+    } else {
+        out.extend_from_slice(b"null");
     }
 }
 
@@ -210,6 +272,25 @@ mod tests {
                 "{bit} {name}: {about}"
             );
         }
+    }
+
+    #[test]
+    fn encode_writes_the_same_object_as_to_json() {
+        let mut d = ControllerDiagnostics {
+            header: Header {
+                seq: 7,
+                t_ns: 1_234_567,
+                wall_ns: 99,
+            },
+            ..ControllerDiagnostics::default()
+        };
+        d.tau[0] = 0.1 + 0.2;
+        d.tau[1] = f64::NAN;
+        d.wa_norm[0] = -1e-300;
+        let mut out = Vec::new();
+        d.encode(&mut out);
+        let parsed: Value = serde_json::from_slice(&out).unwrap();
+        assert_eq!(parsed, d.to_json());
     }
 
     #[test]
