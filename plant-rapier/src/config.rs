@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{Locks, PlantError};
+use crate::{EngineName, Locks, PlantError};
 
 /// How the plant integrates, and the effects it adds on top of the rigid
 /// body dynamics.
@@ -293,29 +293,6 @@ fn check_finite(key: &str, v: &[f64]) -> Result<(), PlantError> {
             "a finite number",
         )),
         None => Ok(()),
-    }
-}
-
-/// The engine that integrates the arm's rigid-body dynamics.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum EngineName {
-    /// The equations of motion in joint coordinates (inertia by the
-    /// composite-rigid-body algorithm, bias by Newton–Euler), RK4; dry
-    /// friction and hard stops as impulses.
-    #[default]
-    Articulated,
-    /// Rapier's multibody through its whole pipeline (first order).
-    Rapier,
-}
-
-impl EngineName {
-    /// The name a scenario uses.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::Articulated => "articulated",
-            Self::Rapier => "rapier",
-        }
     }
 }
 

@@ -33,6 +33,7 @@
 
 mod config;
 pub mod effects;
+mod engine;
 mod machine;
 pub mod node;
 mod plant;
@@ -43,10 +44,11 @@ pub use arm_model::{
     MimicJoint, MimicSpec, ModelError, Origin, TWO_LINK_URDF,
 };
 pub use config::{
-    ActuationConfig, DisturbanceConfig, EngineName, FrictionConfig, PayloadConfig, PerJoint,
-    PlantConfig, SensorConfig,
+    ActuationConfig, DisturbanceConfig, FrictionConfig, PayloadConfig, PerJoint, PlantConfig,
+    SensorConfig,
 };
 pub use effects::Effects;
+pub use engine::EngineName;
 pub use machine::PlantMachine;
 pub use plant::Plant;
 pub use rig::Rig;

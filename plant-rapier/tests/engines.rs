@@ -4,6 +4,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
+
 use arm_model::dynamics::Dynamics;
 use plant_rapier::{ArmModel, EngineName, Plant, PlantConfig};
 use rand::{Rng, SeedableRng};
@@ -72,17 +74,7 @@ fn both_engines_move_every_arm_alike() {
         // Dry friction off: the two engines' friction impulses are solved
         // differently (the next test compares what they do).
         let model = ArmModel::from_urdf_str(urdf).unwrap();
-        let model = ArmModel {
-            joints: model
-                .joints
-                .iter()
-                .map(|j| plant_rapier::JointInfo {
-                    friction: 0.0,
-                    ..j.clone()
-                })
-                .collect(),
-            ..model
-        };
+        let model = common::with_joints(&model, |j| j.friction = 0.0);
         let n = model.dof();
         let q0 = posture(&model, &mut rng);
         let g = Dynamics::new(&model, 1.0).gravity(&q0).to_vec();

@@ -6,6 +6,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
+
 use arm_model::dynamics::Dynamics;
 use plant_rapier::{ArmModel, EngineName, JointKind, Plant, PlantConfig};
 use rand::{Rng, SeedableRng};
@@ -37,17 +39,7 @@ fn check_engine(urdf: &str, seed: u64, engine: EngineName) {
     let n = model.dof();
     // URDF damping stays on (it is in the reference dynamics); dry friction
     // is not a smooth force, so it is off here.
-    let model = ArmModel {
-        joints: model
-            .joints
-            .iter()
-            .map(|j| plant_rapier::JointInfo {
-                friction: 0.0,
-                ..j.clone()
-            })
-            .collect(),
-        ..model
-    };
+    let model = common::with_joints(&model, |j| j.friction = 0.0);
     let config = PlantConfig {
         engine,
         saturate: false,
@@ -55,17 +47,7 @@ fn check_engine(urdf: &str, seed: u64, engine: EngineName) {
     };
     // At rest the damping force grows with the velocity during the step, so
     // the static checks are made without it; the moving one keeps it.
-    let still = ArmModel {
-        joints: model
-            .joints
-            .iter()
-            .map(|j| plant_rapier::JointInfo {
-                damping: 0.0,
-                ..j.clone()
-            })
-            .collect(),
-        ..model.clone()
-    };
+    let still = common::with_joints(&model, |j| j.damping = 0.0);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let dt = 1e-3;
     for _ in 0..20 {

@@ -81,3 +81,13 @@ pub fn energy(q: [f64; 2], qd: [f64; 2]) -> f64 {
     let pe = M1 * G * LC1 * q[0].sin() + M2 * G * (L1 * q[0].sin() + LC2 * (q[0] + q[1]).sin());
     ke + pe
 }
+
+/// `model` with `edit` applied to every joint (dry friction or damping off).
+pub fn with_joints(
+    model: &plant_rapier::ArmModel,
+    edit: impl Fn(&mut plant_rapier::JointInfo),
+) -> plant_rapier::ArmModel {
+    let mut m = model.clone();
+    m.joints.iter_mut().for_each(edit);
+    m
+}
