@@ -145,6 +145,15 @@ impl Dynamics {
         self.solve()
     }
 
+    /// Every link frame's pose in the world (the root link's frame) at q,
+    /// indexed like the model's links: the forward kinematics of the same
+    /// tree the dynamics walk (the live view draws the arm with it).
+    pub fn link_poses(&mut self, q: &[f64]) -> &[Isometry3<f64>] {
+        self.expand(q, None);
+        self.forward_pass();
+        &self.pose
+    }
+
     fn solve(&mut self) -> &[f64] {
         self.forward_pass();
         self.backward_pass();

@@ -284,3 +284,19 @@ fn bad_locks_name_the_key() {
     let e = ArmModel::from_urdf_str_locked(&text, &all).unwrap_err();
     assert_eq!(e, ModelError::NoActuatedJoints);
 }
+
+#[test]
+fn link_poses_place_the_two_link_arm_as_drawn() {
+    use nalgebra::Point3;
+    let m = ArmModel::from_urdf_str(crate::TWO_LINK_URDF).unwrap();
+    let mut d = dynamics::Dynamics::new(&m, 1.0);
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    // Shoulder up, elbow back down: link 1 points along +z, link 2 along +x.
+    let poses = d.link_poses(&[half_pi, -half_pi]).to_vec();
+    let link = |name: &str| m.links.iter().position(|l| l.name == name).unwrap();
+    let elbow = poses[link("link2")] * Point3::origin();
+    assert!((elbow - Point3::new(0.0, 0.0, 0.35)).norm() < 1e-12, "{elbow}");
+    let tip = poses[link("link2")] * Point3::new(0.31, 0.0, 0.0);
+    assert!((tip - Point3::new(0.31, 0.0, 0.35)).norm() < 1e-12, "{tip}");
+    assert_eq!(poses[m.root], nalgebra::Isometry3::identity());
+}

@@ -282,6 +282,7 @@ pub(crate) fn stack(
         realtime_setup: opts.realtime_setup,
         verbose: false,
         controller_cmd: controller_cmd.map(<[String]>::to_vec),
+        live: None,
     })?)
 }
 

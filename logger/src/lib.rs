@@ -14,13 +14,18 @@
 //! last metadata record `testbed.log_stats` counts what the logger received
 //! and what it could not take.
 
+mod channels;
 mod json;
+pub mod live;
 pub mod node;
+mod outputs;
 mod reader;
 mod records;
 mod scan;
+pub mod scene;
 mod writer;
 
+pub use channels::{ChannelSpec, channels};
 pub use json::{DecodeError, Fields, LogMessage};
 pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes};
 pub use writer::{LogWriter, RunMetadata};
@@ -63,6 +68,15 @@ pub enum LogError {
         topic: &'static str,
         /// The cause.
         cause: serde_json::Error,
+    },
+    /// A message for a channel the writer never opened (a bug of the
+    /// caller, reported rather than written to a wrong channel).
+    #[error("{path}: no channel {topic} was opened before its first message")]
+    UnknownChannel {
+        /// The file.
+        path: String,
+        /// The topic.
+        topic: &'static str,
     },
     /// The handler of a message failed while reading.
     #[error("reading {path} ({topic}): {cause}")]

@@ -14,6 +14,8 @@ use wire::{
     Topic, TopicSubscriber,
 };
 
+use crate::live::{Live, LiveConfig, LiveError};
+use crate::outputs::Outputs;
 use crate::{LogError, LogMessage, LogWriter, RUN_END, RunMetadata};
 
 /// What the launcher hands the logger node.
@@ -24,8 +26,14 @@ pub struct LoggerNodeConfig {
     pub out: PathBuf,
     /// The `testbed.run` record (its start time is set when the logger starts).
     pub metadata: RunMetadata,
-    /// The robot's URDF, attached to the log.
+    /// The robot's URDF, attached to the log (and drawn in 3D).
     pub urdf: String,
+    /// Joints the scenario holds still, as the plant holds them.
+    #[serde(default)]
+    pub lock: arm_model::Locks,
+    /// Serve the run live to Foxglove (`testbed run --live`).
+    #[serde(default)]
+    pub live: Option<LiveConfig>,
 }
 
 /// Why the logger node stopped.
@@ -37,6 +45,12 @@ pub enum LoggerNodeError {
     /// The log could not be written.
     #[error(transparent)]
     Log(#[from] LogError),
+    /// The URDF does not load (the launcher checked it: a damaged config).
+    #[error("the logger cannot load the robot: {0}")]
+    Model(#[from] arm_model::ModelError),
+    /// The live view did not start.
+    #[error(transparent)]
+    Live(#[from] LiveError),
 }
 
 impl From<wire::WireError> for LoggerNodeError {
@@ -76,10 +90,13 @@ impl<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> Sub<M> {
         })
     }
 
-    fn drain(&mut self, log: &mut LogWriter) -> Result<(), LoggerNodeError> {
+    fn drain(
+        &mut self,
+        mut take: impl FnMut(&M) -> Result<(), LogError>,
+    ) -> Result<(), LoggerNodeError> {
         while let Some(m) = self.sub.receive()? {
             self.count.add(m.header().seq);
-            log.write(&m)?;
+            take(&m)?;
         }
         let _ = self.sub.drain_events();
         Ok(())
@@ -101,17 +118,17 @@ struct Subs {
 }
 
 impl Subs {
-    fn drain(&mut self, log: &mut LogWriter) -> Result<(), LoggerNodeError> {
+    fn drain(&mut self, out: &mut Outputs) -> Result<(), LoggerNodeError> {
         // Timing first. Drained last, it lost 19 samples right after its
         // buffer's 2048th, in 2 of 8 lockstep runs on a loaded machine, even
         // though its publisher is lossless (retry until delivered). The
         // logger counted them as dropped. Drained first, no run of 32 lost
         // any. The cause inside iceoryx2 is not found yet.
-        self.timing.drain(log)?;
-        self.state.drain(log)?;
-        self.reference.drain(log)?;
-        self.command.drain(log)?;
-        self.diag.drain(log)
+        self.timing.drain(|m| out.take(m))?;
+        self.state.drain(|m| out.take_state(m))?;
+        self.reference.drain(|m| out.take(m))?;
+        self.command.drain(|m| out.take(m))?;
+        self.diag.drain(|m| out.take(m))
     }
 
     fn stats(&self) -> BTreeMap<String, String> {
@@ -147,24 +164,25 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
         diag: Sub::new(link, Topic::Diagnostics)?,
         timing: Sub::new(link, Topic::Timing)?,
     };
+    let model = arm_model::ArmModel::from_urdf_str_locked(&config.urdf, &config.lock)?;
+    // The live view first: a taken port fails the run before anything is
+    // written.
+    let live = match &config.live {
+        Some(live) => Some(Live::start(live, &crate::channels())?),
+        None => None,
+    };
     let mut meta = config.metadata.clone();
     meta.start_time_unix_ns = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_nanos() as u64);
-    let mut log = LogWriter::create(&config.out, &meta, &config.urdf)?;
-    // Every channel exists from the start, even if a topic stays silent.
-    log.add_channel::<JointState>()?;
-    log.add_channel::<ReferenceSample>()?;
-    log.add_channel::<Command>()?;
-    log.add_channel::<ControllerDiagnostics>()?;
-    log.add_channel::<Timing>()?;
-    log.flush()?;
+    let log = LogWriter::create(&config.out, &meta, &config.urdf)?;
+    let mut out = Outputs::open(log, &model, live)?;
 
     let started = link.ready_and_wait_for_start();
     let result: Result<(), LoggerNodeError> = match started {
         Ok(_) => loop {
-            subs.drain(&mut log)?;
-            log.flush_if_due()?;
+            subs.drain(&mut out)?;
+            out.flush_if_due()?;
             if let Err(e) = link.check() {
                 break Err(e.into());
             }
@@ -176,10 +194,10 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
     };
     // STOP, a signal or a vanished launcher: in every case take what is
     // still buffered and finish the file properly.
-    subs.drain(&mut log)?;
+    subs.drain(&mut out)?;
     let mut stats = subs.stats();
     stats.insert(RUN_END.into(), run_end(link, &result));
-    log.finish(stats)?;
+    out.finish(stats)?;
     match result {
         Err(LoggerNodeError::Node(NodeError::Stopped)) => Ok(()),
         other => other,

@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 use mcap::records::MessageHeader;
 use mcap::{Attachment, Compression, WriteOptions, Writer};
 
+use super::channels::ChannelSpec;
 use super::json::LogMessage;
 use super::{LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
 
@@ -150,51 +151,79 @@ impl LogWriter {
         })
     }
 
+    /// The file being written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     fn err(&self) -> impl Fn(mcap::McapError) -> LogError + '_ {
         |cause| LogError::mcap(&self.path.display().to_string(), cause)
     }
 
     /// Registers the channel of `M` (done on first write otherwise).
     pub fn add_channel<M: LogMessage>(&mut self) -> Result<u16, LogError> {
-        if let Some((id, _)) = self.channels.get(M::TOPIC) {
+        match self.channels.get(M::TOPIC) {
+            Some((id, _)) => Ok(*id),
+            None => self.add_channel_spec(&ChannelSpec::of::<M>()),
+        }
+    }
+
+    /// Registers a channel (once: a topic registered before keeps its id).
+    pub fn add_channel_spec(&mut self, spec: &ChannelSpec) -> Result<u16, LogError> {
+        if let Some((id, _)) = self.channels.get(spec.topic) {
             return Ok(*id);
         }
-        let schema = serde_json::to_vec(&M::schema()).map_err(|cause| LogError::Encode {
+        let schema = serde_json::to_vec(&spec.schema).map_err(|cause| LogError::Encode {
             path: self.path.display().to_string(),
-            topic: M::TOPIC,
+            topic: spec.topic,
             cause,
         })?;
         let schema_id = self
             .writer
-            .add_schema(M::SCHEMA, "jsonschema", &schema)
+            .add_schema(spec.schema_name, "jsonschema", &schema)
             .map_err(self.err())?;
         let id = self
             .writer
-            .add_channel(schema_id, M::TOPIC, "json", &BTreeMap::new())
+            .add_channel(schema_id, spec.topic, "json", &BTreeMap::new())
             .map_err(self.err())?;
-        self.channels.insert(M::TOPIC, (id, 0));
+        self.channels.insert(spec.topic, (id, 0));
         Ok(id)
     }
 
-    /// Appends one message.
-    pub fn write<M: LogMessage>(&mut self, msg: &M) -> Result<(), LogError> {
-        let id = self.add_channel::<M>()?;
-        let seq = self.channels.get_mut(M::TOPIC).map_or(0, |(_, s)| {
-            *s = s.wrapping_add(1);
-            *s
-        });
+    /// Appends one message; gives back its JSON (for the live view).
+    pub fn write<M: LogMessage>(&mut self, msg: &M) -> Result<&[u8], LogError> {
+        self.add_channel::<M>()?;
         let h = msg.header();
         let mut data = std::mem::take(&mut self.scratch);
         data.clear();
         msg.encode(&mut data);
-        let header = MessageHeader {
-            channel_id: id,
-            sequence: seq,
-            log_time: h.t_ns,
-            publish_time: h.wall_ns,
-        };
-        let res = self.writer.write_to_known_channel(&header, &data);
+        let res = self.write_json(M::TOPIC, h.t_ns, h.wall_ns, &data);
         self.scratch = data;
+        res.map(|()| self.scratch.as_slice())
+    }
+
+    /// Appends one message already in JSON to a registered channel.
+    pub fn write_json(
+        &mut self,
+        topic: &'static str,
+        log_time: u64,
+        publish_time: u64,
+        json: &[u8],
+    ) -> Result<(), LogError> {
+        let Some((id, seq)) = self.channels.get_mut(topic) else {
+            return Err(LogError::UnknownChannel {
+                path: self.path.display().to_string(),
+                topic,
+            });
+        };
+        *seq = seq.wrapping_add(1);
+        let header = MessageHeader {
+            channel_id: *id,
+            sequence: *seq,
+            log_time,
+            publish_time,
+        };
+        let res = self.writer.write_to_known_channel(&header, json);
         res.map_err(self.err())
     }
 

@@ -64,6 +64,37 @@ pub(crate) struct RunArgs {
     /// appends the node arguments and supervises it like any node.
     #[arg(long, value_name = "CMD", conflicts_with = "external")]
     pub(crate) controller_cmd: Option<String>,
+    /// Serve the run live to Foxglove (Open connection → Foxglove
+    /// WebSocket → ws://ADDR:PORT) from the logger. Without a value:
+    /// 127.0.0.1:8765.
+    #[arg(
+        long,
+        value_name = "ADDR:PORT",
+        num_args = 0..=1,
+        default_missing_value = "127.0.0.1:8765",
+        value_parser = parse_live_addr
+    )]
+    pub(crate) live: Option<std::net::SocketAddr>,
+    /// Samples per topic and second of sim time sent live (the log keeps
+    /// every one).
+    #[arg(long, value_name = "HZ", requires = "live", default_value_t = logger::live::DEFAULT_RATE_HZ, value_parser = parse_live_rate)]
+    pub(crate) live_rate: f64,
+}
+
+/// `ADDR:PORT` of `--live`, a host name (localhost) resolved.
+fn parse_live_addr(s: &str) -> Result<std::net::SocketAddr, String> {
+    use std::net::ToSocketAddrs;
+    s.to_socket_addrs()
+        .map_err(|e| format!("{s:?} is not ADDR:PORT ({e})"))?
+        .next()
+        .ok_or_else(|| format!("{s:?} names no address"))
+}
+
+fn parse_live_rate(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("{s:?} is not a positive number of Hz")),
+    }
 }
 
 /// The words of a `--controller-cmd`, split as a POSIX shell would

@@ -27,6 +27,10 @@ pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
             .as_deref()
             .map(super::args::command_words)
             .transpose()?,
+        live: args.live.map(|addr| logger::live::LiveConfig {
+            addr,
+            rate_hz: args.live_rate,
+        }),
     };
     let outcome = match run::run(opts) {
         Ok(o) => o,

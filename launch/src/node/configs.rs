@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use controller::node::{ControllerNodeConfig, NodeModel};
 use logger::RunMetadata;
+use logger::live::LiveConfig;
 use logger::node::LoggerNodeConfig;
 use plant_rapier::node::PlantNodeConfig;
 use scenario::Plan;
@@ -58,14 +59,16 @@ pub fn trajectory(plan: &Plan) -> TrajectoryNodeConfig {
     }
 }
 
-/// The logger's part: where to write and what the log says about the run
-/// (`controller_cmd`: the user's command that replaces the controller node).
+/// The logger's part: where to write, what the log says about the run
+/// (`controller_cmd`: the user's command that replaces the controller node)
+/// and whether to serve it live.
 pub fn logger(
     plan: &Plan,
     mode: Mode,
     out: &Path,
     toml: &str,
     controller_cmd: Option<&str>,
+    live: Option<&LiveConfig>,
 ) -> LoggerNodeConfig {
     let mut metadata = metadata(plan, mode, out, toml);
     metadata.controller_cmd = controller_cmd.unwrap_or_default().to_string();
@@ -73,6 +76,8 @@ pub fn logger(
         out: out.to_path_buf(),
         metadata,
         urdf: plan.robot.urdf.clone(),
+        lock: plan.scenario.plant.lock.clone(),
+        live: live.cloned(),
     }
 }
 
@@ -151,6 +156,7 @@ pub fn write_all(
     log: &Path,
     toml: &str,
     controller_cmd: Option<&str>,
+    live: Option<&LiveConfig>,
 ) -> Result<Vec<(NodeKind, PathBuf)>, ConfigError> {
     std::fs::create_dir_all(dir).map_err(|cause| ConfigError::Io {
         path: dir.display().to_string(),
@@ -163,9 +169,10 @@ pub fn write_all(
             NodeKind::Plant => write_config(&path, &plant(plan))?,
             NodeKind::Controller => write_config(&path, &controller(plan))?,
             NodeKind::Trajectory => write_config(&path, &trajectory(plan))?,
-            NodeKind::Logger => {
-                write_config(&path, &logger(plan, mode, log, toml, controller_cmd))?
-            }
+            NodeKind::Logger => write_config(
+                &path,
+                &logger(plan, mode, log, toml, controller_cmd, live),
+            )?,
         }
         out.push((kind, path));
     }

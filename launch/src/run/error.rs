@@ -13,6 +13,12 @@ pub enum RunError {
     /// A file could not be written.
     #[error("{0}: {1}")]
     Output(String, std::io::Error),
+    /// The live view's address cannot be listened on (in use, say).
+    #[error(
+        "--live {0}: cannot listen there: {1} (is another run or Foxglove bridge using it? \
+         give another port: --live 127.0.0.1:PORT)"
+    )]
+    LivePort(std::net::SocketAddr, std::io::Error),
     /// A node could not be started.
     #[error("cannot start the {node} node{}: {cause}", if .command.is_empty() { String::new() } else { format!(" (`{}`)", .command) })]
     Spawn {

@@ -13,6 +13,7 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use logger::live::LiveConfig;
 use scenario::Plan;
 use wire::{
     Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, MAX_DOF, NodeKind, NodeStatus,
@@ -73,6 +74,8 @@ pub struct RunOptions {
     /// Run this command (program and arguments) as the controller node
     /// instead of `testbed node controller`; the node arguments are appended.
     pub controller_cmd: Option<Vec<String>>,
+    /// Serve the run live to Foxglove from the logger (`--live`).
+    pub live: Option<LiveConfig>,
 }
 
 /// What a finished run produced.
@@ -198,6 +201,13 @@ fn check_up_front(opts: &RunOptions) -> Result<(), RunError> {
     if let Some(path) = &opts.csv {
         File::create(path).map_err(|e| RunError::Output(path.display().to_string(), e))?;
     }
+    if let Some(live) = &opts.live {
+        // Taken now, it would fail the logger after the others started.
+        // (Released at once: the logger binds it; a thief in between makes
+        // the logger fail, named.)
+        std::net::TcpListener::bind(live.addr)
+            .map_err(|cause| RunError::LivePort(live.addr, cause))?;
+    }
     if let Some(command) = &opts.controller_cmd {
         spawn::check_program(command).map_err(|cause| RunError::Spawn {
             node: NodeKind::Controller.name(),
@@ -242,6 +252,7 @@ impl RunFiles {
             &log,
             &toml,
             command.as_deref(),
+            opts.live.as_ref(),
         )
         .map_err(|e| RunError::Output(run_dir.display().to_string(), std::io::Error::other(e)))?;
         Ok(Self {

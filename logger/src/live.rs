@@ -1,0 +1,239 @@
+//! The live view (`testbed run --live`): while the run goes, the logger
+//! serves the run's channels (the same list, topics and schemas as the log,
+//! [`crate::channels`]) over the Foxglove WebSocket protocol with the
+//! `foxglove` crate. Only the logger process does this, and only when asked:
+//! without `--live` nothing here runs, and no tokio runtime exists.
+//!
+//! The run must not wait for a viewer. Each topic goes out live at most
+//! `rate_hz` times per second of sim time (every k-th sample: which ones is
+//! deterministic); a topic nobody subscribes to costs one check. The server
+//! queues each client's messages and drops the oldest when a client falls
+//! behind, so a client that never reads costs the logger a bounded queue.
+
+use std::collections::{BTreeMap, HashMap, HashSet};
+use std::net::SocketAddr;
+use std::sync::{Arc, Mutex};
+
+use foxglove::websocket::{Capability, ChannelView, Client, ClientId, ServerListener};
+use foxglove::{ChannelId, Context, PartialMetadata, RawChannel, Schema, WebSocketServerHandle};
+use serde::{Deserialize, Serialize};
+
+use crate::ChannelSpec;
+
+/// The port Foxglove's own examples use, and its app's default.
+pub const DEFAULT_PORT: u16 = 8765;
+/// Most samples per topic and second of sim time sent live.
+pub const DEFAULT_RATE_HZ: f64 = 50.0;
+/// Messages the server queues per client before dropping the oldest
+/// (≈ 3 s of every topic at the default rate).
+const BACKLOG: usize = 1024;
+
+/// What the launcher hands the logger for a live run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LiveConfig {
+    /// Where to listen.
+    pub addr: SocketAddr,
+    /// Most samples per topic and second of sim time sent live (the log
+    /// keeps every one).
+    pub rate_hz: f64,
+}
+
+/// Why the live view could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum LiveError {
+    /// The address is taken or not ours to listen on.
+    #[error("the live view cannot listen on {addr}: {cause}")]
+    Listen {
+        /// The address.
+        addr: SocketAddr,
+        /// The cause, as the server gives it.
+        cause: String,
+    },
+    /// A channel could not be opened.
+    #[error("the live view cannot open channel {topic}: {cause}")]
+    Channel {
+        /// The topic.
+        topic: &'static str,
+        /// The cause.
+        cause: String,
+    },
+    /// The rate is not a positive number.
+    #[error("live rate_hz must be a positive number, got {0}")]
+    Rate(f64),
+}
+
+/// One channel as served live.
+struct LiveTopic {
+    name: &'static str,
+    channel: Arc<RawChannel>,
+    next_ns: u64,
+    sent: u64,
+}
+
+/// Who is connected and what they subscribed to, kept by the server's
+/// callbacks (its own threads), read by the logger.
+#[derive(Default)]
+struct ClientBook(Mutex<Book>);
+
+#[derive(Default)]
+struct Book {
+    /// Clients in the order they first subscribed.
+    order: Vec<ClientId>,
+    clients: HashMap<ClientId, ClientCount>,
+}
+
+#[derive(Default)]
+struct ClientCount {
+    channels: HashSet<ChannelId>,
+    /// Messages handed to the server for this client.
+    messages: u64,
+}
+
+impl ClientBook {
+    fn book(&self) -> std::sync::MutexGuard<'_, Book> {
+        // A poisoned lock only means a callback panicked mid-count: the
+        // counts are still the best there are.
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn count(&self, channel: ChannelId) {
+        for c in self.book().clients.values_mut() {
+            if c.channels.contains(&channel) {
+                c.messages += 1;
+            }
+        }
+    }
+}
+
+impl ServerListener for ClientBook {
+    fn on_subscribe(&self, client: Client, channel: ChannelView) {
+        let mut book = self.book();
+        if !book.clients.contains_key(&client.id()) {
+            book.order.push(client.id());
+        }
+        let entry = book.clients.entry(client.id()).or_default();
+        entry.channels.insert(channel.id());
+    }
+
+    fn on_unsubscribe(&self, client: Client, channel: ChannelView) {
+        if let Some(c) = self.book().clients.get_mut(&client.id()) {
+            c.channels.remove(&channel.id());
+        }
+    }
+}
+
+/// The running live view.
+pub struct Live {
+    server: Option<WebSocketServerHandle>,
+    topics: Vec<LiveTopic>,
+    period_ns: u64,
+    book: Arc<ClientBook>,
+    config: LiveConfig,
+    /// The topic whose samples set the viewer's clock.
+    clock_topic: &'static str,
+}
+
+impl Live {
+    /// Starts the server on `config.addr` with `channels` (the first one's
+    /// samples drive the viewer's clock).
+    pub fn start(config: &LiveConfig, channels: &[ChannelSpec]) -> Result<Self, LiveError> {
+        if !(config.rate_hz.is_finite() && config.rate_hz > 0.0) {
+            return Err(LiveError::Rate(config.rate_hz));
+        }
+        let ctx = Context::new();
+        let book = Arc::new(ClientBook::default());
+        let addr = config.addr;
+        let server = ctx
+            .websocket_server()
+            .name(format!("testbed {}", env!("CARGO_PKG_VERSION")))
+            .bind(addr.ip().to_string(), addr.port())
+            .capabilities([Capability::Time])
+            .message_backlog_size(BACKLOG)
+            .listener(book.clone())
+            .start_blocking()
+            .map_err(|e| LiveError::Listen {
+                addr,
+                cause: e.to_string(),
+            })?;
+        let topics = channels
+            .iter()
+            .map(|spec| open(&ctx, spec))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            server: Some(server),
+            topics,
+            period_ns: (1e9 / config.rate_hz) as u64,
+            book,
+            config: config.clone(),
+            clock_topic: channels.first().map_or("", |c| c.topic),
+        })
+    }
+
+    /// Offers one message of `topic` (its JSON) stamped `t_ns`: sent if its
+    /// topic is due and someone subscribed, skipped otherwise.
+    pub fn offer(&mut self, topic: &str, t_ns: u64, json: &[u8]) {
+        let Some(t) = self.topics.iter_mut().find(|t| t.name == topic) else {
+            return;
+        };
+        if t_ns < t.next_ns {
+            return;
+        }
+        t.next_ns = t_ns.saturating_add(self.period_ns);
+        if topic == self.clock_topic
+            && let Some(server) = &self.server
+        {
+            server.broadcast_time(t_ns);
+        }
+        if !t.channel.has_sinks() {
+            return;
+        }
+        t.channel
+            .log_with_meta(json, PartialMetadata::with_log_time(t_ns));
+        t.sent += 1;
+        self.book.count(t.channel.id());
+    }
+
+    /// Stops the server; what was sent, for the log's stats record.
+    pub fn finish(mut self) -> BTreeMap<String, String> {
+        if let Some(server) = self.server.take() {
+            // Dropping the shutdown handle closes the connections at once:
+            // the run is over, nothing is left to send.
+            drop(server.stop());
+        }
+        let mut out = BTreeMap::new();
+        out.insert("live.address".into(), self.config.addr.to_string());
+        out.insert("live.rate_hz".into(), format!("{:?}", self.config.rate_hz));
+        for t in &self.topics {
+            let name = t.name.trim_start_matches('/');
+            out.insert(format!("live.{name}.sent"), t.sent.to_string());
+        }
+        let book = self.book.book();
+        out.insert("live.clients".into(), book.order.len().to_string());
+        for (k, id) in book.order.iter().enumerate() {
+            let messages = book.clients.get(id).map_or(0, |c| c.messages);
+            out.insert(format!("live.client{}.messages", k + 1), messages.to_string());
+        }
+        out
+    }
+}
+
+fn open(ctx: &Arc<Context>, spec: &ChannelSpec) -> Result<LiveTopic, LiveError> {
+    let err = |cause: String| LiveError::Channel {
+        topic: spec.topic,
+        cause,
+    };
+    let schema = serde_json::to_vec(&spec.schema).map_err(|e| err(e.to_string()))?;
+    let channel = ctx
+        .channel_builder(spec.topic)
+        .message_encoding("json")
+        .schema(Schema::new(spec.schema_name, "jsonschema", schema))
+        .build_raw()
+        .map_err(|e| err(e.to_string()))?;
+    Ok(LiveTopic {
+        name: spec.topic,
+        channel,
+        next_ns: 0,
+        sent: 0,
+    })
+}
