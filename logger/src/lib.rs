@@ -16,6 +16,7 @@
 
 mod channels;
 mod json;
+mod layout;
 pub mod live;
 pub mod node;
 mod outputs;
@@ -26,6 +27,7 @@ pub mod scene;
 mod writer;
 
 pub use channels::{ChannelSpec, channels};
+pub use layout::foxglove_layout;
 pub use json::{DecodeError, Fields, LogMessage};
 pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes};
 pub use writer::{LogWriter, RunMetadata};

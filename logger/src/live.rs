@@ -125,6 +125,8 @@ impl ServerListener for ClientBook {
 
 /// The running live view.
 pub struct Live {
+    /// Holds the channels and the server's sinks: both go with it.
+    _context: Arc<Context>,
     server: Option<WebSocketServerHandle>,
     topics: Vec<LiveTopic>,
     period_ns: u64,
@@ -161,6 +163,7 @@ impl Live {
             .map(|spec| open(&ctx, spec))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
+            _context: ctx,
             server: Some(server),
             topics,
             period_ns: (1e9 / config.rate_hz) as u64,

@@ -152,7 +152,7 @@ fn pose(p: &Isometry3<f64>) -> Value {
 
 /// Alternating link colours, so that neighbours stand apart.
 fn color(link: usize) -> Value {
-    if link % 2 == 0 {
+    if link.is_multiple_of(2) {
         json!({"r": 0.95, "g": 0.55, "b": 0.1, "a": 1.0})
     } else {
         json!({"r": 0.25, "g": 0.5, "b": 0.9, "a": 1.0})

@@ -5,6 +5,7 @@
 mod compare;
 mod hardening;
 mod leftovers;
+mod live;
 mod liveness;
 mod log_replay;
 mod python;

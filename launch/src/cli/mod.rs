@@ -72,6 +72,17 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
     },
+    /// Write the Foxglove layout for an arm (the paper's five figures, the
+    /// timing and the arm in 3D); `testbed run` writes one into each run's
+    /// folder, and foxglove/testbed-layout.json is the paper arm's.
+    Layout {
+        /// The arm's URDF [default: the paper's two-link arm].
+        #[arg(long, value_name = "URDF")]
+        robot: Option<PathBuf>,
+        /// Write here instead of to standard output.
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
     /// Run one node of a stack (the launcher starts these; start one by hand
     /// with `testbed run --external <node>` to debug or replace it).
     Node {
@@ -124,6 +135,15 @@ pub fn run() -> Result<ExitCode> {
         Command::Bindings { lang, out } => {
             let BindingsLang::Python = lang;
             let text = launch::bindings::python();
+            match out {
+                Some(path) => std::fs::write(&path, text)
+                    .with_context(|| format!("writing {}", path.display()))?,
+                None => print!("{text}"),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Layout { robot, out } => {
+            let text = robot::layout(robot.as_deref())?;
             match out {
                 Some(path) => std::fs::write(&path, text)
                     .with_context(|| format!("writing {}", path.display()))?,

@@ -35,6 +35,16 @@ pub fn describe(path: &Path) -> Result<String> {
     Ok(out)
 }
 
+/// The Foxglove layout (pretty JSON) for the arm at `path`, or the paper's.
+pub fn layout(path: Option<&Path>) -> Result<String> {
+    let model = match path {
+        Some(p) => RobotSource::from_file(p, &Locks::new())?.model,
+        None => ArmModel::from_urdf_str(plant_rapier::TWO_LINK_URDF)?,
+    };
+    let layout = logger::foxglove_layout(&model.joint_names());
+    Ok(serde_json::to_string_pretty(&layout)? + "\n")
+}
+
 fn joints(out: &mut String, m: &ArmModel) {
     let _ = writeln!(
         out,

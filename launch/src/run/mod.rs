@@ -3,6 +3,7 @@
 
 mod error;
 mod nodes;
+mod files;
 pub mod spawn;
 pub mod timing;
 
@@ -23,6 +24,7 @@ use wire::{
 use crate::analysis::{AnalyseOptions, LogAnalysis, analyse};
 use crate::mode::Mode;
 use nodes::NodeStates;
+use files::RunFiles;
 use spawn::{Children, describe};
 
 /// The nodes `testbed run` starts, in start order (the logger first, so it
@@ -216,51 +218,6 @@ fn check_up_front(opts: &RunOptions) -> Result<(), RunError> {
         })?;
     }
     Ok(())
-}
-
-/// The run's folder: the scenario it runs, each node's config, the log's path.
-struct RunFiles {
-    run_dir: PathBuf,
-    log: PathBuf,
-    configs: Vec<(NodeKind, PathBuf)>,
-}
-
-impl RunFiles {
-    fn write(opts: &RunOptions) -> Result<Self, RunError> {
-        let plan = &opts.plan;
-        let out = |p: &Path| {
-            let p = p.display().to_string();
-            move |e| RunError::Output(p.clone(), e)
-        };
-        let run_dir =
-            std::path::absolute(opts.runs_dir.join(run_id())).map_err(out(&opts.runs_dir))?;
-        std::fs::create_dir_all(&run_dir).map_err(out(&run_dir))?;
-        let scenario_file = run_dir.join("scenario.toml");
-        let toml = plan.effective_toml().map_err(|e| {
-            RunError::Output(
-                scenario_file.display().to_string(),
-                std::io::Error::other(e),
-            )
-        })?;
-        std::fs::write(&scenario_file, &toml).map_err(out(&scenario_file))?;
-        let log = run_dir.join("run.mcap");
-        let command = opts.controller_cmd.as_ref().map(shell_words::join);
-        let configs = crate::node::configs::write_all(
-            &run_dir.join("nodes"),
-            plan,
-            opts.mode,
-            &log,
-            &toml,
-            command.as_deref(),
-            opts.live.as_ref(),
-        )
-        .map_err(|e| RunError::Output(run_dir.display().to_string(), std::io::Error::other(e)))?;
-        Ok(Self {
-            run_dir,
-            log,
-            configs,
-        })
-    }
 }
 
 /// Starts every node the launcher owns; says how to start the external ones.

@@ -1,0 +1,308 @@
+//! `testbed run --live`: a WebSocket client here connects as the Foxglove
+//! app does (protocol `foxglove.sdk.v1`), subscribes, and checks what
+//! arrives against what the log keeps.
+
+use std::collections::{BTreeMap, HashMap};
+use std::net::{TcpListener, TcpStream};
+use std::path::Path;
+use std::process::{Child, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::{Value, json};
+use tungstenite::client::IntoClientRequest;
+use tungstenite::{Message, WebSocket};
+
+use crate::util::{ended, fails, testbed, wait_for_nodes};
+
+/// A port free a moment ago (the launcher refuses it, named, if taken since).
+fn free_port() -> u16 {
+    TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
+}
+
+/// A channel as the server advertised it.
+#[derive(Debug, Clone)]
+struct Advertised {
+    topic: String,
+    schema_name: String,
+    schema: Value,
+}
+
+struct Viewer {
+    ws: WebSocket<TcpStream>,
+    channels: HashMap<u64, Advertised>,
+    /// Subscription id → channel id.
+    subs: HashMap<u32, u64>,
+}
+
+impl Viewer {
+    /// Connects as soon as the logger listens (watchdog: 60 s, or the
+    /// launcher ending first).
+    fn connect(port: u16, launcher: &mut Child) -> Viewer {
+        let start = Instant::now();
+        let stream = loop {
+            if let Ok(s) = TcpStream::connect(("127.0.0.1", port)) {
+                break s;
+            }
+            assert!(
+                launcher.try_wait().unwrap().is_none(),
+                "the run ended before its live view listened"
+            );
+            assert!(start.elapsed() < Duration::from_secs(60), "nobody listens on {port}");
+            std::thread::sleep(Duration::from_millis(2));
+        };
+        stream
+            .set_read_timeout(Some(Duration::from_secs(30)))
+            .unwrap();
+        let mut req = format!("ws://127.0.0.1:{port}").into_client_request().unwrap();
+        req.headers_mut()
+            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
+        let (ws, _) = tungstenite::client::client(req, stream).unwrap();
+        let mut v = Viewer {
+            ws,
+            channels: HashMap::new(),
+            subs: HashMap::new(),
+        };
+        while v.channels.len() < logger::channels().len() {
+            let m = v.ws.read().unwrap();
+            v.on_control(&m);
+        }
+        v
+    }
+
+    fn on_control(&mut self, m: &Message) {
+        let Message::Text(text) = m else { return };
+        let v: Value = serde_json::from_str(text).unwrap();
+        if v["op"] != "advertise" {
+            return;
+        }
+        for c in v["channels"].as_array().unwrap() {
+            assert_eq!(c["encoding"], "json", "{c}");
+            assert_eq!(c["schemaEncoding"], "jsonschema", "{c}");
+            let schema = serde_json::from_str(c["schema"].as_str().unwrap()).unwrap();
+            self.channels.insert(
+                c["id"].as_u64().unwrap(),
+                Advertised {
+                    topic: c["topic"].as_str().unwrap().into(),
+                    schema_name: c["schemaName"].as_str().unwrap().into(),
+                    schema,
+                },
+            );
+        }
+    }
+
+    fn subscribe(&mut self, topics: &[&str]) {
+        let mut subs = Vec::new();
+        for (id, c) in &self.channels {
+            if topics.is_empty() || topics.contains(&c.topic.as_str()) {
+                let sub = self.subs.len() as u32 + 1;
+                self.subs.insert(sub, *id);
+                subs.push(json!({"id": sub, "channelId": id}));
+            }
+        }
+        let msg = json!({"op": "subscribe", "subscriptions": subs}).to_string();
+        self.ws.send(Message::text(msg)).unwrap();
+    }
+
+    /// Reads until the server closes: (topic, log time, JSON) in order.
+    fn read_to_end(&mut self) -> Vec<(String, u64, Value)> {
+        let mut out = Vec::new();
+        loop {
+            let m = match self.ws.read() {
+                Ok(m) => m,
+                Err(tungstenite::Error::ConnectionClosed | tungstenite::Error::AlreadyClosed) => {
+                    break;
+                }
+                Err(tungstenite::Error::Io(e)) if e.kind() != std::io::ErrorKind::WouldBlock => {
+                    break;
+                }
+                Err(e) => panic!("live view: {e}"),
+            };
+            let Message::Binary(b) = &m else {
+                self.on_control(&m);
+                continue;
+            };
+            // Opcode 1: message data (subscription, log time, payload).
+            if b[0] != 1 {
+                continue;
+            }
+            let sub = u32::from_le_bytes(b[1..5].try_into().unwrap());
+            let t = u64::from_le_bytes(b[5..13].try_into().unwrap());
+            let value: Value = serde_json::from_slice(&b[13..]).unwrap();
+            let topic = self.channels[&self.subs[&sub]].topic.clone();
+            out.push((topic, t, value));
+        }
+        out
+    }
+}
+
+/// The channels of the run's log: topic → (schema name, schema).
+fn log_channels(log: &Path) -> BTreeMap<String, (String, Value)> {
+    let buf = std::fs::read(log).unwrap();
+    let summary = mcap::Summary::read(&buf).unwrap().unwrap();
+    summary
+        .channels
+        .values()
+        .map(|c| {
+            let s = c.schema.as_ref().unwrap();
+            let schema = serde_json::from_slice(&s.data).unwrap();
+            (c.topic.clone(), (s.name.clone(), schema))
+        })
+        .collect()
+}
+
+fn live_run(port: u16, mode: &str, extra: &[&str], dir: &Path) -> Child {
+    testbed()
+        .args(["run", "--mode", mode, "--json", "--live"])
+        .arg(format!("127.0.0.1:{port}"))
+        .args(extra)
+        .arg("--runs-dir")
+        .arg(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// A lockstep run seen live: the joint states and the arm's frames arrive
+/// in order, every k-th sample, valid against the advertised schemas; the
+/// live channels are the log's; the log counts the client.
+#[test]
+fn a_lockstep_run_streams_live_what_its_log_keeps() {
+    let dir = tempfile::tempdir().unwrap();
+    let port = free_port();
+    let mut run = live_run(port, "lockstep", &["--duration", "60"], dir.path());
+    let mut viewer = Viewer::connect(port, &mut run);
+    viewer.subscribe(&["/joint_state", "/arm/transforms"]);
+    let got = viewer.read_to_end();
+    let (status, out, err) = ended(&mut run, 300);
+    assert!(status.success(), "{err}");
+    let report = parse_json_str(&out);
+
+    let validators: HashMap<String, jsonschema::Validator> = viewer
+        .channels
+        .values()
+        .map(|c| (c.topic.clone(), jsonschema::validator_for(&c.schema).unwrap()))
+        .collect();
+    let mut last: HashMap<&str, u64> = HashMap::new();
+    let mut counts: BTreeMap<&str, u64> = BTreeMap::new();
+    for (topic, t, v) in &got {
+        if let Err(e) = validators[topic].validate(v) {
+            panic!("{topic} at {t}: {e}\n{v}");
+        }
+        if let Some(prev) = last.insert(topic, *t) {
+            assert!(*t > prev, "{topic}: {t} after {prev}");
+        }
+        // 50 Hz of a 1 kHz run: every 20th sample, the same ones each run.
+        assert_eq!(t % 20_000_000, 0, "{topic} at {t}");
+        if topic == "/joint_state" {
+            assert_eq!(v["t_ns"].as_u64(), Some(*t));
+        }
+        *counts.entry(topic).or_default() += 1;
+    }
+    assert!(counts.get("/joint_state").copied().unwrap_or(0) >= 10, "{counts:?}");
+    assert!(counts.get("/arm/transforms").copied().unwrap_or(0) >= 10, "{counts:?}");
+
+    // The same channels live and in the log, with the same schemas.
+    let log = Path::new(report["log"].as_str().unwrap());
+    let live: BTreeMap<String, (String, Value)> = viewer
+        .channels
+        .values()
+        .map(|c| (c.topic.clone(), (c.schema_name.clone(), c.schema.clone())))
+        .collect();
+    assert_eq!(live, log_channels(log));
+    let stats = logger::read_log(log, None).unwrap().stats.unwrap();
+    assert_eq!(stats["live.clients"], "1", "{stats:?}");
+    let handed: u64 = stats["live.client1.messages"].parse().unwrap();
+    assert!(handed >= got.len() as u64, "{handed} < {}", got.len());
+}
+
+fn parse_json_str(out: &str) -> Value {
+    serde_json::from_str(out).unwrap_or_else(|e| panic!("{e}: {out}"))
+}
+
+/// Thread names of process `pid`.
+fn threads(pid: u32) -> Vec<String> {
+    std::fs::read_dir(format!("/proc/{pid}/task"))
+        .map(|d| {
+            d.flatten()
+                .filter_map(|t| std::fs::read_to_string(t.path().join("comm")).ok())
+                .map(|s| s.trim().to_string())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// A real-time run with a viewer that subscribes to everything at the
+/// highest rate and never reads misses no more deadlines than the same run
+/// without `--live` (allowing for this shared machine's noise), and a run
+/// without `--live` has no tokio thread in its logger.
+#[test]
+fn a_realtime_run_with_a_viewer_that_never_reads_keeps_its_deadlines() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut plain = testbed()
+        .args(["run", "--duration", "3", "--json", "--runs-dir"])
+        .arg(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let nodes = wait_for_nodes(plain.id());
+    let logger = nodes.iter().find(|n| n.0 == "logger").unwrap().1;
+    let names = threads(logger);
+    assert!(!names.iter().any(|n| n.contains("tokio")), "{names:?}");
+    let (status, out, err) = ended(&mut plain, 120);
+    assert!(status.success(), "{err}");
+    let base = parse_json_str(&out)["timing"]["deadline_misses"].as_u64().unwrap();
+
+    let port = free_port();
+    let extra = ["--duration", "3", "--live-rate", "1000"];
+    let mut run = live_run(port, "realtime", &extra, dir.path());
+    let mut viewer = Viewer::connect(port, &mut run);
+    viewer.subscribe(&[]);
+    let nodes = wait_for_nodes(run.id());
+    let logger = nodes.iter().find(|n| n.0 == "logger").unwrap().1;
+    let names = threads(logger);
+    assert!(names.iter().any(|n| n.contains("tokio")), "{names:?}");
+    // From here on the viewer reads nothing until the run is over.
+    let (status, out, err) = ended(&mut run, 120);
+    assert!(status.success(), "{err}");
+    let report = parse_json_str(&out);
+    let live = report["timing"]["deadline_misses"].as_u64().unwrap();
+    let steps = report["steps"].as_u64().unwrap();
+    assert!(
+        live <= 2 * base + steps / 100,
+        "{live} misses with a stuck viewer, {base} without"
+    );
+    let stats = logger::read_log(Path::new(report["log"].as_str().unwrap()), None)
+        .unwrap()
+        .stats
+        .unwrap();
+    assert_eq!(stats["live.clients"], "1", "{stats:?}");
+    drop(viewer);
+}
+
+/// A taken port is refused, named, before any node starts or any file is
+/// written.
+#[test]
+fn a_taken_live_port_fails_before_anything_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let taken = TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = taken.local_addr().unwrap();
+    let err = fails(
+        testbed()
+            .args(["run", "--mode", "lockstep", "--live"])
+            .arg(addr.to_string())
+            .arg("--runs-dir")
+            .arg(dir.path()),
+    );
+    assert!(err.contains(&format!("--live {addr}")), "{err}");
+    assert!(err.contains("in use"), "{err}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    // And a bad value is refused by the parser.
+    let err = fails(testbed().args(["run", "--live", "nowhere"]));
+    assert!(err.contains("ADDR:PORT"), "{err}");
+}
