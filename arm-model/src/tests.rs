@@ -295,7 +295,10 @@ fn link_poses_place_the_two_link_arm_as_drawn() {
     let poses = d.link_poses(&[half_pi, -half_pi]).to_vec();
     let link = |name: &str| m.links.iter().position(|l| l.name == name).unwrap();
     let elbow = poses[link("link2")] * Point3::origin();
-    assert!((elbow - Point3::new(0.0, 0.0, 0.35)).norm() < 1e-12, "{elbow}");
+    assert!(
+        (elbow - Point3::new(0.0, 0.0, 0.35)).norm() < 1e-12,
+        "{elbow}"
+    );
     let tip = poses[link("link2")] * Point3::new(0.31, 0.0, 0.0);
     assert!((tip - Point3::new(0.31, 0.0, 0.35)).norm() < 1e-12, "{tip}");
     assert_eq!(poses[m.root], nalgebra::Isometry3::identity());

@@ -7,8 +7,7 @@ use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
 
 use crate::LogMessage;
 use crate::scene::{
-    SCENE_SCHEMA, SCENE_TOPIC, TRANSFORMS_SCHEMA, TRANSFORMS_TOPIC, scene_schema,
-    transforms_schema,
+    SCENE_SCHEMA, SCENE_TOPIC, TRANSFORMS_SCHEMA, TRANSFORMS_TOPIC, scene_schema, transforms_schema,
 };
 
 /// One channel: JSON messages with a JSON schema.

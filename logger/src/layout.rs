@@ -85,7 +85,10 @@ pub fn foxglove_layout(joints: &[String]) -> Value {
         "||W_c||".into(),
     ));
     let torques = per_joint(joints, |i, _| {
-        vec![series(format!("/command.tau[{i}]"), format!("tau{}", i + 1))]
+        vec![series(
+            format!("/command.tau[{i}]"),
+            format!("tau{}", i + 1),
+        )]
     });
     let timing = ["round_trip_ns", "controller_compute_ns", "wake_late_ns"]
         .iter()

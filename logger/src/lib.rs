@@ -13,6 +13,12 @@
 //! software version and start time; the robot's URDF is an attachment; a
 //! last metadata record `testbed.log_stats` counts what the logger received
 //! and what it could not take.
+//!
+//! Besides the wire's topics, the logger derives the arm's link frames and
+//! a stick figure for Foxglove's 3D panel ([`scene`]); with `--live` it also
+//! serves every channel over the Foxglove WebSocket protocol ([`live`]).
+//! Log and live view open one channel list ([`channels`]), and
+//! [`foxglove_layout`] lays them out for either.
 
 mod channels;
 mod json;
@@ -27,8 +33,8 @@ pub mod scene;
 mod writer;
 
 pub use channels::{ChannelSpec, channels};
-pub use layout::foxglove_layout;
 pub use json::{DecodeError, Fields, LogMessage};
+pub use layout::foxglove_layout;
 pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes};
 pub use writer::{LogWriter, RunMetadata};
 

@@ -215,7 +215,10 @@ impl Live {
         out.insert("live.clients".into(), book.order.len().to_string());
         for (k, id) in book.order.iter().enumerate() {
             let messages = book.clients.get(id).map_or(0, |c| c.messages);
-            out.insert(format!("live.client{}.messages", k + 1), messages.to_string());
+            out.insert(
+                format!("live.client{}.messages", k + 1),
+                messages.to_string(),
+            );
         }
         out
     }

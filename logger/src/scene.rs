@@ -54,7 +54,10 @@ impl ArmScene {
         for (i, l) in model.links.iter().enumerate() {
             if i != model.root && !model.joints.iter().any(|j| j.parent == i) {
                 let com = iso(&l.inertial_origin).translation.vector;
-                bones.push(Bone { link: i, to: com * 2.0 });
+                bones.push(Bone {
+                    link: i,
+                    to: com * 2.0,
+                });
             }
         }
         bones.retain(|b| b.to.norm() > 1e-6);
@@ -164,7 +167,10 @@ fn time(t_ns: u64) -> Value {
 }
 
 fn object(title: &str, props: Value) -> Value {
-    let required: Vec<&String> = props.as_object().map(|o| o.keys().collect()).unwrap_or_default();
+    let required: Vec<&String> = props
+        .as_object()
+        .map(|o| o.keys().collect())
+        .unwrap_or_default();
     json!({"title": title, "type": "object", "properties": props, "required": required})
 }
 
@@ -273,7 +279,10 @@ mod tests {
     fn messages_match_their_schemas() {
         let model = ArmModel::from_urdf_str(arm_model::TWO_LINK_URDF).unwrap();
         let mut scene = ArmScene::new(&model);
-        validate(&transforms_schema(), &scene.transforms(1_500_000_000, &[0.3, -0.2]));
+        validate(
+            &transforms_schema(),
+            &scene.transforms(1_500_000_000, &[0.3, -0.2]),
+        );
         validate(&scene_schema(), &scene.scene(0));
     }
 

@@ -285,9 +285,10 @@ mod tests {
                     s.header.seq = k;
                     s.dof = 12;
                     s.q = [k as f64 * 1e-3; wire::MAX_DOF];
-                    let r = w.write(&s).map(|_| ()).and_then(|()| {
-                        if k % 1000 == 999 { w.flush() } else { Ok(()) }
-                    });
+                    let r = w
+                        .write(&s)
+                        .map(|_| ())
+                        .and_then(|()| if k % 1000 == 999 { w.flush() } else { Ok(()) });
                     if let Err(e) = r {
                         err = Some(e.to_string());
                         break;

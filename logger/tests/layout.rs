@@ -57,7 +57,12 @@ fn the_layout_names_only_published_topics_and_fields() {
             );
             series += 1;
         }
-        for topic in panel["topics"].as_object().into_iter().flatten().map(|t| t.0) {
+        for topic in panel["topics"]
+            .as_object()
+            .into_iter()
+            .flatten()
+            .map(|t| t.0)
+        {
             assert!(
                 topics.contains(&topic.as_str()),
                 "{id}: {topic} is not published"
@@ -66,7 +71,14 @@ fn the_layout_names_only_published_topics_and_fields() {
     }
     assert!(series >= 20, "only {series} series");
     // The five figures, the timing and the arm.
-    for id in ["positions", "velocities", "errors", "weights", "torques", "timing"] {
+    for id in [
+        "positions",
+        "velocities",
+        "errors",
+        "weights",
+        "torques",
+        "timing",
+    ] {
         assert!(panels.contains_key(&format!("Plot!{id}")), "no plot {id}");
     }
     assert!(panels.contains_key("3D!arm"));

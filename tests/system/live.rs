@@ -51,13 +51,18 @@ impl Viewer {
                 launcher.try_wait().unwrap().is_none(),
                 "the run ended before its live view listened"
             );
-            assert!(start.elapsed() < Duration::from_secs(60), "nobody listens on {port}");
+            assert!(
+                start.elapsed() < Duration::from_secs(60),
+                "nobody listens on {port}"
+            );
             std::thread::sleep(Duration::from_millis(2));
         };
         stream
             .set_read_timeout(Some(Duration::from_secs(30)))
             .unwrap();
-        let mut req = format!("ws://127.0.0.1:{port}").into_client_request().unwrap();
+        let mut req = format!("ws://127.0.0.1:{port}")
+            .into_client_request()
+            .unwrap();
         req.headers_mut()
             .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
         let (ws, _) = tungstenite::client::client(req, stream).unwrap();
@@ -185,7 +190,12 @@ fn a_lockstep_run_streams_live_what_its_log_keeps() {
     let validators: HashMap<String, jsonschema::Validator> = viewer
         .channels
         .values()
-        .map(|c| (c.topic.clone(), jsonschema::validator_for(&c.schema).unwrap()))
+        .map(|c| {
+            (
+                c.topic.clone(),
+                jsonschema::validator_for(&c.schema).unwrap(),
+            )
+        })
         .collect();
     let mut last: HashMap<&str, u64> = HashMap::new();
     let mut counts: BTreeMap<&str, u64> = BTreeMap::new();
@@ -203,8 +213,14 @@ fn a_lockstep_run_streams_live_what_its_log_keeps() {
         }
         *counts.entry(topic).or_default() += 1;
     }
-    assert!(counts.get("/joint_state").copied().unwrap_or(0) >= 10, "{counts:?}");
-    assert!(counts.get("/arm/transforms").copied().unwrap_or(0) >= 10, "{counts:?}");
+    assert!(
+        counts.get("/joint_state").copied().unwrap_or(0) >= 10,
+        "{counts:?}"
+    );
+    assert!(
+        counts.get("/arm/transforms").copied().unwrap_or(0) >= 10,
+        "{counts:?}"
+    );
 
     // The same channels live and in the log, with the same schemas.
     let log = Path::new(report["log"].as_str().unwrap());
@@ -256,7 +272,9 @@ fn a_realtime_run_with_a_viewer_that_never_reads_keeps_its_deadlines() {
     assert!(!names.iter().any(|n| n.contains("tokio")), "{names:?}");
     let (status, out, err) = ended(&mut plain, 120);
     assert!(status.success(), "{err}");
-    let base = parse_json_str(&out)["timing"]["deadline_misses"].as_u64().unwrap();
+    let base = parse_json_str(&out)["timing"]["deadline_misses"]
+        .as_u64()
+        .unwrap();
 
     let port = free_port();
     let extra = ["--duration", "3", "--live-rate", "1000"];

@@ -50,6 +50,10 @@ fn log_is_complete_mcap_with_valid_json_messages() {
     assert_eq!(counts["/controller/diagnostics"], steps, "{counts:?}");
     assert_eq!(counts["/timing"], steps, "{counts:?}");
     assert_eq!(counts["/reference"], steps + 1, "{counts:?}");
+    // The arm's frames at 50 Hz of sim time (states at 0, 20, …, 500 ms),
+    // its figure once a second.
+    assert_eq!(counts["/arm/transforms"], 26, "{counts:?}");
+    assert_eq!(counts["/arm/scene"], 1, "{counts:?}");
 
     let mut validators = BTreeMap::new();
     for ch in summary.channels.values() {
@@ -71,9 +75,21 @@ fn log_is_complete_mcap_with_valid_json_messages() {
                 msg.channel.topic, msg.sequence
             );
         }
-        // log_time is sim time, publish_time the sample's wall timestamp.
-        assert_eq!(msg.log_time, value["t_ns"].as_u64().unwrap());
-        assert_eq!(msg.publish_time, value["wall_ns"].as_u64().unwrap());
+        // log_time is sim time, publish_time the sample's wall timestamp
+        // (the arm's messages carry sim time in Foxglove's stamp).
+        let arm = value["transforms"][0]["timestamp"]
+            .as_object()
+            .or(value["entities"][0]["timestamp"].as_object());
+        match arm {
+            Some(t) => {
+                let ns = t["sec"].as_u64().unwrap() * 1_000_000_000 + t["nsec"].as_u64().unwrap();
+                assert_eq!(msg.log_time, ns, "{}", msg.channel.topic);
+            }
+            None => {
+                assert_eq!(msg.log_time, value["t_ns"].as_u64().unwrap());
+                assert_eq!(msg.publish_time, value["wall_ns"].as_u64().unwrap());
+            }
+        }
         seen += 1;
     }
     assert_eq!(seen, counts.values().sum::<u64>());

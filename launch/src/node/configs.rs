@@ -169,10 +169,9 @@ pub fn write_all(
             NodeKind::Plant => write_config(&path, &plant(plan))?,
             NodeKind::Controller => write_config(&path, &controller(plan))?,
             NodeKind::Trajectory => write_config(&path, &trajectory(plan))?,
-            NodeKind::Logger => write_config(
-                &path,
-                &logger(plan, mode, log, toml, controller_cmd, live),
-            )?,
+            NodeKind::Logger => {
+                write_config(&path, &logger(plan, mode, log, toml, controller_cmd, live))?
+            }
         }
         out.push((kind, path));
     }

@@ -2,8 +2,8 @@
 //! processes, starts them together, watches them, and stops them in order.
 
 mod error;
-mod nodes;
 mod files;
+mod nodes;
 pub mod spawn;
 pub mod timing;
 
@@ -23,8 +23,8 @@ use wire::{
 
 use crate::analysis::{AnalyseOptions, LogAnalysis, analyse};
 use crate::mode::Mode;
-use nodes::NodeStates;
 use files::RunFiles;
+use nodes::NodeStates;
 use spawn::{Children, describe};
 
 /// The nodes `testbed run` starts, in start order (the logger first, so it
