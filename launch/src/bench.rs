@@ -41,6 +41,8 @@ pub struct BenchOptions {
     /// real time SCHED_FIFO with locked memory); the timer floor then runs
     /// with the plant's placement, so that the two compare like for like.
     pub realtime_setup: bool,
+    /// The logs' chunk compression.
+    pub log_compression: logger::LogCompression,
     /// Run this law instead of the scenarios' (None: theirs).
     pub law: Option<controller::LawName>,
 }
@@ -283,6 +285,7 @@ pub(crate) fn stack(
         verbose: false,
         controller_cmd: controller_cmd.map(<[String]>::to_vec),
         live: None,
+        log_compression: opts.log_compression,
     })?)
 }
 

@@ -21,6 +21,7 @@
 //! [`foxglove_layout`] lays them out for either.
 
 mod channels;
+mod compression;
 mod json;
 mod layout;
 pub mod live;
@@ -33,6 +34,7 @@ pub mod scene;
 mod writer;
 
 pub use channels::{ChannelSpec, channels};
+pub use compression::LogCompression;
 pub use json::{DecodeError, Fields, LogMessage};
 pub use layout::foxglove_layout;
 pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes};

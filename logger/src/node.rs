@@ -31,6 +31,9 @@ pub struct LoggerNodeConfig {
     /// Joints the scenario holds still, as the plant holds them.
     #[serde(default)]
     pub lock: arm_model::Locks,
+    /// Chunk compression of the log.
+    #[serde(default)]
+    pub compression: crate::LogCompression,
     /// Serve the run live to Foxglove (`testbed run --live`).
     #[serde(default)]
     pub live: Option<LiveConfig>,
@@ -175,7 +178,7 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
     meta.start_time_unix_ns = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_nanos() as u64);
-    let log = LogWriter::create(&config.out, &meta, &config.urdf)?;
+    let log = LogWriter::create_with(&config.out, &meta, &config.urdf, config.compression)?;
     let mut out = Outputs::open(log, &model, live)?;
 
     let started = link.ready_and_wait_for_start();

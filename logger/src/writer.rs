@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use mcap::records::MessageHeader;
-use mcap::{Attachment, Compression, WriteOptions, Writer};
+use mcap::{Attachment, WriteOptions, Writer};
 
 use super::channels::ChannelSpec;
+use super::compression::LogCompression;
 use super::json::LogMessage;
 use super::{LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
 
@@ -109,8 +110,18 @@ pub struct LogWriter {
 }
 
 impl LogWriter {
-    /// Creates the file and writes the run's metadata and the URDF.
+    /// Creates the file (zstd chunks) and writes the run's metadata and the URDF.
     pub fn create(path: &Path, meta: &RunMetadata, urdf: &str) -> Result<Self, LogError> {
+        Self::create_with(path, meta, urdf, LogCompression::Zstd)
+    }
+
+    /// [`LogWriter::create`] with chunks compressed as `compression` says.
+    pub fn create_with(
+        path: &Path,
+        meta: &RunMetadata,
+        urdf: &str,
+        compression: LogCompression,
+    ) -> Result<Self, LogError> {
         let p = path.display().to_string();
         let file = File::create(path).map_err(|cause| LogError::Io {
             path: p.clone(),
@@ -118,7 +129,7 @@ impl LogWriter {
         })?;
         let mcap_err = |cause| LogError::mcap(&p, cause);
         let mut writer = WriteOptions::new()
-            .compression(Some(Compression::Zstd))
+            .compression(compression.mcap())
             // Level 1, not zstd's default 3: in lockstep the logger paces
             // the run, and this is its largest cost (the files grow 4 %).
             .compression_level(1)

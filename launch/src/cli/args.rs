@@ -64,6 +64,11 @@ pub(crate) struct RunArgs {
     /// appends the node arguments and supervises it like any node.
     #[arg(long, value_name = "CMD", conflicts_with = "external")]
     pub(crate) controller_cmd: Option<String>,
+    /// Chunk compression of the log: zstd (smallest), lz4 or none (the
+    /// logger's cheapest, ten times larger; in lockstep the logger paces
+    /// the run).
+    #[arg(long, value_name = "KIND", default_value = "zstd", value_parser = logger::LogCompression::parse)]
+    pub(crate) log_compression: logger::LogCompression,
     /// Serve the run live to Foxglove (Open connection → Foxglove
     /// WebSocket → ws://ADDR:PORT) from the logger. Without a value:
     /// 127.0.0.1:8765.
@@ -133,6 +138,11 @@ pub(crate) struct BenchArgs {
     /// Measure without pinning, SCHED_FIFO or locked memory.
     #[arg(long)]
     pub(crate) no_realtime_setup: bool,
+    /// Chunk compression of the log: zstd (smallest), lz4 or none (the
+    /// logger's cheapest, ten times larger; in lockstep the logger paces
+    /// the run).
+    #[arg(long, value_name = "KIND", default_value = "zstd", value_parser = logger::LogCompression::parse)]
+    pub(crate) log_compression: logger::LogCompression,
     /// Run this law instead of the scenarios' (with --controller-cmd: the
     /// law the testbed's controller runs, whose parameters the command gets).
     #[arg(long, value_name = "LAW")]

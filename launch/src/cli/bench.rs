@@ -31,6 +31,7 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
         duration_s: args.duration,
         large_arm: args.large_arm,
         realtime_setup: !args.no_realtime_setup,
+        log_compression: args.log_compression,
         law: args.law,
     };
     let progress = |what: &str| eprintln!("testbed bench: {what}");

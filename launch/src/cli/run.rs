@@ -27,6 +27,7 @@ pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
             .as_deref()
             .map(super::args::command_words)
             .transpose()?,
+        log_compression: args.log_compression,
         live: args.live.map(|addr| logger::live::LiveConfig {
             addr,
             rate_hz: args.live_rate,

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use controller::node::{ControllerNodeConfig, NodeModel};
-use logger::RunMetadata;
+use logger::{LogCompression, RunMetadata};
 use logger::live::LiveConfig;
 use logger::node::LoggerNodeConfig;
 use plant_rapier::node::PlantNodeConfig;
@@ -59,25 +59,35 @@ pub fn trajectory(plan: &Plan) -> TrajectoryNodeConfig {
     }
 }
 
-/// The logger's part: where to write, what the log says about the run
-/// (`controller_cmd`: the user's command that replaces the controller node)
-/// and whether to serve it live.
+/// What a run's options, beyond its plan, tell the logger.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LoggerOptions<'a> {
+    /// The user's command that replaces the controller node (recorded).
+    pub controller_cmd: Option<&'a str>,
+    /// Serve the run live.
+    pub live: Option<&'a LiveConfig>,
+    /// The log's chunk compression.
+    pub compression: LogCompression,
+}
+
+/// The logger's part: where to write, what the log says about the run,
+/// how it is compressed and whether it is served live.
 pub fn logger(
     plan: &Plan,
     mode: Mode,
     out: &Path,
     toml: &str,
-    controller_cmd: Option<&str>,
-    live: Option<&LiveConfig>,
+    opts: LoggerOptions<'_>,
 ) -> LoggerNodeConfig {
     let mut metadata = metadata(plan, mode, out, toml);
-    metadata.controller_cmd = controller_cmd.unwrap_or_default().to_string();
+    metadata.controller_cmd = opts.controller_cmd.unwrap_or_default().to_string();
     LoggerNodeConfig {
         out: out.to_path_buf(),
         metadata,
         urdf: plan.robot.urdf.clone(),
         lock: plan.scenario.plant.lock.clone(),
-        live: live.cloned(),
+        compression: opts.compression,
+        live: opts.live.cloned(),
     }
 }
 
@@ -155,8 +165,7 @@ pub fn write_all(
     mode: Mode,
     log: &Path,
     toml: &str,
-    controller_cmd: Option<&str>,
-    live: Option<&LiveConfig>,
+    logger_opts: LoggerOptions<'_>,
 ) -> Result<Vec<(NodeKind, PathBuf)>, ConfigError> {
     std::fs::create_dir_all(dir).map_err(|cause| ConfigError::Io {
         path: dir.display().to_string(),
@@ -170,7 +179,7 @@ pub fn write_all(
             NodeKind::Controller => write_config(&path, &controller(plan))?,
             NodeKind::Trajectory => write_config(&path, &trajectory(plan))?,
             NodeKind::Logger => {
-                write_config(&path, &logger(plan, mode, log, toml, controller_cmd, live))?
+                write_config(&path, &logger(plan, mode, log, toml, logger_opts))?
             }
         }
         out.push((kind, path));

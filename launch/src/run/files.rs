@@ -5,6 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use logger::foxglove_layout;
+
+use crate::node::configs::LoggerOptions;
 use wire::NodeKind;
 
 use super::{RunError, RunOptions, run_id};
@@ -51,8 +53,11 @@ impl RunFiles {
             opts.mode,
             &log,
             &toml,
-            command.as_deref(),
-            opts.live.as_ref(),
+            LoggerOptions {
+                controller_cmd: command.as_deref(),
+                live: opts.live.as_ref(),
+                compression: opts.log_compression,
+            },
         )
         .map_err(|e| RunError::Output(run_dir.display().to_string(), std::io::Error::other(e)))?;
         Ok(Self {

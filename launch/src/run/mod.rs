@@ -14,6 +14,7 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use logger::LogCompression;
 use logger::live::LiveConfig;
 use scenario::Plan;
 use wire::{
@@ -78,6 +79,8 @@ pub struct RunOptions {
     pub controller_cmd: Option<Vec<String>>,
     /// Serve the run live to Foxglove from the logger (`--live`).
     pub live: Option<LiveConfig>,
+    /// The log's chunk compression.
+    pub log_compression: LogCompression,
 }
 
 /// What a finished run produced.
