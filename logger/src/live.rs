@@ -8,7 +8,12 @@
 //! `rate_hz` times per second of sim time (every k-th sample: which ones is
 //! deterministic); a topic nobody subscribes to costs one check. The server
 //! queues each client's messages and drops the oldest when a client falls
-//! behind, so a client that never reads costs the logger a bounded queue.
+//! behind, so a client that never reads costs the logger a bounded queue;
+//! once its control queue (the clock's ticks among them) is full too, the
+//! server disconnects it. How many of a client's messages the server
+//! dropped, foxglove 0.30 does not tell (its `ConnectedClient::log` throws
+//! the count away); what the stats record per client is what was handed to
+//! the server for it, and whether it was still subscribed at the end.
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::net::SocketAddr;
@@ -199,11 +204,17 @@ impl Live {
 
     /// Stops the server; what was sent, for the log's stats record.
     pub fn finish(mut self) -> BTreeMap<String, String> {
+        let out = self.stats();
         if let Some(server) = self.server.take() {
             // Dropping the shutdown handle closes the connections at once:
             // the run is over, nothing is left to send.
             drop(server.stop());
         }
+        out
+    }
+
+    /// The counts, taken while the clients are still connected.
+    fn stats(&self) -> BTreeMap<String, String> {
         let mut out = BTreeMap::new();
         out.insert("live.address".into(), self.config.addr.to_string());
         out.insert("live.rate_hz".into(), format!("{:?}", self.config.rate_hz));
@@ -214,10 +225,17 @@ impl Live {
         let book = self.book.book();
         out.insert("live.clients".into(), book.order.len().to_string());
         for (k, id) in book.order.iter().enumerate() {
-            let messages = book.clients.get(id).map_or(0, |c| c.messages);
+            let (messages, subscribed) = book
+                .clients
+                .get(id)
+                .map_or((0, 0), |c| (c.messages, c.channels.len()));
+            let client = format!("live.client{}", k + 1);
+            out.insert(format!("{client}.messages"), messages.to_string());
+            // A client that left, or that the server disconnected because
+            // its control queue was full, has no subscription left.
             out.insert(
-                format!("live.client{}.messages", k + 1),
-                messages.to_string(),
+                format!("{client}.subscribed_at_end"),
+                subscribed.to_string(),
             );
         }
         out

@@ -232,6 +232,7 @@ fn a_lockstep_run_streams_live_what_its_log_keeps() {
     assert_eq!(live, log_channels(log));
     let stats = logger::read_log(log, None).unwrap().stats.unwrap();
     assert_eq!(stats["live.clients"], "1", "{stats:?}");
+    assert_eq!(stats["live.client1.subscribed_at_end"], "2", "{stats:?}");
     let handed: u64 = stats["live.client1.messages"].parse().unwrap();
     assert!(handed >= got.len() as u64, "{handed} < {}", got.len());
 }

@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use controller::node::{ControllerNodeConfig, NodeModel};
-use logger::{LogCompression, RunMetadata};
 use logger::live::LiveConfig;
 use logger::node::LoggerNodeConfig;
+use logger::{LogCompression, RunMetadata};
 use plant_rapier::node::PlantNodeConfig;
 use scenario::Plan;
 use trajectory::node::TrajectoryNodeConfig;
@@ -178,9 +178,7 @@ pub fn write_all(
             NodeKind::Plant => write_config(&path, &plant(plan))?,
             NodeKind::Controller => write_config(&path, &controller(plan))?,
             NodeKind::Trajectory => write_config(&path, &trajectory(plan))?,
-            NodeKind::Logger => {
-                write_config(&path, &logger(plan, mode, log, toml, logger_opts))?
-            }
+            NodeKind::Logger => write_config(&path, &logger(plan, mode, log, toml, logger_opts))?,
         }
         out.push((kind, path));
     }
