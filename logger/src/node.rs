@@ -14,7 +14,7 @@ use wire::{
     Topic, TopicSubscriber,
 };
 
-use crate::live::{Live, LiveConfig, LiveError};
+use crate::live::{LiveConfig, LiveError};
 use crate::outputs::Outputs;
 use crate::{LogError, LogMessage, LogWriter, RUN_END, RunMetadata};
 
@@ -171,7 +171,7 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
     // The live view first: a taken port fails the run before anything is
     // written.
     let live = match &config.live {
-        Some(live) => Some(Live::start(live, &crate::channels())?),
+        Some(live) => Some(crate::live::start(live, &crate::channels())?),
         None => None,
     };
     let mut meta = config.metadata.clone();

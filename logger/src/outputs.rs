@@ -8,7 +8,7 @@ use arm_model::ArmModel;
 use serde_json::Value;
 use wire::JointState;
 
-use crate::live::Live;
+use crate::live::LiveView;
 use crate::scene::{ArmScene, SCENE_TOPIC, TRANSFORMS_TOPIC};
 use crate::{LogError, LogMessage, LogWriter, channels};
 
@@ -22,7 +22,7 @@ const SCENE_EVERY_NS: u64 = 1_000_000_000;
 /// The logger's outputs.
 pub(crate) struct Outputs {
     log: LogWriter,
-    live: Option<Live>,
+    live: Option<Box<dyn LiveView>>,
     arm: ArmScene,
     dof: usize,
     next_transforms_ns: u64,
@@ -36,7 +36,7 @@ impl Outputs {
     pub(crate) fn open(
         mut log: LogWriter,
         model: &ArmModel,
-        live: Option<Live>,
+        live: Option<Box<dyn LiveView>>,
     ) -> Result<Self, LogError> {
         for spec in channels() {
             log.add_channel_spec(&spec)?;

@@ -1,8 +1,5 @@
-//! The live view (`testbed run --live`): while the run goes, the logger
-//! serves the run's channels (the same list, topics and schemas as the log,
-//! [`crate::channels`]) over the Foxglove WebSocket protocol with the
-//! `foxglove` crate. Only the logger process does this, and only when asked:
-//! without `--live` nothing here runs, and no tokio runtime exists.
+//! The live view's server: the `foxglove` crate's WebSocket server on its
+//! own tokio runtime, started only for a run with `--live`.
 //!
 //! The run must not wait for a viewer. Each topic goes out live at most
 //! `rate_hz` times per second of sim time (every k-th sample: which ones is
@@ -16,57 +13,16 @@
 //! the server for it, and whether it was still subscribed at the end.
 
 use std::collections::{BTreeMap, HashMap, HashSet};
-use std::net::SocketAddr;
 use std::sync::{Arc, Mutex};
 
+use super::{LiveConfig, LiveError, LiveView};
+use crate::ChannelSpec;
 use foxglove::websocket::{Capability, ChannelView, Client, ClientId, ServerListener};
 use foxglove::{ChannelId, Context, PartialMetadata, RawChannel, Schema, WebSocketServerHandle};
-use serde::{Deserialize, Serialize};
 
-use crate::ChannelSpec;
-
-/// The port Foxglove's own examples use, and its app's default.
-pub const DEFAULT_PORT: u16 = 8765;
-/// Most samples per topic and second of sim time sent live.
-pub const DEFAULT_RATE_HZ: f64 = 50.0;
 /// Messages the server queues per client before dropping the oldest
 /// (≈ 3 s of every topic at the default rate).
 const BACKLOG: usize = 1024;
-
-/// What the launcher hands the logger for a live run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct LiveConfig {
-    /// Where to listen.
-    pub addr: SocketAddr,
-    /// Most samples per topic and second of sim time sent live (the log
-    /// keeps every one).
-    pub rate_hz: f64,
-}
-
-/// Why the live view could not start.
-#[derive(Debug, thiserror::Error)]
-pub enum LiveError {
-    /// The address is taken or not ours to listen on.
-    #[error("the live view cannot listen on {addr}: {cause}")]
-    Listen {
-        /// The address.
-        addr: SocketAddr,
-        /// The cause, as the server gives it.
-        cause: String,
-    },
-    /// A channel could not be opened.
-    #[error("the live view cannot open channel {topic}: {cause}")]
-    Channel {
-        /// The topic.
-        topic: &'static str,
-        /// The cause.
-        cause: String,
-    },
-    /// The rate is not a positive number.
-    #[error("live rate_hz must be a positive number, got {0}")]
-    Rate(f64),
-}
 
 /// One channel as served live.
 struct LiveTopic {
@@ -129,7 +85,7 @@ impl ServerListener for ClientBook {
 }
 
 /// The running live view.
-pub struct Live {
+pub(super) struct Live {
     /// Holds the channels and the server's sinks: both go with it.
     _context: Arc<Context>,
     server: Option<WebSocketServerHandle>,
@@ -144,10 +100,7 @@ pub struct Live {
 impl Live {
     /// Starts the server on `config.addr` with `channels` (the first one's
     /// samples drive the viewer's clock).
-    pub fn start(config: &LiveConfig, channels: &[ChannelSpec]) -> Result<Self, LiveError> {
-        if !(config.rate_hz.is_finite() && config.rate_hz > 0.0) {
-            return Err(LiveError::Rate(config.rate_hz));
-        }
+    pub(super) fn start(config: &LiveConfig, channels: &[ChannelSpec]) -> Result<Self, LiveError> {
         let ctx = Context::new();
         let book = Arc::new(ClientBook::default());
         let addr = config.addr;
@@ -178,41 +131,6 @@ impl Live {
         })
     }
 
-    /// Offers one message of `topic` (its JSON) stamped `t_ns`: sent if its
-    /// topic is due and someone subscribed, skipped otherwise.
-    pub fn offer(&mut self, topic: &str, t_ns: u64, json: &[u8]) {
-        let Some(t) = self.topics.iter_mut().find(|t| t.name == topic) else {
-            return;
-        };
-        if t_ns < t.next_ns {
-            return;
-        }
-        t.next_ns = t_ns.saturating_add(self.period_ns);
-        if topic == self.clock_topic
-            && let Some(server) = &self.server
-        {
-            server.broadcast_time(t_ns);
-        }
-        if !t.channel.has_sinks() {
-            return;
-        }
-        t.channel
-            .log_with_meta(json, PartialMetadata::with_log_time(t_ns));
-        t.sent += 1;
-        self.book.count(t.channel.id());
-    }
-
-    /// Stops the server; what was sent, for the log's stats record.
-    pub fn finish(mut self) -> BTreeMap<String, String> {
-        let out = self.stats();
-        if let Some(server) = self.server.take() {
-            // Dropping the shutdown handle closes the connections at once:
-            // the run is over, nothing is left to send.
-            drop(server.stop());
-        }
-        out
-    }
-
     /// The counts, taken while the clients are still connected.
     fn stats(&self) -> BTreeMap<String, String> {
         let mut out = BTreeMap::new();
@@ -237,6 +155,40 @@ impl Live {
                 format!("{client}.subscribed_at_end"),
                 subscribed.to_string(),
             );
+        }
+        out
+    }
+}
+
+impl LiveView for Live {
+    fn offer(&mut self, topic: &str, t_ns: u64, json: &[u8]) {
+        let Some(t) = self.topics.iter_mut().find(|t| t.name == topic) else {
+            return;
+        };
+        if t_ns < t.next_ns {
+            return;
+        }
+        t.next_ns = t_ns.saturating_add(self.period_ns);
+        if topic == self.clock_topic
+            && let Some(server) = &self.server
+        {
+            server.broadcast_time(t_ns);
+        }
+        if !t.channel.has_sinks() {
+            return;
+        }
+        t.channel
+            .log_with_meta(json, PartialMetadata::with_log_time(t_ns));
+        t.sent += 1;
+        self.book.count(t.channel.id());
+    }
+
+    fn finish(mut self: Box<Self>) -> BTreeMap<String, String> {
+        let out = self.stats();
+        if let Some(server) = self.server.take() {
+            // Dropping the shutdown handle closes the connections at once:
+            // the run is over, nothing is left to send.
+            drop(server.stop());
         }
         out
     }
