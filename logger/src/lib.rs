@@ -7,7 +7,7 @@
 //! back ([`read_log`]). Nothing here steps the loop.
 //!
 //! Channels carry JSON messages with `jsonschema` schemas (so Foxglove can
-//! plot every field), in zstd-compressed chunks; each message's log time is
+//! plot every field), in zstd-compressed chunks (LZ4 or none on request); each message's log time is
 //! its sim time and its publish time the sample's wall timestamp. A metadata
 //! record `testbed.run` holds the scenario (full TOML), run id, mode, rate,
 //! software version and start time; the robot's URDF is an attachment; a
