@@ -118,9 +118,15 @@ impl Viewer {
         loop {
             let m = match self.ws.read() {
                 Ok(m) => m,
-                Err(tungstenite::Error::ConnectionClosed | tungstenite::Error::AlreadyClosed) => {
-                    break;
-                }
+                // The end of the run: a close frame, or (a server that could
+                // not close in time) the logger process ending.
+                Err(
+                    tungstenite::Error::ConnectionClosed
+                    | tungstenite::Error::AlreadyClosed
+                    | tungstenite::Error::Protocol(
+                        tungstenite::error::ProtocolError::ResetWithoutClosingHandshake,
+                    ),
+                ) => break,
                 Err(tungstenite::Error::Io(e)) if e.kind() != std::io::ErrorKind::WouldBlock => {
                     break;
                 }

@@ -24,6 +24,9 @@ use foxglove::{ChannelId, Context, PartialMetadata, RawChannel, Schema, WebSocke
 /// (≈ 3 s of every topic at the default rate).
 const BACKLOG: usize = 1024;
 
+/// How long the logger waits for the clients' close frames at the end.
+const STOP_WAIT: std::time::Duration = std::time::Duration::from_millis(500);
+
 /// One channel as served live.
 struct LiveTopic {
     name: &'static str,
@@ -186,9 +189,17 @@ impl LiveView for Live {
     fn finish(mut self: Box<Self>) -> BTreeMap<String, String> {
         let out = self.stats();
         if let Some(server) = self.server.take() {
-            // Dropping the shutdown handle closes the connections at once:
-            // the run is over, nothing is left to send.
-            drop(server.stop());
+            // A graceful stop sends each client a close frame; a client that
+            // does not read may never let it through, so the logger waits
+            // for it a moment only (the process then ends, and with it the
+            // connections).
+            let stopping = server.stop();
+            let (done, stopped) = std::sync::mpsc::channel();
+            std::thread::spawn(move || {
+                stopping.wait_blocking();
+                let _ = done.send(());
+            });
+            let _ = stopped.recv_timeout(STOP_WAIT);
         }
         out
     }
