@@ -80,13 +80,13 @@ impl ArmScene {
             .iter()
             .zip(poses)
             .map(|(name, pose)| {
-                let (t, r) = (pose.translation.vector, pose.rotation);
+                let (translation, rotation) = parts(pose);
                 json!({
                     "timestamp": stamp,
                     "parent_frame_id": WORLD_FRAME,
                     "child_frame_id": name,
-                    "translation": {"x": t.x, "y": t.y, "z": t.z},
-                    "rotation": {"x": r.i, "y": r.j, "z": r.k, "w": r.w},
+                    "translation": translation,
+                    "rotation": rotation,
                 })
             })
             .collect();
@@ -145,12 +145,18 @@ fn cylinder_pose(to: Vector3<f64>) -> Isometry3<f64> {
     Isometry3::from_parts((to / 2.0).into(), rotation)
 }
 
-fn pose(p: &Isometry3<f64>) -> Value {
+/// A rigid transform as Foxglove's Vector3 and Quaternion.
+fn parts(p: &Isometry3<f64>) -> (Value, Value) {
     let (t, r) = (p.translation.vector, p.rotation);
-    json!({
-        "position": {"x": t.x, "y": t.y, "z": t.z},
-        "orientation": {"x": r.i, "y": r.j, "z": r.k, "w": r.w},
-    })
+    (
+        json!({"x": t.x, "y": t.y, "z": t.z}),
+        json!({"x": r.i, "y": r.j, "z": r.k, "w": r.w}),
+    )
+}
+
+fn pose(p: &Isometry3<f64>) -> Value {
+    let (position, orientation) = parts(p);
+    json!({"position": position, "orientation": orientation})
 }
 
 /// Alternating link colours, so that neighbours stand apart.
