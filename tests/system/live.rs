@@ -23,6 +23,22 @@ fn free_port() -> u16 {
         .port()
 }
 
+/// One WebSocket connection as Foxglove opens it.
+fn handshake(port: u16) -> Result<WebSocket<TcpStream>, String> {
+    let stream = TcpStream::connect(("127.0.0.1", port)).map_err(|e| e.to_string())?;
+    stream
+        .set_read_timeout(Some(Duration::from_secs(30)))
+        .map_err(|e| e.to_string())?;
+    let mut req = format!("ws://127.0.0.1:{port}")
+        .into_client_request()
+        .unwrap();
+    req.headers_mut()
+        .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
+    tungstenite::client::client(req, stream)
+        .map(|(ws, _)| ws)
+        .map_err(|e| e.to_string())
+}
+
 /// A channel as the server advertised it.
 #[derive(Debug, Clone)]
 struct Advertised {
@@ -42,11 +58,11 @@ impl Viewer {
     /// Connects as soon as the logger listens (watchdog: 60 s, or the
     /// launcher ending first).
     fn connect(port: u16, launcher: &mut Child) -> Viewer {
+        // Retried until the logger's server answers: the launcher checks the
+        // port by listening on it a moment first, and a connection that
+        // lands then is reset.
         let start = Instant::now();
-        let stream = loop {
-            if let Ok(s) = TcpStream::connect(("127.0.0.1", port)) {
-                break s;
-            }
+        let ws = loop {
             assert!(
                 launcher.try_wait().unwrap().is_none(),
                 "the run ended before its live view listened"
@@ -55,17 +71,11 @@ impl Viewer {
                 start.elapsed() < Duration::from_secs(60),
                 "nobody listens on {port}"
             );
+            if let Ok(ws) = handshake(port) {
+                break ws;
+            }
             std::thread::sleep(Duration::from_millis(2));
         };
-        stream
-            .set_read_timeout(Some(Duration::from_secs(30)))
-            .unwrap();
-        let mut req = format!("ws://127.0.0.1:{port}")
-            .into_client_request()
-            .unwrap();
-        req.headers_mut()
-            .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
-        let (ws, _) = tungstenite::client::client(req, stream).unwrap();
         let mut v = Viewer {
             ws,
             channels: HashMap::new(),
