@@ -125,7 +125,7 @@ pub struct LogAnalysis {
     pub timing: TimingSummary,
     /// Rows the run should have.
     pub expected_rows: u64,
-    /// Rows whose samples were dropped.
+    /// Rows whose samples were dropped or never came (of a finished run).
     pub missing_rows: u64,
     /// Largest |τ_replayed − τ_logged| and steps compared, with `verify`.
     pub verify: Option<(f64, u64)>,
@@ -323,11 +323,19 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         w.flush().map_err(out_err)?;
     }
     let wall = a.wall;
+    // A log the logger finished holds every row it was sent: the rows
+    // still incomplete are lost too.
+    let finished = contents.cut_short.is_none() && contents.run_end() == Some("finished");
+    let unfinished = if finished {
+        a.assembler.unfinished()
+    } else {
+        0
+    };
     Ok(LogAnalysis {
         wall_span_s: wall.1.saturating_sub(wall.0) as f64 / 1e9,
         wall_window_ns: wall,
         expected_rows: plan.steps,
-        missing_rows: a.assembler.missing(),
+        missing_rows: a.assembler.missing() + unfinished,
         summary: a.summary.finish(),
         timing: a.timing.finish(mode, plan.scenario.rate_hz),
         verify: a.verifier.map(|v| (v.max_abs_torque_diff, v.steps)),

@@ -75,6 +75,13 @@ impl RecordAssembler {
         self.missing
     }
 
+    /// Rows neither emitted nor given up: at the end of a finished run's
+    /// log, rows whose samples never came (a topic that was never
+    /// delivered leaves every row here, not in [`Self::missing`]).
+    pub fn unfinished(&self) -> u64 {
+        self.steps.saturating_sub(self.next)
+    }
+
     /// True once every row has been emitted or given up.
     pub fn complete(&self) -> bool {
         self.next >= self.steps
@@ -213,6 +220,22 @@ mod tests {
         }
         assert_eq!(rows(&mut a), 99);
         assert_eq!(a.missing(), 1);
+        assert_eq!(a.unfinished(), 0);
         assert!(a.complete());
+    }
+
+    /// Regression: a lockstep log whose logger never got the controller's
+    /// topics (an iceoryx2 connection left unmade) gave no row, no missing
+    /// row, and a run that passed with a summary of zero steps.
+    #[test]
+    fn a_topic_never_delivered_leaves_every_row_unfinished() {
+        let mut a = RecordAssembler::new(1, 1e-3, 400);
+        for k in 0..=400 {
+            a.push_state(state(k));
+        }
+        assert_eq!(rows(&mut a), 0);
+        assert_eq!(a.missing(), 0);
+        assert_eq!(a.unfinished(), 400);
+        assert!(!a.complete());
     }
 }

@@ -1,6 +1,6 @@
 //! The laws of BASELINES.md and `testbed compare`, as a user runs them.
 
-use crate::util::{fails, json, ok, testbed};
+use crate::util::{assert_same_csv, fails, json, ok, testbed};
 
 const LAWS: [&str; 9] = [
     "nac",
@@ -50,9 +50,10 @@ fn every_law_in_lockstep_equals_its_sim_bit_for_bit() {
             .args(common)
             .arg("--csv")
             .arg(&sim_csv)));
-        assert!(
-            std::fs::read(&run_csv).unwrap() == std::fs::read(&sim_csv).unwrap(),
-            "{law}: lockstep CSV differs from sim"
+        assert_same_csv(
+            &format!("{law}: lockstep vs sim"),
+            &std::fs::read(&run_csv).unwrap(),
+            &std::fs::read(&sim_csv).unwrap(),
         );
         for key in SUMMARY_KEYS {
             assert_eq!(run[key], sim[key], "{law}: {key}");

@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use crate::util::{fails, json, ok, testbed};
+use crate::util::{assert_same_csv, fails, json, ok, testbed};
 
 /// Runs a lockstep run of `duration` seconds; returns its JSON and log path.
 fn lockstep_run(dir: &Path, duration: &str) -> (serde_json::Value, PathBuf) {
@@ -225,7 +225,11 @@ fn replay_writes_csv_and_figures() {
     ok(testbed()
         .args(["sim", "--duration", "1", "--csv"])
         .arg(&sim_csv));
-    assert!(std::fs::read(&csv).unwrap() == std::fs::read(&sim_csv).unwrap());
+    assert_same_csv(
+        "replay vs sim",
+        &std::fs::read(&csv).unwrap(),
+        &std::fs::read(&sim_csv).unwrap(),
+    );
     for fig in [
         "fig1_positions",
         "fig2_velocities",

@@ -6,7 +6,9 @@ use std::time::Duration;
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 
-use crate::util::{fails, json, nodes_of, ok, shm_files, testbed, wait_bounded, wait_for_nodes};
+use crate::util::{
+    assert_same_csv, fails, json, nodes_of, ok, shm_files, testbed, wait_bounded, wait_for_nodes,
+};
 
 fn sim_csv(dir: &std::path::Path, duration: &str) -> Vec<u8> {
     let path = dir.join(format!("sim-{duration}.csv"));
@@ -35,9 +37,10 @@ fn lockstep_equals_sim_bit_for_bit() {
         .arg("--csv")
         .arg(&csv));
     let run = json(&out);
-    assert!(
-        std::fs::read(&csv).unwrap() == sim_csv(dir.path(), "2.5"),
-        "lockstep CSV differs from sim"
+    assert_same_csv(
+        "lockstep vs sim",
+        &std::fs::read(&csv).unwrap(),
+        &sim_csv(dir.path(), "2.5"),
     );
     let sim = json(&ok(testbed().args(["sim", "--duration", "2.5", "--json"])));
     for key in [

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::util::{fails, json, ok, repo_root, testbed};
+use crate::util::{assert_same_csv, fails, json, ok, repo_root, testbed};
 
 /// Every shipped scenario, as listed by `testbed scenarios`.
 fn shipped() -> Vec<String> {
@@ -104,9 +104,10 @@ fn seeded_effects_reproduce_exactly_across_processes_and_seeds_differ() {
         .arg(&runs)
         .arg("--csv")
         .arg(&lockstep_csv)));
-    assert!(
-        sim1 == std::fs::read(&lockstep_csv).unwrap(),
-        "lockstep differs from sim"
+    assert_same_csv(
+        "sim vs lockstep",
+        &sim1,
+        &std::fs::read(&lockstep_csv).unwrap(),
     );
     // The controller, re-driven from the logged measurements, gives the
     // logged torques exactly.

@@ -36,6 +36,37 @@ pub fn fails(cmd: &mut Command) -> String {
     err
 }
 
+/// Fails the test unless two CSV texts are equal, naming the first row
+/// that differs and the column values on it (a bare "differs" tells a
+/// flaky failure's reader nothing).
+pub fn assert_same_csv(what: &str, a: &[u8], b: &[u8]) {
+    if a == b {
+        return;
+    }
+    let (a, b) = (String::from_utf8_lossy(a), String::from_utf8_lossy(b));
+    let (la, lb): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
+    let header: Vec<&str> = la.first().map_or(vec![], |h| h.split(',').collect());
+    let row = la.iter().zip(&lb).position(|(x, y)| x != y);
+    let detail = match row {
+        Some(i) => {
+            let cols: Vec<String> = la[i]
+                .split(',')
+                .zip(lb[i].split(','))
+                .enumerate()
+                .filter(|(_, (x, y))| x != y)
+                .map(|(c, (x, y))| format!("{}: {x} vs {y}", header.get(c).unwrap_or(&"?")))
+                .collect();
+            format!("line {} differs first: {}", i + 1, cols.join("; "))
+        }
+        None => "one is a prefix of the other".into(),
+    };
+    panic!(
+        "{what}: CSVs differ ({} vs {} lines); {detail}",
+        la.len(),
+        lb.len()
+    );
+}
+
 /// Parses stdout as JSON.
 pub fn json(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("stdout is one JSON object")

@@ -35,6 +35,7 @@ mod layout;
 mod leftovers;
 mod messages;
 mod node;
+mod ports_lock;
 mod reference;
 mod topics;
 

@@ -7,11 +7,11 @@ use std::sync::{Arc, OnceLock};
 use std::time::Duration;
 
 use iceoryx2::node::NodeWaitFailure;
-use iceoryx2::port::BackpressureAction;
 use iceoryx2::port::listener::{Listener, ListenerWaitError};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::{BackpressureAction, DegradationAction, DegradationCause, DegradationInfo};
 use iceoryx2::prelude::*;
 
 /// A pub/sub topic and its paired event service (same name).
@@ -325,7 +325,9 @@ impl Bus {
         delivery: Delivery,
     ) -> Result<TopicPublisher<T>, WireError> {
         let service = self.service::<T>(topic)?;
-        let builder = service.publisher_builder();
+        let builder = service
+            .publisher_builder()
+            .set_degradation_handler(move |c, i| degraded(topic, c, i));
         let builder = match delivery {
             Delivery::Lossless => builder
                 .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
@@ -387,6 +389,7 @@ impl Bus {
         let subscriber = service
             .subscriber_builder()
             .buffer_size(SUBSCRIBER_BUFFER)
+            .set_degradation_handler(move |c, i| degraded(topic, c, i))
             .create()
             .map_err(|e| ipc("create subscriber", topic.name())(format!("{e:?}")))?;
         let listener = if listen {
@@ -405,6 +408,24 @@ impl Bus {
             listener,
         })
     }
+}
+
+/// A connection iceoryx2 could not make or found corrupted: said on stderr
+/// whatever iceoryx2's log level (by default it only warns, and samples on
+/// that connection would be lost without a word), and the send or receive
+/// that found it fails.
+fn degraded(topic: Topic, cause: DegradationCause, info: &DegradationInfo) -> DegradationAction {
+    let what = match cause {
+        DegradationCause::FailedToEstablishConnection => "could not connect",
+        DegradationCause::ConnectionCorrupted => "found a corrupted connection between",
+    };
+    eprintln!(
+        "testbed: iceoryx2 {what} publisher {:x} and subscriber {:x} of {}",
+        info.sender_port_id,
+        info.receiver_port_id,
+        topic.name()
+    );
+    DegradationAction::DegradeAndFail
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> TopicPublisher<T> {

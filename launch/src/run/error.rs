@@ -83,6 +83,23 @@ pub enum RunError {
         /// Steps of the run.
         steps: u64,
     },
+    /// A lockstep run loses nothing by design: rows missing from its log
+    /// mean a topic was not delivered to the logger.
+    #[error(
+        "the lockstep run's log lacks {missing} of {steps} steps, so its figures are not \
+         printed (the logger received: {received}); a topic was not delivered, which is a \
+         fault of the shared-memory transport: run it again. The log is kept: {log}"
+    )]
+    LockstepIncomplete {
+        /// Rows missing.
+        missing: u64,
+        /// Rows expected.
+        steps: u64,
+        /// The logger's per-topic counts.
+        received: String,
+        /// The log.
+        log: String,
+    },
     /// Ctrl-C or SIGTERM.
     #[error("interrupted; all nodes stopped")]
     Interrupted,

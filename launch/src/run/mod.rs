@@ -187,6 +187,9 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     }
     // One analysis path: the summary comes from the log just written.
     let analysis = analyse_log(&files.log, opts.csv.as_deref())?;
+    if opts.mode == Mode::Lockstep && analysis.missing_rows > 0 {
+        return Err(incomplete(&analysis));
+    }
     Ok(RunOutcome {
         analysis,
         run_dir: files.run_dir,
@@ -194,6 +197,24 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         wall_time_s,
         peak_rss_kb,
     })
+}
+
+/// The error for a lockstep log with rows missing, with the logger's counts.
+fn incomplete(analysis: &LogAnalysis) -> RunError {
+    let received = analysis
+        .contents
+        .stats
+        .iter()
+        .flatten()
+        .filter_map(|(k, v)| Some(format!("{} {v}", k.strip_suffix(".received")?)))
+        .collect::<Vec<_>>()
+        .join(", ");
+    RunError::LockstepIncomplete {
+        missing: analysis.missing_rows,
+        steps: analysis.expected_rows,
+        received,
+        log: analysis.contents.path.display().to_string(),
+    }
 }
 
 /// What can be refused before anything starts: too many joints, an
