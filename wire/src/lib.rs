@@ -51,8 +51,9 @@ pub use messages::*;
 pub use node::{HEARTBEAT, Mode, NodeError, NodeLink, SILENT_AFTER, ns_to_s};
 pub use reference::ReferenceWindow;
 pub use topics::{
-    Bus, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix, SUBSCRIBER_BUFFER,
-    Topic, TopicPublisher, TopicSubscriber, WireError, monotonic_ns,
+    Bus, CONNECTION_FAILED, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix,
+    SUBSCRIBER_BUFFER, Topic, TopicPublisher, TopicSubscriber, WireError, connection_failures,
+    monotonic_ns,
 };
 
 /// iceoryx2's own messages on stderr: only its errors unless `verbose`

@@ -7,8 +7,8 @@
 use std::time::Duration;
 
 use crate::{
-    Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, NODE_DONE, NODE_FAILED,
-    NODE_READY, NODE_RUNNING, NodeKind, NodeStatus, RunPrefix, Topic, TopicPublisher,
+    Bus, CONNECTION_FAILED, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, NODE_DONE,
+    NODE_FAILED, NODE_READY, NODE_RUNNING, NodeKind, NodeStatus, RunPrefix, Topic, TopicPublisher,
     TopicSubscriber, WireError, monotonic_ns,
 };
 
@@ -206,6 +206,13 @@ impl NodeLink {
     /// may create its own.
     pub fn ready_and_wait_for_start(&mut self) -> Result<u64, NodeError> {
         self.ports_lock = None;
+        let failed = crate::connection_failures();
+        if failed > 0 {
+            self.report(NODE_FAILED, 0)?;
+            return Err(NodeError::Protocol(format!(
+                "{CONNECTION_FAILED} {failed} pair(s) of ports while creating them"
+            )));
+        }
         self.report(NODE_READY, 0)?;
         let mut last_report = monotonic_ns();
         loop {

@@ -410,17 +410,33 @@ impl Bus {
     }
 }
 
+/// What a node says on stderr when iceoryx2 cannot connect two ports: the
+/// launcher starts the run again when a node's last words hold it.
+pub const CONNECTION_FAILED: &str = "iceoryx2 could not connect";
+
+static CONNECTION_FAILURES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Connections iceoryx2 could not make in this process so far (one made
+/// while a port is created only warns inside iceoryx2, and that port then
+/// never retries it: [`crate::NodeLink`] fails the node at READY).
+pub fn connection_failures() -> u64 {
+    CONNECTION_FAILURES.load(Ordering::Relaxed)
+}
+
 /// A connection iceoryx2 could not make or found corrupted: said on stderr
 /// whatever iceoryx2's log level (by default it only warns, and samples on
 /// that connection would be lost without a word), and the send or receive
 /// that found it fails.
 fn degraded(topic: Topic, cause: DegradationCause, info: &DegradationInfo) -> DegradationAction {
     let what = match cause {
-        DegradationCause::FailedToEstablishConnection => "could not connect",
-        DegradationCause::ConnectionCorrupted => "found a corrupted connection between",
+        DegradationCause::FailedToEstablishConnection => {
+            CONNECTION_FAILURES.fetch_add(1, Ordering::Relaxed);
+            CONNECTION_FAILED
+        }
+        DegradationCause::ConnectionCorrupted => "iceoryx2 found a corrupted connection between",
     };
     eprintln!(
-        "testbed: iceoryx2 {what} publisher {:x} and subscriber {:x} of {}",
+        "testbed: {what} publisher {:x} and subscriber {:x} of {}",
         info.sender_port_id,
         info.receiver_port_id,
         topic.name()

@@ -6,6 +6,7 @@ mod files;
 mod nodes;
 pub mod spawn;
 pub mod timing;
+mod transport;
 
 pub use error::RunError;
 
@@ -128,10 +129,15 @@ pub fn node_args(
     args
 }
 
-/// Runs the stack to the end.
+/// Runs the stack to the end; a run the shared-memory transport failed to
+/// connect is started again ([`transport`]).
 pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
-    check_up_front(&opts)?;
-    let files = RunFiles::write(&opts)?;
+    transport::with_retries(&opts, run_once)
+}
+
+fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
+    check_up_front(opts)?;
+    let files = RunFiles::write(opts)?;
     let prefix = RunPrefix::unique();
     // Domains that killed launchers left behind.
     for stale in RunPrefix::stale_domains(&prefix) {
@@ -149,8 +155,8 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     // A node that cannot be started ends the run like any other failure:
     // the ones already started get STOP, and the domain is removed.
     let mut children = Children::default();
-    let result = spawn_nodes(&opts, &prefix, &files.configs, cpus, &mut children)
-        .and_then(|()| supervise(&opts, &bus, &status, &control, &mut children));
+    let result = spawn_nodes(opts, &prefix, &files.configs, cpus, &mut children)
+        .and_then(|()| supervise(opts, &bus, &status, &control, &mut children));
     let peak_rss_kb = children.peak_rss_kb();
     // Whatever happened: STOP (the logger then finishes the file), grace,
     // SIGTERM, SIGKILL, reap.
@@ -188,7 +194,7 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     // One analysis path: the summary comes from the log just written.
     let analysis = analyse_log(&files.log, opts.csv.as_deref())?;
     if opts.mode == Mode::Lockstep && analysis.missing_rows > 0 {
-        return Err(incomplete(&analysis));
+        return Err(transport::incomplete(&analysis));
     }
     Ok(RunOutcome {
         analysis,
@@ -197,24 +203,6 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
         wall_time_s,
         peak_rss_kb,
     })
-}
-
-/// The error for a lockstep log with rows missing, with the logger's counts.
-fn incomplete(analysis: &LogAnalysis) -> RunError {
-    let received = analysis
-        .contents
-        .stats
-        .iter()
-        .flatten()
-        .filter_map(|(k, v)| Some(format!("{} {v}", k.strip_suffix(".received")?)))
-        .collect::<Vec<_>>()
-        .join(", ");
-    RunError::LockstepIncomplete {
-        missing: analysis.missing_rows,
-        steps: analysis.expected_rows,
-        received,
-        log: analysis.contents.path.display().to_string(),
-    }
 }
 
 /// What can be refused before anything starts: too many joints, an

@@ -1,0 +1,90 @@
+//! When the shared-memory transport, not the run, failed: iceoryx2 0.10
+//! now and then leaves a pair of ports unconnected when a run starts (see
+//! `wire`'s port-creation lock). A node then fails saying
+//! [`wire::CONNECTION_FAILED`], or a lockstep log lacks steps; the run is
+//! started again, from scratch, in a new domain. Lockstep runs are
+//! deterministic, so a run started again gives the same bits.
+
+use crate::analysis::LogAnalysis;
+
+use super::{RunError, RunOptions, RunOutcome};
+
+/// Runs in all, the first included.
+const ATTEMPTS: u32 = 3;
+
+/// Runs `once`, again while the transport is to blame (not with nodes
+/// started by hand: they would have to be started again too).
+pub(super) fn with_retries(
+    opts: &RunOptions,
+    once: impl Fn(&RunOptions) -> Result<RunOutcome, RunError>,
+) -> Result<RunOutcome, RunError> {
+    let mut attempt = 1;
+    loop {
+        match once(opts) {
+            Err(e)
+                if is_transport_failure(&e) && attempt < ATTEMPTS && opts.external.is_empty() =>
+            {
+                eprintln!(
+                    "testbed: {e}\ntestbed: the shared-memory transport failed to connect; \
+                     starting the run again ({} of {ATTEMPTS})",
+                    attempt + 1
+                );
+                attempt += 1;
+            }
+            other => return other,
+        }
+    }
+}
+
+/// A failure of the transport rather than of the run.
+fn is_transport_failure(e: &RunError) -> bool {
+    match e {
+        RunError::LockstepIncomplete { .. } => true,
+        RunError::NodeFailed { stderr, .. } => stderr.contains(wire::CONNECTION_FAILED),
+        _ => false,
+    }
+}
+
+/// The error for a lockstep log with rows missing, with the logger's counts.
+pub(super) fn incomplete(analysis: &LogAnalysis) -> RunError {
+    let received = analysis
+        .contents
+        .stats
+        .iter()
+        .flatten()
+        .filter_map(|(k, v)| Some(format!("{} {v}", k.strip_suffix(".received")?)))
+        .collect::<Vec<_>>()
+        .join(", ");
+    RunError::LockstepIncomplete {
+        missing: analysis.missing_rows,
+        steps: analysis.expected_rows,
+        received,
+        log: analysis.contents.path.display().to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_connection_failures_are_the_transports() {
+        let failed = |stderr: &str| RunError::NodeFailed {
+            node: "plant",
+            how: "exited with status 1".into(),
+            stderr: stderr.into(),
+        };
+        assert!(is_transport_failure(&failed(&format!(
+            "testbed: {} publisher 5 and subscriber 6 of testbed/joint_state",
+            wire::CONNECTION_FAILED
+        ))));
+        assert!(!is_transport_failure(&failed("plant: NaN in the state")));
+        assert!(!is_transport_failure(&RunError::Interrupted));
+        assert!(is_transport_failure(&RunError::LockstepIncomplete {
+            missing: 400,
+            steps: 400,
+            received: String::new(),
+            log: String::new(),
+        }));
+    }
+}
