@@ -66,9 +66,6 @@ impl RunPrefix {
         #[allow(unsafe_code)]
         let removed =
             unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(&config) };
-        // The port-creation lock goes with the domain (absent if no node
-        // of the run ever started).
-        let _ = std::fs::remove_file(self.ports_lock_path());
         removed.map_err(|e| WireError::Ipc {
             what: "remove domain",
             topic: self.as_str().to_string(),

@@ -58,19 +58,6 @@ fn run_files(dir: &Path) -> Vec<(String, PathBuf)> {
     out
 }
 
-/// The runs' port-creation locks in `/dev/shm` (the rest of `/dev/shm` is
-/// iceoryx2's, removed with each domain).
-fn lock_files() -> Vec<(String, PathBuf)> {
-    let Ok(entries) = std::fs::read_dir("/dev/shm") else {
-        return Vec::new();
-    };
-    entries
-        .flatten()
-        .map(|e| (e.file_name().to_string_lossy().to_string(), e.path()))
-        .filter(|(name, _)| RunPrefix::is_ports_lock(name))
-        .collect()
-}
-
 impl RunPrefix {
     /// Whether this run is over for good: its launcher is gone (or it is
     /// `own`, the caller's run, once its nodes are reaped) and no process
@@ -88,16 +75,9 @@ impl RunPrefix {
     /// nodes have ended). Returns how many files were removed.
     pub fn remove_leftover_files(&self, own: bool) -> usize {
         let mut removed = 0;
-        let mut checked: Vec<(RunPrefix, bool)> = Vec::new();
-        for (dir, files) in folders()
-            .into_iter()
-            .map(|dir| {
-                let files = run_files(&dir);
-                (dir, files)
-            })
-            .chain([(PathBuf::from("/dev/shm"), lock_files())])
-        {
-            for (name, path) in files {
+        for dir in folders() {
+            let mut checked: Vec<(RunPrefix, bool)> = Vec::new();
+            for (name, path) in run_files(&dir) {
                 let Some(end) = name.find('_') else { continue };
                 let Ok(prefix) = RunPrefix::parse(&name[..=end]) else {
                     continue;

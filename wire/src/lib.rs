@@ -35,7 +35,6 @@ mod layout;
 mod leftovers;
 mod messages;
 mod node;
-mod ports_lock;
 mod reference;
 mod topics;
 

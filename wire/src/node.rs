@@ -97,9 +97,6 @@ pub struct NodeLink {
     /// The last state and step reported, repeated as the heartbeat.
     last_report: (u32, u64),
     last_report_ns: u64,
-    /// Held from `connect` until READY: the node's ports are created while
-    /// no other node of the run creates any ([`crate::ports_lock`]).
-    ports_lock: Option<crate::ports_lock::PortsLock>,
 }
 
 /// How often a node says it is alive (its last status again) while it
@@ -118,7 +115,6 @@ impl NodeLink {
         parent_pid: Option<u32>,
         mode: Mode,
     ) -> Result<Self, WireError> {
-        let ports_lock = Some(crate::ports_lock::PortsLock::acquire(prefix)?);
         let bus = Bus::new(prefix, kind.name())?;
         let status = bus.publisher(Topic::Status, Delivery::DropWhenFull)?;
         let control = bus.subscriber(Topic::Control)?;
@@ -135,7 +131,6 @@ impl NodeLink {
             pending_start: None,
             last_report: (0, 0),
             last_report_ns: 0,
-            ports_lock,
         })
     }
 
@@ -202,10 +197,8 @@ impl NodeLink {
     }
 
     /// Reports READY and blocks until START; returns the epoch of step 0.
-    /// Every port of the node must exist by now: the next node of the run
-    /// may create its own.
+    /// A node whose ports iceoryx2 could not all connect fails here.
     pub fn ready_and_wait_for_start(&mut self) -> Result<u64, NodeError> {
-        self.ports_lock = None;
         let failed = crate::connection_failures();
         if failed > 0 {
             self.report(NODE_FAILED, 0)?;

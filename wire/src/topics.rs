@@ -212,7 +212,13 @@ pub struct TopicPublisher<T: Debug + ZeroCopySend + Copy + 'static> {
     publisher: Publisher<ipc::Service, T, ()>,
     /// None on topics without waiters.
     notifier: Option<Notifier<ipc::Service>>,
+    /// The service, to count its subscribers, when every one must get
+    /// every sample (lossless).
+    lossless: Option<PubSubService<T>>,
 }
+
+type PubSubService<T> =
+    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>;
 
 /// A subscriber, with its listener unless it is read by polling.
 pub struct TopicSubscriber<T: Debug + ZeroCopySend + Copy + 'static> {
@@ -359,6 +365,7 @@ impl Bus {
             topic,
             publisher,
             notifier,
+            lossless: (delivery == Delivery::Lossless).then_some(service),
         })
     }
 
@@ -456,6 +463,17 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicPublisher<T> {
             .write_payload(value)
             .send()
             .map_err(|e| ipc("send", self.topic.name())(format!("{e:?}")))?;
+        if let Some(service) = &self.lossless {
+            // A subscriber registered but not connected would miss every
+            // sample without a word (iceoryx2 sometimes leaves a pair
+            // unconnected when a run starts): a transport failure.
+            let subscribers = service.dynamic_config().number_of_subscribers();
+            if delivered < subscribers {
+                return Err(ipc("send", self.topic.name())(format!(
+                    "{CONNECTION_FAILED}: a sample reached {delivered} of {subscribers} subscribers"
+                )));
+            }
+        }
         if let Some(n) = &self.notifier {
             n.notify()
                 .map_err(|e| ipc("notify", self.topic.name())(format!("{e:?}")))?;

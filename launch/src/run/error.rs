@@ -83,14 +83,15 @@ pub enum RunError {
         /// Steps of the run.
         steps: u64,
     },
-    /// A lockstep run loses nothing by design: rows missing from its log
-    /// mean a topic was not delivered to the logger.
+    /// A topic was not delivered to the logger: in lockstep, which loses
+    /// nothing by design, any row missing; in real time, a topic never
+    /// received.
     #[error(
-        "the lockstep run's log lacks {missing} of {steps} steps, so its figures are not \
-         printed (the logger received: {received}); a topic was not delivered, which is a \
-         fault of the shared-memory transport: run it again. The log is kept: {log}"
+        "the run's log lacks {missing} of {steps} steps, so its figures are not printed (the \
+         logger received: {received}); a topic was not delivered, which is a fault of the \
+         shared-memory transport: run it again. The log is kept: {log}"
     )]
-    LockstepIncomplete {
+    LogIncomplete {
         /// Rows missing.
         missing: u64,
         /// Rows expected.

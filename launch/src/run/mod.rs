@@ -193,9 +193,7 @@ fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
     }
     // One analysis path: the summary comes from the log just written.
     let analysis = analyse_log(&files.log, opts.csv.as_deref())?;
-    if opts.mode == Mode::Lockstep && analysis.missing_rows > 0 {
-        return Err(transport::incomplete(&analysis));
-    }
+    transport::check_log(&analysis, opts.mode)?;
     Ok(RunOutcome {
         analysis,
         run_dir: files.run_dir,
