@@ -132,6 +132,9 @@ pub struct ArmBench {
     pub timer_floor: TimerFloor,
     /// Peak resident memory, kB: the in-process loop (this process) and each node.
     pub peak_rss_kb: Vec<(String, u64)>,
+    /// CPU time of each node in the first lockstep run, s: where the
+    /// lockstep time goes (plant and controller share one CPU).
+    pub lockstep_node_cpu_s: Vec<(String, f64)>,
 }
 
 /// The whole bench. The top-level figures are the paper scenario's.
@@ -330,6 +333,7 @@ fn bench_arm(
     let sim_s = plan.steps as f64 * plan.dt();
     let (inprocess, costs) = in_process(plan, opts, progress)?;
     let mut lock_walls = Vec::new();
+    let mut node_cpu = Vec::new();
     let mut rss = vec![(
         "in-process loop".to_string(),
         run::spawn::peak_rss_kb(std::process::id()).unwrap_or(0),
@@ -339,6 +343,9 @@ fn bench_arm(
         let out = stack(plan, Mode::Lockstep, opts, None)?;
         lock_walls.push(out.wall_time_s);
         if i == 0 {
+            node_cpu = (out.node_cpu_s.iter())
+                .map(|(k, s)| (k.name().to_string(), *s))
+                .collect();
             rss.extend(
                 out.peak_rss_kb
                     .iter()
@@ -365,6 +372,7 @@ fn bench_arm(
         realtime,
         timer_floor: floor,
         peak_rss_kb: rss,
+        lockstep_node_cpu_s: node_cpu,
     })
 }
 

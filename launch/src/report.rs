@@ -461,6 +461,10 @@ pub fn bench_table(b: &launch::bench::BenchReport) -> String {
             .map(|(n, kb)| format!("{n} {:.1} MB", *kb as f64 / 1024.0))
             .collect();
         let _ = writeln!(out, "  peak memory     {}", rss.join(", "));
+        let cpu: Vec<String> = (a.lockstep_node_cpu_s.iter())
+            .map(|(n, s)| format!("{n} {s:.3} s"))
+            .collect();
+        let _ = writeln!(out, "  lockstep CPU    {}", cpu.join(", "));
     }
     out
 }

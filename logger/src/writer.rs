@@ -133,6 +133,9 @@ impl LogWriter {
             // Level 1, not zstd's default 3: in lockstep the logger paces
             // the run, and this is its largest cost (the files grow 4 %).
             .compression_level(1)
+            // In this process: zstd's worker threads (one per physical
+            // CPU by default) compete with the plant and the controller.
+            .compression_threads(0)
             .chunk_size(Some(CHUNK_BYTES))
             .profile("")
             .library(format!("testbed {}", env!("CARGO_PKG_VERSION")))

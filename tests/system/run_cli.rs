@@ -348,6 +348,13 @@ fn bench_reports_every_figure() {
     assert_eq!(arms.len(), 2);
     assert_eq!(arms[1]["dof"], 6);
     assert!(arms[0]["peak_rss_kb"].as_array().unwrap().len() >= 5, "{b}");
+    // Where the lockstep time went: every node used some CPU.
+    let cpu = arms[0]["lockstep_node_cpu_s"].as_array().unwrap();
+    assert_eq!(cpu.len(), 4, "{b}");
+    assert!(
+        cpu.iter().all(|n| n[1].as_f64().is_some_and(|s| s > 0.0)),
+        "{b}"
+    );
     assert!(b["machine"]["cores"].as_u64().unwrap() >= 1);
     let err = crate::util::fails(testbed().args(["bench", "--realtime-s", "0"]));
     assert!(err.contains("--realtime-s"), "{err}");

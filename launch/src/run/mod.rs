@@ -97,6 +97,8 @@ pub struct RunOutcome {
     pub wall_time_s: f64,
     /// Peak resident memory of each node (kB), read just before STOP.
     pub peak_rss_kb: Vec<(NodeKind, u64)>,
+    /// CPU time of each node (s) up to just before STOP.
+    pub node_cpu_s: Vec<(NodeKind, f64)>,
 }
 
 /// A fresh folder name for a run: UTC-free, sortable, unique on this machine.
@@ -158,6 +160,7 @@ fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
     let result = spawn_nodes(opts, &prefix, &files.configs, cpus, &mut children)
         .and_then(|()| supervise(opts, &bus, &status, &control, &mut children));
     let peak_rss_kb = children.peak_rss_kb();
+    let node_cpu_s = children.cpu_s();
     // Whatever happened: STOP (the logger then finishes the file), grace,
     // SIGTERM, SIGKILL, reap.
     let end = result
@@ -200,6 +203,7 @@ fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
         log: files.log,
         wall_time_s,
         peak_rss_kb,
+        node_cpu_s,
     })
 }
 

@@ -195,6 +195,15 @@ impl Children {
             .collect()
     }
 
+    /// CPU time each child still running has used so far, s (all its
+    /// threads, user and system).
+    pub fn cpu_s(&self) -> Vec<(NodeKind, f64)> {
+        self.0
+            .iter()
+            .filter_map(|c| cpu_ns(c.pid()).map(|ns| (c.kind, ns as f64 / 1e9)))
+            .collect()
+    }
+
     /// How `kind` ended (status and stderr tail), once it has.
     pub fn exit_of(&mut self, kind: NodeKind) -> Option<(ExitStatus, String)> {
         let c = self.0.iter_mut().find(|c| c.kind == kind)?;
@@ -265,4 +274,16 @@ pub fn peak_rss_kb(pid: u32) -> Option<u64> {
     let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     line.split_whitespace().nth(1)?.parse().ok()
+}
+
+/// CPU time of process `pid` so far, ns: the sum over its threads of the
+/// first field of /proc/<pid>/task/<tid>/schedstat (time on a CPU).
+pub fn cpu_ns(pid: u32) -> Option<u64> {
+    let tasks = std::fs::read_dir(format!("/proc/{pid}/task")).ok()?;
+    let mut total = 0;
+    for task in tasks.flatten() {
+        let stat = std::fs::read_to_string(task.path().join("schedstat")).ok()?;
+        total += stat.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
+    Some(total)
 }
