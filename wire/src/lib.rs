@@ -28,6 +28,7 @@
 
 pub mod clock;
 mod config;
+mod connections;
 mod domain;
 mod fields;
 mod files;
@@ -39,6 +40,7 @@ mod reference;
 mod topics;
 
 pub use config::{ConfigError, read_config, write_config};
+pub use connections::{CONNECTION_FAILED, connection_failures};
 pub use domain::DomainNodes;
 pub use fields::{FieldRef, FieldSource, MessageFields};
 pub use files::{MAX_TEXT_FILE_BYTES, MAX_URDF_BYTES, read_regular_file, read_text_file};
@@ -50,9 +52,8 @@ pub use messages::*;
 pub use node::{HEARTBEAT, Mode, NodeError, NodeLink, SILENT_AFTER, ns_to_s};
 pub use reference::ReferenceWindow;
 pub use topics::{
-    Bus, CONNECTION_FAILED, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix,
-    SUBSCRIBER_BUFFER, Topic, TopicPublisher, TopicSubscriber, WireError, connection_failures,
-    monotonic_ns,
+    Bus, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix, SUBSCRIBER_BUFFER,
+    Topic, TopicPublisher, TopicSubscriber, WireError, monotonic_ns,
 };
 
 /// iceoryx2's own messages on stderr: only its errors unless `verbose`

@@ -7,11 +7,13 @@ use std::sync::{Arc, OnceLock};
 use std::time::Duration;
 
 use iceoryx2::node::NodeWaitFailure;
+use iceoryx2::port::BackpressureAction;
 use iceoryx2::port::listener::{Listener, ListenerWaitError};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::port::{BackpressureAction, DegradationAction, DegradationCause, DegradationInfo};
+
+use crate::connections::{CONNECTION_FAILED, degraded};
 use iceoryx2::prelude::*;
 
 /// A pub/sub topic and its paired event service (same name).
@@ -415,40 +417,6 @@ impl Bus {
             listener,
         })
     }
-}
-
-/// What a node says on stderr when iceoryx2 cannot connect two ports: the
-/// launcher starts the run again when a node's last words hold it.
-pub const CONNECTION_FAILED: &str = "iceoryx2 could not connect";
-
-static CONNECTION_FAILURES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-
-/// Connections iceoryx2 could not make in this process so far (one made
-/// while a port is created only warns inside iceoryx2, and that port then
-/// never retries it: [`crate::NodeLink`] fails the node at READY).
-pub fn connection_failures() -> u64 {
-    CONNECTION_FAILURES.load(Ordering::Relaxed)
-}
-
-/// A connection iceoryx2 could not make or found corrupted: said on stderr
-/// whatever iceoryx2's log level (by default it only warns, and samples on
-/// that connection would be lost without a word), and the send or receive
-/// that found it fails.
-fn degraded(topic: Topic, cause: DegradationCause, info: &DegradationInfo) -> DegradationAction {
-    let what = match cause {
-        DegradationCause::FailedToEstablishConnection => {
-            CONNECTION_FAILURES.fetch_add(1, Ordering::Relaxed);
-            CONNECTION_FAILED
-        }
-        DegradationCause::ConnectionCorrupted => "iceoryx2 found a corrupted connection between",
-    };
-    eprintln!(
-        "testbed: {what} publisher {:x} and subscriber {:x} of {}",
-        info.sender_port_id,
-        info.receiver_port_id,
-        topic.name()
-    );
-    DegradationAction::DegradeAndFail
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> TopicPublisher<T> {
