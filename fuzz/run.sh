@@ -13,6 +13,11 @@ command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
 # cargo-fuzz passes -Z sanitizer flags; this lets the one stable toolchain
 # of this machine accept them (no nightly can be installed here).
 export RUSTC_BOOTSTRAP=1
+# Build every target first, so a failing build says so (not "crashed").
+if ! cargo fuzz build ${FUZZ_DEV:+--dev} --fuzz-dir fuzz; then
+    echo "fuzz: the targets did not build (see above; no fuzzing ran)" >&2
+    exit 1
+fi
 scratch="$(mktemp -d)"
 trap 'rm -rf "$scratch"' EXIT
 for target in scenario urdf log; do
