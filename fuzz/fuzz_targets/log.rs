@@ -7,7 +7,7 @@ use logger::LogMessage;
 use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
 
 fuzz_target!(|data: &[u8]| {
-    let mut decode = |topic: &str, v: &serde_json::Value| {
+    let mut decode = |topic: &str, v: &[u8]| {
         let _ = match topic {
             t if t == JointState::TOPIC => JointState::parse(v).map(|_| ()),
             t if t == ReferenceSample::TOPIC => ReferenceSample::parse(v).map(|_| ()),

@@ -15,7 +15,9 @@ use crate::mode::Mode;
 use crate::run::timing::{TimingStats, TimingSummary};
 use crate::summary::{Summary, SummaryBuilder};
 use crate::verify::Verifier;
-use logger::{DecodeError, LogContents, LogError, LogMessage, MessageError, read_log};
+use logger::{
+    DecodeError, LogContents, LogError, LogMessage, MessageError, read_log, read_log_head,
+};
 
 /// Why a log could not be analysed.
 #[derive(Debug, thiserror::Error)]
@@ -213,7 +215,7 @@ struct Analyser<'a, 'o> {
 }
 
 impl Analyser<'_, '_> {
-    fn on_message(&mut self, topic: &str, v: &serde_json::Value) -> Result<(), MessageError> {
+    fn on_message(&mut self, topic: &str, v: &[u8]) -> Result<(), MessageError> {
         match topic {
             t if t == JointState::TOPIC => {
                 let s = JointState::parse(v)?;
@@ -245,7 +247,12 @@ impl Analyser<'_, '_> {
             t if t == ReferenceSample::TOPIC => {
                 ReferenceSample::parse(v)?;
             }
-            _ => {}
+            // The arm's frames and figure: not analysed, but a log whose
+            // message is not JSON is damaged there.
+            _ => {
+                serde_json::from_slice::<serde::de::IgnoredAny>(v)
+                    .map_err(|e| DecodeError(format!("not JSON ({e})")))?;
+            }
         }
         let (summary, series, csv) = (&mut self.summary, &mut self.series, &mut self.csv);
         self.assembler.emit(|r| {
@@ -277,7 +284,7 @@ impl Analyser<'_, '_> {
 
 /// Reads the log at `path` and computes everything from it.
 pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, AnalysisError> {
-    let head = read_log(path, None)?;
+    let head = read_log_head(path)?;
     let (plan, mode) = plan_from(&head)?;
     let n = plan.robot.model.dof();
     let verifier = if opts.verify {

@@ -29,8 +29,10 @@ pub struct RecordAssembler {
     next: u64,
     newest_state: Option<u64>,
     newest_diag: Option<u64>,
-    states: BTreeMap<u64, JointState>,
-    diags: BTreeMap<u64, ControllerDiagnostics>,
+    // Boxed: a B-tree moves its values around its nodes, and these are
+    // large (a third of `replay`'s copying was B-tree removals).
+    states: BTreeMap<u64, Box<JointState>>,
+    diags: BTreeMap<u64, Box<ControllerDiagnostics>>,
     missing: u64,
     qdd: Vec<f64>,
 }
@@ -57,7 +59,7 @@ impl RecordAssembler {
         let seq = s.header.seq;
         if seq >= self.next {
             self.newest_state = Some(self.newest_state.map_or(seq, |n| n.max(seq)));
-            self.states.insert(seq, s);
+            self.states.insert(seq, Box::new(s));
         }
     }
 
@@ -66,7 +68,7 @@ impl RecordAssembler {
         let seq = d.header.seq;
         if seq >= self.next {
             self.newest_diag = Some(self.newest_diag.map_or(seq, |n| n.max(seq)));
-            self.diags.insert(seq, d);
+            self.diags.insert(seq, Box::new(d));
         }
     }
 

@@ -8,8 +8,8 @@
 
 use serde_json::{Map, Value, json};
 use wire::{
-    Command, ControllerDiagnostics, FieldRef, FieldSource, Header, JointState, Joints, MAX_DOF,
-    MessageFields, ReferenceSample, Timing, joints,
+    Command, ControllerDiagnostics, FieldRef, FieldSource, Header, JointState, MessageFields,
+    ReferenceSample, Timing,
 };
 
 /// A logged message that does not decode: what is missing or wrong.
@@ -81,12 +81,9 @@ pub trait LogMessage: MessageFields {
         out.push(b'}');
     }
 
-    /// The message back from its JSON object.
-    fn parse(v: &Value) -> Result<Self, DecodeError> {
-        let m = Fields(
-            v.as_object()
-                .ok_or(DecodeError("not a JSON object".into()))?,
-        );
+    /// The message back from its JSON text (a logged message's data).
+    fn parse(text: &[u8]) -> Result<Self, DecodeError> {
+        let m = crate::json_object::JsonObject::parse(text)?;
         let header = || -> Result<Header, String> {
             Ok(Header {
                 seq: m.u("seq")?,
@@ -167,59 +164,6 @@ fn write_real(out: &mut Vec<u8>, x: f64) {
 
 fn number(x: f64) -> Value {
     serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number)
-}
-
-/// Field access on a parsed JSON object.
-pub struct Fields<'a>(&'a Map<String, Value>);
-
-impl Fields<'_> {
-    fn get(&self, k: &str) -> Result<&Value, String> {
-        self.0
-            .get(k)
-            .ok_or_else(|| format!("field '{k}' is missing"))
-    }
-}
-
-impl FieldSource for Fields<'_> {
-    fn u(&self, k: &str) -> Result<u64, String> {
-        self.get(k)?
-            .as_u64()
-            .ok_or_else(|| format!("field '{k}' is not an unsigned integer"))
-    }
-    fn u32(&self, k: &str) -> Result<u32, String> {
-        u32::try_from(self.u(k)?).map_err(|_| format!("field '{k}' is out of range"))
-    }
-    fn i(&self, k: &str) -> Result<i64, String> {
-        self.get(k)?
-            .as_i64()
-            .ok_or_else(|| format!("field '{k}' is not an integer"))
-    }
-    fn f(&self, k: &str) -> Result<f64, String> {
-        real(self.get(k)?).ok_or_else(|| format!("field '{k}' is not a number"))
-    }
-    fn j(&self, k: &str) -> Result<Joints, String> {
-        let a = self
-            .get(k)?
-            .as_array()
-            .ok_or_else(|| format!("field '{k}' is not an array"))?;
-        if a.len() > MAX_DOF {
-            return Err(format!(
-                "field '{k}' has {} entries (at most {MAX_DOF})",
-                a.len()
-            ));
-        }
-        let v: Option<Vec<f64>> = a.iter().map(real).collect();
-        Ok(joints(&v.ok_or_else(|| {
-            format!("field '{k}' holds a non-number")
-        })?))
-    }
-}
-
-fn real(v: &Value) -> Option<f64> {
-    match v {
-        Value::Null => Some(f64::NAN),
-        other => other.as_f64(),
-    }
 }
 
 impl LogMessage for JointState {
@@ -307,7 +251,7 @@ mod tests {
         s.q[0] = 0.1 + 0.2;
         s.q[1] = -1e-300;
         s.qd[0] = f64::NAN;
-        let back = JointState::parse(&s.to_json()).unwrap();
+        let back = JointState::parse(s.to_json().to_string().as_bytes()).unwrap();
         assert_eq!(back.header, s.header);
         assert_eq!(back.q[0].to_bits(), s.q[0].to_bits());
         assert_eq!(back.q[1].to_bits(), s.q[1].to_bits());
@@ -329,12 +273,16 @@ mod tests {
         let mut v = Command::default().to_json();
         v["tau"] = json!("x");
         assert_eq!(
-            Command::parse(&v).unwrap_err().to_string(),
+            Command::parse(v.to_string().as_bytes())
+                .unwrap_err()
+                .to_string(),
             "field 'tau' is not an array"
         );
         v.as_object_mut().unwrap().remove("seq");
         assert_eq!(
-            Command::parse(&v).unwrap_err().to_string(),
+            Command::parse(v.to_string().as_bytes())
+                .unwrap_err()
+                .to_string(),
             "field 'seq' is missing"
         );
     }

@@ -23,6 +23,7 @@
 mod channels;
 mod compression;
 mod json;
+mod json_object;
 mod layout;
 pub mod live;
 pub mod node;
@@ -35,9 +36,9 @@ mod writer;
 
 pub use channels::{ChannelSpec, channels};
 pub use compression::LogCompression;
-pub use json::{DecodeError, Fields, LogMessage};
+pub use json::{DecodeError, LogMessage};
 pub use layout::foxglove_layout;
-pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes};
+pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes, read_log_head};
 pub use writer::{LogWriter, RunMetadata};
 
 /// Name of the metadata record that describes the run.

@@ -59,10 +59,11 @@ pub enum MessageError {
     Sink(#[from] std::io::Error),
 }
 
-/// Called for every message of a log, in file order.
-pub type OnMessage<'a> = &'a mut dyn FnMut(&str, &serde_json::Value) -> Result<(), MessageError>;
+/// Called for every message of a log, in file order, with its topic and
+/// data (JSON text: [`crate::LogMessage::parse`] decodes it).
+pub type OnMessage<'a> = &'a mut dyn FnMut(&str, &[u8]) -> Result<(), MessageError>;
 
-/// Reads `path` record by record, calling `on_message(topic, json)` (if
+/// Reads `path` record by record, calling `on_message(topic, data)` (if
 /// given) for every message in file order. A truncated or unfinished file is
 /// read up to its last whole record; `cut_short` then says why it ended.
 pub fn read_log(path: &Path, on_message: Option<OnMessage<'_>>) -> Result<LogContents, LogError> {
@@ -74,11 +75,31 @@ pub fn read_log(path: &Path, on_message: Option<OnMessage<'_>>) -> Result<LogCon
     read_log_bytes(&buf, path, on_message)
 }
 
+/// The run's metadata and URDF of the log at `path`: the records before its
+/// first message (where the logger writes them), without unpacking the
+/// rest. Only `run` and `urdf` are read.
+pub fn read_log_head(path: &Path) -> Result<LogContents, LogError> {
+    let buf = wire::read_regular_file(path, None).map_err(|cause| LogError::Io {
+        path: path.display().to_string(),
+        cause,
+    })?;
+    read(&buf, path, None, true)
+}
+
 /// [`read_log`] of a log already in memory (`path` names it in messages).
 pub fn read_log_bytes(
     buf: &[u8],
     path: &Path,
+    on_message: Option<OnMessage<'_>>,
+) -> Result<LogContents, LogError> {
+    read(buf, path, on_message, false)
+}
+
+fn read(
+    buf: &[u8],
+    path: &Path,
     mut on_message: Option<OnMessage<'_>>,
+    head_only: bool,
 ) -> Result<LogContents, LogError> {
     let p = path.display().to_string();
     if !buf.starts_with(mcap::MAGIC) {
@@ -107,6 +128,7 @@ pub fn read_log_bytes(
             Record::Channel(c) => {
                 topics.insert(c.id, c.topic);
             }
+            Record::Message { .. } if head_only => break,
             Record::Message { header, data } => {
                 let topic = topics.get(&header.channel_id);
                 if let (Some(topic), Some(handler)) = (topic, on_message.as_mut())
@@ -137,7 +159,7 @@ pub fn read_log_bytes(
             reason: "no testbed.run metadata: not a log written by testbed".into(),
         });
     }
-    if !out.complete && out.cut_short.is_none() {
+    if !out.complete && out.cut_short.is_none() && !head_only {
         out.cut_short = Some("the logger never finished the file (no footer)".into());
     }
     Ok(out)
@@ -151,11 +173,7 @@ fn deliver(
     data: &[u8],
     path: &str,
 ) -> Result<Option<String>, LogError> {
-    let value: serde_json::Value = match serde_json::from_slice(data) {
-        Ok(v) => v,
-        Err(e) => return Ok(Some(format!("a {topic} message is not JSON ({e})"))),
-    };
-    match handler(topic, &value) {
+    match handler(topic, data) {
         Ok(()) => Ok(None),
         Err(MessageError::Malformed(e)) => Ok(Some(format!("a {topic} message is malformed: {e}"))),
         Err(MessageError::Sink(cause)) => Err(LogError::Sink {
@@ -179,7 +197,7 @@ mod tests {
         let mut seen = 0;
         for e in std::fs::read_dir(&dir).unwrap().flatten() {
             let buf = std::fs::read(e.path()).unwrap();
-            let mut count = |_: &str, _: &serde_json::Value| Ok(());
+            let mut count = |_: &str, _: &[u8]| Ok(());
             match read_log_bytes(&buf, &e.path(), Some(&mut count)) {
                 Ok(c) => assert!(c.cut_short.is_some(), "{}", e.path().display()),
                 Err(err) => assert!(!err.to_string().is_empty()),
@@ -191,5 +209,45 @@ mod tests {
             "the regression inputs are missing from {}",
             dir.display()
         );
+    }
+
+    /// The head is the metadata and URDF, read without the messages; the
+    /// full read hands every message's JSON to the handler.
+    #[test]
+    fn the_head_holds_the_run_and_the_urdf() {
+        let dir = std::env::temp_dir().join(format!("testbed-head-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("run.mcap");
+        let meta = crate::RunMetadata {
+            run_id: "head".into(),
+            ..crate::RunMetadata::default()
+        };
+        let mut w = crate::LogWriter::create(&path, &meta, "<robot name='r'/>").unwrap();
+        for k in 0..3u64 {
+            let mut s = wire::JointState::default();
+            s.header.seq = k;
+            w.write(&s).unwrap();
+        }
+        w.finish(BTreeMap::new()).unwrap();
+
+        let head = read_log_head(&path).unwrap();
+        assert_eq!(head.run.get("run_id").map(String::as_str), Some("head"));
+        assert_eq!(head.urdf.as_deref(), Some("<robot name='r'/>"));
+        assert_eq!((head.messages, head.complete), (0, false));
+        assert!(head.cut_short.is_none());
+
+        let mut seqs = Vec::new();
+        let mut take = |_: &str, data: &[u8]| {
+            seqs.push(
+                <wire::JointState as crate::LogMessage>::parse(data)?
+                    .header
+                    .seq,
+            );
+            Ok(())
+        };
+        let all = read_log(&path, Some(&mut take)).unwrap();
+        assert_eq!((all.messages, all.complete), (3, true));
+        assert_eq!(seqs, [0, 1, 2]);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
