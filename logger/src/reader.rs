@@ -197,7 +197,11 @@ mod tests {
         let mut seen = 0;
         for e in std::fs::read_dir(&dir).unwrap().flatten() {
             let buf = std::fs::read(e.path()).unwrap();
-            let mut count = |_: &str, _: &[u8]| Ok(());
+            // Every message decoded as JSON, as a reader of the log does.
+            let mut count = |_: &str, data: &[u8]| {
+                crate::json_object::JsonObject::parse(data)?;
+                Ok(())
+            };
             match read_log_bytes(&buf, &e.path(), Some(&mut count)) {
                 Ok(c) => assert!(c.cut_short.is_some(), "{}", e.path().display()),
                 Err(err) => assert!(!err.to_string().is_empty()),
