@@ -249,10 +249,7 @@ impl Analyser<'_, '_> {
             }
             // The arm's frames and figure: not analysed, but a log whose
             // message is not JSON is damaged there.
-            _ => {
-                serde_json::from_slice::<serde::de::IgnoredAny>(v)
-                    .map_err(|e| DecodeError(format!("not JSON ({e})")))?;
-            }
+            _ => logger::JsonObject::check(v)?,
         }
         let (summary, series, csv) = (&mut self.summary, &mut self.series, &mut self.csv);
         self.assembler.emit(|r| {

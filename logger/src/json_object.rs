@@ -37,13 +37,20 @@ impl<'a> JsonObject<'a> {
     /// The object in `text`: an error when the text is not JSON or not an
     /// object.
     pub fn parse(text: &'a [u8]) -> Result<Self, DecodeError> {
-        let not_json = |e: serde_json::Error| DecodeError(format!("not JSON ({e})"));
         let mut de = serde_json::Deserializer::from_slice(text);
         let fields = (&mut de).deserialize_any(TopLevel).map_err(not_json)?;
         de.end().map_err(not_json)?;
         fields
             .map(JsonObject)
             .ok_or(DecodeError("not a JSON object".into()))
+    }
+
+    /// Checks that `text` is JSON, of any shape (for messages nothing
+    /// decodes further).
+    pub fn check(text: &[u8]) -> Result<(), DecodeError> {
+        serde_json::from_slice::<IgnoredAny>(text)
+            .map(|_| ())
+            .map_err(not_json)
     }
 
     fn get(&self, k: &str) -> Result<&Raw, String> {
@@ -98,6 +105,10 @@ impl FieldSource for JsonObject<'_> {
         }
         Ok(joints(xs))
     }
+}
+
+fn not_json(e: serde_json::Error) -> DecodeError {
+    DecodeError(format!("not JSON ({e})"))
 }
 
 /// The whole text: `Some(fields)` for an object, `None` for anything else.
@@ -292,7 +303,14 @@ mod tests {
                 .0
                 .starts_with("not JSON")
         );
+        assert!(
+            JsonObject::check(b"[1,")
+                .unwrap_err()
+                .0
+                .starts_with("not JSON")
+        );
         for text in [&b"[1,{}]"[..], b"3", b"null", b"\"s\"", b"true"] {
+            JsonObject::check(text).unwrap();
             assert_eq!(JsonObject::parse(text).unwrap_err().0, "not a JSON object");
         }
     }

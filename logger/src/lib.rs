@@ -37,6 +37,7 @@ mod writer;
 pub use channels::{ChannelSpec, channels};
 pub use compression::LogCompression;
 pub use json::{DecodeError, LogMessage};
+pub use json_object::JsonObject;
 pub use layout::foxglove_layout;
 pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes, read_log_head};
 pub use writer::{LogWriter, RunMetadata};

@@ -67,23 +67,21 @@ pub type OnMessage<'a> = &'a mut dyn FnMut(&str, &[u8]) -> Result<(), MessageErr
 /// given) for every message in file order. A truncated or unfinished file is
 /// read up to its last whole record; `cut_short` then says why it ended.
 pub fn read_log(path: &Path, on_message: Option<OnMessage<'_>>) -> Result<LogContents, LogError> {
-    let p = path.display().to_string();
-    let buf = wire::read_regular_file(path, None).map_err(|cause| LogError::Io {
-        path: p.clone(),
+    read_log_bytes(&read_file(path)?, path, on_message)
+}
+
+fn read_file(path: &Path) -> Result<Vec<u8>, LogError> {
+    wire::read_regular_file(path, None).map_err(|cause| LogError::Io {
+        path: path.display().to_string(),
         cause,
-    })?;
-    read_log_bytes(&buf, path, on_message)
+    })
 }
 
 /// The run's metadata and URDF of the log at `path`: the records before its
 /// first message (where the logger writes them), without unpacking the
 /// rest. Only `run` and `urdf` are read.
 pub fn read_log_head(path: &Path) -> Result<LogContents, LogError> {
-    let buf = wire::read_regular_file(path, None).map_err(|cause| LogError::Io {
-        path: path.display().to_string(),
-        cause,
-    })?;
-    read(&buf, path, None, true)
+    read(&read_file(path)?, path, None, true)
 }
 
 /// [`read_log`] of a log already in memory (`path` names it in messages).
