@@ -56,7 +56,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let n = config.dof;
     let mut link = NodeLink::connect(NodeKind::Controller, &prefix, None, mode)?;
     let states = link.bus.subscriber::<JointState>(Topic::JointState)?;
-    let mut references = ReferenceWindow::new(&link, mode)?;
+    let mut references = ReferenceWindow::new(&link, mode, config.reference_period())?;
     let commands = link
         .bus
         .publisher::<Command>(Topic::Command, mode.delivery())?;
@@ -72,7 +72,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             }
             // The same rule as the testbed's controller: the newest sample
             // at or before the state, final in lockstep.
+            let started_wall_ns = monotonic_ns();
             let r = references.take(&mut link, s.header.t_ns)?;
+            let reference_t_ns = r.map_or(wire::NONE_U64, |r| r.header.t_ns);
             let r = r.unwrap_or_default();
             let mut d = ControllerDiagnostics {
                 header: s.header,
@@ -99,6 +101,9 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 tau: d.tau,
                 state_wall_ns: s.header.wall_ns,
                 compute_ns: 0,
+                started_wall_ns,
+                reference_t_ns,
+                stale_references: references.stale_count(),
             })?;
             diagnostics.send(d)?;
             handled += 1;

@@ -88,6 +88,10 @@ impl ControllerMachine {
             tau: joints(&d.tau),
             state_wall_ns: state.header.wall_ns,
             compute_ns: 0,
+            started_wall_ns: 0,
+            reference_t_ns: reference.map_or(wire::NONE_U64, |r| r.header.t_ns),
+            // The node's count (it knows which sample was due).
+            stale_references: 0,
         };
         (command, diag_msg(header, d, reference.unwrap_or(&zero)))
     }

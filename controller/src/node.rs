@@ -26,6 +26,10 @@ pub struct ControllerNodeConfig {
     pub dof: usize,
     /// Control period, ns.
     pub period_ns: u64,
+    /// Reference sample period, ns: which sample is due at a state's time
+    /// (0 or absent: the control period).
+    #[serde(default)]
+    pub reference_period_ns: u64,
     /// The arm's model, for `pd-gravity` and `ctc` (None for the others).
     #[serde(default)]
     pub model: Option<NodeModel>,
@@ -42,6 +46,14 @@ pub struct NodeModel {
 }
 
 impl ControllerNodeConfig {
+    /// The reference period, ns (the control period when unset).
+    pub fn reference_period(&self) -> u64 {
+        match self.reference_period_ns {
+            0 => self.period_ns,
+            r => r,
+        }
+    }
+
     /// The step machine this configuration describes.
     pub fn machine(&self) -> Result<ControllerMachine, ControllerError> {
         let model = match &self.model {
@@ -91,7 +103,7 @@ pub fn run(
     let diagnostics = link
         .bus
         .publisher::<ControllerDiagnostics>(Topic::Diagnostics, mode.delivery())?;
-    let mut reference = ReferenceWindow::new(link, mode)?;
+    let mut reference = ReferenceWindow::new(link, mode, config.reference_period())?;
     link.ready_and_wait_for_start()?;
 
     let mut handled = 0u64;
@@ -102,6 +114,7 @@ pub fn run(
                 finished = true;
                 continue;
             }
+            let started_wall_ns = monotonic_ns();
             let started = Instant::now();
             let r = reference.take(link, s.header.t_ns)?;
             let (mut cmd, mut diag) = m.step(&s, r.as_ref());
@@ -109,6 +122,8 @@ pub fn run(
             let wall_ns = monotonic_ns();
             cmd.header.wall_ns = wall_ns;
             cmd.compute_ns = compute_ns;
+            cmd.started_wall_ns = started_wall_ns;
+            cmd.stale_references = reference.stale_count();
             diag.header.wall_ns = wall_ns;
             diag.compute_ns = compute_ns;
             commands.send(cmd)?;

@@ -12,7 +12,8 @@ use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
 use crate::assemble::RecordAssembler;
 use crate::csv_out;
 use crate::mode::Mode;
-use crate::run::timing::{TimingStats, TimingSummary};
+use crate::run::data_path::DataPath;
+use crate::run::timing::{RunFacts, TimingStats, TimingSummary, judge};
 use crate::summary::{Summary, SummaryBuilder};
 use crate::verify::Verifier;
 use logger::{
@@ -208,6 +209,7 @@ struct Analyser<'a, 'o> {
     assembler: RecordAssembler,
     summary: SummaryBuilder,
     timing: TimingStats,
+    data_path: DataPath,
     series: Option<Series>,
     verifier: Option<Verifier>,
     csv: Option<&'o mut dyn Write>,
@@ -227,6 +229,7 @@ impl Analyser<'_, '_> {
                 if let Some(ver) = self.verifier.as_mut() {
                     ver.push_state(s);
                 }
+                self.data_path.add_state(&s);
                 self.assembler.push_state(s);
             }
             t if t == ControllerDiagnostics::TOPIC => {
@@ -239,6 +242,7 @@ impl Analyser<'_, '_> {
             }
             t if t == Command::TOPIC => {
                 let c = Command::parse(v)?;
+                self.data_path.add_command(&c);
                 if let Some(ver) = self.verifier.as_mut() {
                     ver.push_command(c);
                 }
@@ -314,6 +318,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
             plan.scenario.controller.tc,
         ),
         timing: TimingStats::new(plan.period_ns),
+        data_path: DataPath::new(plan.steps, plan.reference_period_ns),
         series: opts.series.then(|| Series::new(n)),
         verifier,
         csv,
@@ -335,13 +340,28 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
     } else {
         0
     };
+    let missing_rows = a.assembler.missing() + unfinished;
+    let summary = a.summary.finish();
+    // A log of format 1 has no data-path stamps to recount from.
+    let data_path = (contents.log_format().unwrap_or(0) >= 2).then(|| a.data_path.finish());
+    let mut timing = a.timing.finish(mode, plan.scenario.rate_hz, data_path);
+    judge(
+        &mut timing,
+        &RunFacts {
+            missing_rows,
+            run_end: contents.run_end(),
+            cut_short: contents.cut_short.as_deref(),
+            first_non_finite_s: summary.first_non_finite_s,
+            period_ns: plan.period_ns,
+        },
+    );
     Ok(LogAnalysis {
         wall_span_s: wall.1.saturating_sub(wall.0) as f64 / 1e9,
         wall_window_ns: wall,
         expected_rows: plan.steps,
-        missing_rows: a.assembler.missing() + unfinished,
-        summary: a.summary.finish(),
-        timing: a.timing.finish(mode, plan.scenario.rate_hz),
+        missing_rows,
+        summary,
+        timing,
         verify: a.verifier.map(|v| (v.max_abs_torque_diff, v.steps)),
         series: a.series,
         contents,

@@ -249,7 +249,7 @@ impl FloorProbe {
             });
             last = Some(wake);
         }
-        let t = stats.finish(Mode::Realtime, rate_hz);
+        let t = stats.finish(Mode::Realtime, rate_hz, None);
         TimerFloor {
             cycles: t.cycles,
             deadline_misses: t.late_wakeups,

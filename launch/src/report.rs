@@ -347,27 +347,43 @@ fn metric_lines(out: &mut String, m: &ArmMetrics, compute: &Percentiles) {
 }
 
 fn timing_lines(out: &mut String, t: &TimingSummary) {
+    let stale = t
+        .stale_references
+        .map_or_else(|| "n/a".to_string(), |n| n.to_string());
     let _ = writeln!(
         out,
-        "\ntiming ({} at {} Hz): {} cycles, {} deadline misses, {} wake-ups late by a period",
+        "\ntiming ({} at {} Hz): verdict {}; {} cycles, {} deadline misses, {stale} stale \
+         references, {} wake-ups late by a period",
         t.mode.as_str(),
         t.rate_hz,
+        t.verdict.as_str().to_uppercase(),
         t.cycles,
         t.deadline_misses,
         t.late_wakeups
     );
-    let _ = writeln!(
-        out,
-        "  period jitter us  {}",
-        percentiles(&t.period_jitter_us)
-    );
-    let _ = writeln!(out, "  wake late us      {}", percentiles(&t.wake_late_us));
-    let _ = writeln!(out, "  round trip us     {}", percentiles(&t.round_trip_us));
-    let _ = writeln!(
-        out,
-        "  controller us     {}",
-        percentiles(&t.controller_compute_us)
-    );
+    for reason in &t.reasons {
+        let _ = writeln!(out, "  - {reason}");
+    }
+    if let Some(n) = t.timing_faults_before_non_finite {
+        let _ = writeln!(
+            out,
+            "  timing faults (misses, stale references) up to the first non-finite step: {n}"
+        );
+    }
+    let mut row = |name: &str, p: &Percentiles| {
+        let _ = writeln!(out, "  {name:<17} {}", percentiles(p));
+    };
+    row("period jitter us", &t.period_jitter_us);
+    row("wake late us", &t.wake_late_us);
+    row("round trip us", &t.round_trip_us);
+    row("controller us", &t.controller_compute_us);
+    if let Some(d) = &t.data_path {
+        row("state age us", &d.state_age_us);
+        row("command age us", &d.command_age_us);
+        if d.reference_lag_us.count > 0 {
+            row("ref. lag us", &d.reference_lag_us);
+        }
+    }
 }
 
 fn run_notes(out: &mut String, r: &Report) {

@@ -72,6 +72,9 @@ pub struct Summary {
     pub fault_steps: u64,
     /// Every state, torque and error was finite and no step faulted.
     pub finite: bool,
+    /// Sim time of the first step that was not (None: every step was).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_non_finite_s: Option<f64>,
     /// The metrics of BASELINES.md for the whole arm.
     pub metrics: ArmMetrics,
 }
@@ -160,6 +163,7 @@ pub struct SummaryBuilder {
     breached: u64,
     faults: u64,
     finite: bool,
+    first_non_finite: Option<f64>,
     effects_seen: u32,
     saturated: u64,
     dropped: u64,
@@ -199,6 +203,7 @@ impl SummaryBuilder {
             breached: 0,
             faults: 0,
             finite: true,
+            first_non_finite: None,
             effects_seen: 0,
             saturated: 0,
             dropped: 0,
@@ -222,6 +227,9 @@ impl SummaryBuilder {
         let all_finite = [r.q, r.qd, r.tau, r.z1, r.z2, r.wa_norm]
             .iter()
             .all(|s| s.iter().all(|x| x.is_finite()));
+        if (r.fault || !all_finite) && self.first_non_finite.is_none() {
+            self.first_non_finite = Some(r.t);
+        }
         self.finite &= all_finite && !r.fault;
         let after = r.t >= self.tc;
         self.after_tc += u64::from(after);
@@ -336,6 +344,7 @@ impl SummaryBuilder {
             barrier_breached_steps: self.breached,
             fault_steps: self.faults,
             finite: self.finite,
+            first_non_finite_s: self.first_non_finite,
             metrics,
         }
     }

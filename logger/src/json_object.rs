@@ -64,6 +64,9 @@ impl<'a> JsonObject<'a> {
 }
 
 impl FieldSource for JsonObject<'_> {
+    fn has(&self, k: &str) -> bool {
+        self.0.iter().any(|(key, _)| key == k)
+    }
     fn u(&self, k: &str) -> Result<u64, String> {
         match self.get(k)? {
             Raw::U(x) => Ok(*x),

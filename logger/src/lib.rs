@@ -40,7 +40,7 @@ pub use json::{DecodeError, LogMessage};
 pub use json_object::JsonObject;
 pub use layout::foxglove_layout;
 pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes, read_log_head};
-pub use writer::{LogWriter, RunMetadata};
+pub use writer::{LOG_FORMAT, LogWriter, RunMetadata};
 
 /// Name of the metadata record that describes the run.
 pub const RUN_METADATA: &str = "testbed.run";

@@ -33,6 +33,14 @@ impl LogContents {
         self.stats.as_ref()?.get(crate::RUN_END).map(String::as_str)
     }
 
+    /// The log's format ([`crate::LOG_FORMAT`]); 1 for a log that predates
+    /// the record, None when the record is not a number.
+    pub fn log_format(&self) -> Option<u32> {
+        self.run
+            .get("log_format")
+            .map_or(Some(1), |v| v.parse().ok())
+    }
+
     /// Samples the logger could not take, summed over topics (None if the
     /// logger never finished the file).
     pub fn logger_dropped(&self) -> Option<u64> {

@@ -66,9 +66,16 @@ pub struct RunMetadata {
     pub controller_cmd: String,
 }
 
+/// The log format this logger writes, recorded as `log_format` in the
+/// `testbed.run` metadata (a log without it is format 1). Format 2 adds the
+/// data path's stamps: `JointState.command_seq` and `applied_wall_ns`,
+/// `Command.started_wall_ns`, `reference_t_ns` and `stale_references`.
+pub const LOG_FORMAT: u32 = 2;
+
 impl RunMetadata {
     fn to_map(&self) -> BTreeMap<String, String> {
         BTreeMap::from([
+            ("log_format".into(), LOG_FORMAT.to_string()),
             ("run_id".into(), self.run_id.clone()),
             ("mode".into(), self.mode.clone()),
             ("rate_hz".into(), format!("{:?}", self.rate_hz)),

@@ -2,7 +2,7 @@
 //! node, `testbed sim` and the benchmarks all drive this one machine, so a
 //! lockstep run and an in-process one compute the same bits.
 
-use wire::{Command, Header, JointState, MAX_DOF, STATE_FINAL, joints};
+use wire::{Command, Header, JointState, MAX_DOF, NONE_U64, STATE_FINAL, joints};
 
 use crate::{ArmModel, PlantConfig, PlantError, Rig};
 
@@ -19,6 +19,8 @@ pub struct PlantMachine {
     qd_meas: Vec<f64>,
     /// Deadline misses so far (the real-time node counts them).
     pub misses: u64,
+    /// Seq of the newest command taken ([`NONE_U64`] before the first).
+    taken_seq: u64,
 }
 
 impl PlantMachine {
@@ -45,6 +47,7 @@ impl PlantMachine {
             q_meas: vec![0.0; n],
             qd_meas: vec![0.0; n],
             misses: 0,
+            taken_seq: NONE_U64,
         })
     }
 
@@ -97,6 +100,9 @@ impl PlantMachine {
             effects: self.rig.effects().0,
             reserved: 0,
             deadline_misses: self.misses,
+            command_seq: self.taken_seq,
+            // Clock data: the node stamps it.
+            applied_wall_ns: 0,
         }
     }
 
@@ -110,6 +116,9 @@ impl PlantMachine {
                 expected: self.n,
                 got: c.dof as usize,
             });
+        }
+        if let Some(c) = cmd {
+            self.taken_seq = c.header.seq;
         }
         self.rig.step(cmd.map(|c| &c.tau[..self.n]))
     }

@@ -149,6 +149,7 @@ fn lockstep(link: &mut NodeLink, ports: &Ports, m: &mut PlantMachine) -> Result<
     ports.state.send(state)?;
     for k in 0..m.steps() {
         let cmd = wait_for_command(link, &ports.command, k)?;
+        let taken_wall = monotonic_ns();
         m.step(Some(&cmd))?;
         ports.timing.send(Timing {
             header: wire::Header {
@@ -161,6 +162,7 @@ fn lockstep(link: &mut NodeLink, ports: &Ports, m: &mut PlantMachine) -> Result<
             ..Timing::default()
         })?;
         state = m.state(k + 1, monotonic_ns());
+        state.applied_wall_ns = taken_wall;
         ports.state.send(state)?;
         if (k + 1) % PROGRESS_EVERY == 0 {
             link.report(NODE_RUNNING, k + 1)?;
@@ -199,11 +201,12 @@ fn wait_for_command(
     }
 }
 
-/// The newest command seen and the newest one applied.
+/// The newest command seen and the newest one taken, with when.
 #[derive(Default)]
 struct Held {
     latest: Option<Command>,
     taken_seq: Option<u64>,
+    taken_wall_ns: u64,
 }
 
 fn realtime(
@@ -240,6 +243,7 @@ fn realtime(
             .filter(|c| held.taken_seq.is_none_or(|s| c.header.seq > s));
         if let Some(c) = fresh {
             held.taken_seq = Some(c.header.seq);
+            held.taken_wall_ns = wake;
         }
         m.step(fresh.as_ref())?;
         ports.timing.send(Timing {
@@ -259,6 +263,7 @@ fn realtime(
             deadline_misses: m.misses,
         })?;
         state = m.state(k, monotonic_ns());
+        state.applied_wall_ns = held.taken_wall_ns;
         ports.state.send(state)?;
         last_wake = wake;
         if k % 32 == 0 {

@@ -169,15 +169,22 @@ class Subscriber:
         self.dtype = dtype_of(self.structure)
         self.port = port
         self.listener = listener
+        self.last_header = b""
 
     def receive(self) -> Optional[np.void]:
-        """The next buffered message as a structured numpy record, or None."""
-        sample = self.port.receive()
-        if sample is None:
-            return None
-        record = _view(sample.payload_ptr, self.structure, self.dtype).copy()
-        sample.delete()
-        return record
+        """The next buffered message as a structured numpy record, or None.
+        A copy of the message before it (same header: a send a signal
+        interrupted and the publisher made again) is dropped."""
+        while True:
+            sample = self.port.receive()
+            if sample is None:
+                return None
+            record = _view(sample.payload_ptr, self.structure, self.dtype).copy()
+            sample.delete()
+            header = record["header"].tobytes()
+            if header != self.last_header:
+                self.last_header = header
+                return record
 
     def wait_event(self, seconds: float) -> bool:
         """Blocks until a wake-up or `seconds`; True if one came."""
@@ -205,12 +212,16 @@ class Subscriber:
 class ReferenceWindow:
     """The testbed's one rule for which reference sample a state uses: the
     newest at or before the state's sim time; in lockstep, only once that
-    choice is final (a sample at or after the state's time has arrived)."""
+    choice is final (a sample at or after the state's time has arrived).
+    A sample older than the one due on the reference grid (or none) is a
+    stale reference; `stale` counts them, as the Rust window does."""
 
-    def __init__(self, bus: Bus, lockstep: bool):
+    def __init__(self, bus: Bus, lockstep: bool, period_ns: int):
         self.sub = bus.subscriber("reference", listen=False)
         self.recent: deque = deque()
         self.wait_for_final = lockstep
+        self.period_ns = max(int(period_ns), 1)
+        self.stale = 0
 
     def _arrive(self, r) -> None:
         t = int(r["header"]["t_ns"])
@@ -227,7 +238,11 @@ class ReferenceWindow:
                 self._arrive(r)
             settled = bool(self.recent) and int(self.recent[-1]["header"]["t_ns"]) >= t_ns
             if settled or not self.wait_for_final:
-                return self._pick(t_ns)
+                picked = self._pick(t_ns)
+                due = t_ns // self.period_ns * self.period_ns
+                if picked is None or int(picked["header"]["t_ns"]) < due:
+                    self.stale += 1
+                return picked
             idle()
 
     def _pick(self, t_ns: int) -> Optional[np.void]:

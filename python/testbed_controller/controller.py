@@ -27,6 +27,9 @@ class RunInfo:
     #: The scenario's `[controller]` table as the launcher resolved it
     #: (law, tc, k1, k2, beta, …: SPEC §11), defaults filled in.
     params: dict = field(default_factory=dict)
+    #: Period of the reference samples, ns (0: the control period): which
+    #: sample is due at a state's time.
+    reference_period_ns: int = 0
 
     @property
     def dt(self) -> float:

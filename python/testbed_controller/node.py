@@ -135,7 +135,11 @@ def read_run_info(path: str, mode: str) -> RunInfo:
         with open(path, encoding="utf-8") as f:
             cfg = json.load(f)
         return RunInfo(
-            dof=int(cfg["dof"]), period_ns=int(cfg["period_ns"]), mode=mode, params=dict(cfg["params"])
+            dof=int(cfg["dof"]),
+            period_ns=int(cfg["period_ns"]),
+            mode=mode,
+            params=dict(cfg["params"]),
+            reference_period_ns=int(cfg.get("reference_period_ns", 0)),
         )
     except (OSError, ValueError, KeyError, TypeError) as e:
         raise SystemExit(f"controller: cannot read the config {path}: {e!r}") from e
@@ -150,7 +154,7 @@ class Loop:
         self.n = info.dof
         self.link = link
         self.states = bus.subscriber("joint_state")
-        self.refs = ReferenceWindow(bus, lockstep)
+        self.refs = ReferenceWindow(bus, lockstep, info.reference_period_ns or info.period_ns)
         self.commands = bus.publisher("command", lossless=lockstep)
         self.diags = bus.publisher("diagnostics", lossless=lockstep)
         self.idle = lambda: (bus.wait(0.001), link.check())
@@ -177,6 +181,7 @@ class Loop:
             self.states.drain_events()
 
     def step(self, s) -> None:
+        started_wall_ns = time.monotonic_ns()
         started = time.perf_counter_ns()
         n = self.n
         h = s["header"]
@@ -195,6 +200,9 @@ class Loop:
         m["tau"][:n] = tau
         m["state_wall_ns"] = h["wall_ns"]
         m["compute_ns"] = compute_ns
+        m["started_wall_ns"] = started_wall_ns
+        m["reference_t_ns"] = wire.NONE_U64 if r is None else int(r["header"]["t_ns"])
+        m["stale_references"] = self.refs.stale
         self.commands.send(sample)
         self.publish_diagnostics(h, wall_ns, compute_ns, state, r, fault, tau, extra)
 

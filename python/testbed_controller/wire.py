@@ -20,6 +20,7 @@ HEARTBEAT_NS = 100000000  # a node repeats its status at least this often while 
 SILENT_AFTER_S = 3  # the launcher names a node not heard from for this long
 RUN_PREFIX_STEM = "tbrun"  # every run's shared-memory prefix starts so
 STATE_FINAL = 1  # JointState.flags: the last state, no command expected
+NONE_U64 = 18446744073709551615  # JointState.command_seq, Command.reference_t_ns: none
 CONTROL_START = 1  # Control.command
 CONTROL_STOP = 2  # Control.command
 NODE_READY = 1  # NodeStatus.state
@@ -69,15 +70,17 @@ class JointState(ctypes.Structure):
         ("effects", ctypes.c_uint32),
         ("reserved", ctypes.c_uint32),
         ("deadline_misses", ctypes.c_uint64),
+        ("command_seq", ctypes.c_uint64),
+        ("applied_wall_ns", ctypes.c_uint64),
     ]
-    SIZE = 624
+    SIZE = 640
     ALIGN = 8
-    OFFSETS = {"header": 0, "dof": 24, "flags": 28, "q": 32, "qd": 128, "q_measured": 224, "qd_measured": 320, "tau_applied": 416, "disturbance": 512, "effects": 608, "reserved": 612, "deadline_misses": 616}
+    OFFSETS = {"header": 0, "dof": 24, "flags": 28, "q": 32, "qd": 128, "q_measured": 224, "qd_measured": 320, "tau_applied": 416, "disturbance": 512, "effects": 608, "reserved": 612, "deadline_misses": 616, "command_seq": 624, "applied_wall_ns": 632}
     JOINT_FIELDS = ("q", "qd", "q_measured", "qd_measured", "tau_applied", "disturbance")
 
     @staticmethod
     def type_name() -> str:
-        return "testbed.JointState.v2"
+        return "testbed.JointState.v3"
 
 
 class ReferenceSample(ctypes.Structure):
@@ -109,15 +112,18 @@ class Command(ctypes.Structure):
         ("tau", ctypes.c_double * MAX_DOF),
         ("state_wall_ns", ctypes.c_uint64),
         ("compute_ns", ctypes.c_uint64),
+        ("started_wall_ns", ctypes.c_uint64),
+        ("reference_t_ns", ctypes.c_uint64),
+        ("stale_references", ctypes.c_uint64),
     ]
-    SIZE = 144
+    SIZE = 168
     ALIGN = 8
-    OFFSETS = {"header": 0, "dof": 24, "fault": 28, "tau": 32, "state_wall_ns": 128, "compute_ns": 136}
+    OFFSETS = {"header": 0, "dof": 24, "fault": 28, "tau": 32, "state_wall_ns": 128, "compute_ns": 136, "started_wall_ns": 144, "reference_t_ns": 152, "stale_references": 160}
     JOINT_FIELDS = ("tau",)
 
     @staticmethod
     def type_name() -> str:
-        return "testbed.Command.v1"
+        return "testbed.Command.v2"
 
 
 class ControllerDiagnostics(ctypes.Structure):

@@ -143,6 +143,7 @@ impl ArmDefault {
             reference: ReferenceConfig {
                 joints: reference,
                 rate_hz: None,
+                horizon_s: trajectory::DEFAULT_HORIZON_S,
             },
             envelope: EnvelopeConfig {
                 joints: envelope,

@@ -288,7 +288,7 @@ fn a_realtime_run_with_a_viewer_that_never_reads_keeps_its_deadlines() {
     let names = threads(logger);
     assert!(!names.iter().any(|n| n.contains("tokio")), "{names:?}");
     let (status, out, err) = ended(&mut plain, 120);
-    assert!(status.success(), "{err}");
+    assert!(matches!(status.code(), Some(0 | 3)), "{err}");
     let base = parse_json_str(&out)["timing"]["deadline_misses"]
         .as_u64()
         .unwrap();
@@ -304,7 +304,8 @@ fn a_realtime_run_with_a_viewer_that_never_reads_keeps_its_deadlines() {
     assert!(names.iter().any(|n| n.contains("tokio")), "{names:?}");
     // From here on the viewer reads nothing until the run is over.
     let (status, out, err) = ended(&mut run, 120);
-    assert!(status.success(), "{err}");
+    // Clean or degraded (a loaded machine): the misses are judged below.
+    assert!(matches!(status.code(), Some(0 | 3)), "{err}");
     let report = parse_json_str(&out);
     let live = report["timing"]["deadline_misses"].as_u64().unwrap();
     let steps = report["steps"].as_u64().unwrap();

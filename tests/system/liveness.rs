@@ -99,9 +99,11 @@ fn a_controller_stopped_and_continued_in_real_time_shows_its_misses() {
     std::thread::sleep(Duration::from_secs(1));
     kill(Pid::from_raw(pid as i32), Signal::SIGCONT).unwrap();
     let (status, out, err) = crate::util::ended(&mut launcher, 60);
-    assert!(status.success(), "{err}");
+    // The frozen controller's misses make the verdict degraded (exit 3).
+    assert_eq!(status.code(), Some(3), "{err}");
     let s: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(s["run_end"], "finished");
+    assert_eq!(s["timing"]["verdict"], "degraded");
     let misses = s["timing"]["deadline_misses"].as_u64().unwrap();
     assert!(
         misses >= 500,

@@ -159,7 +159,13 @@ fn logs_of_every_compression_hold_the_same_messages() {
             if m.channel.topic == "/timing" {
                 o.clear();
             }
-            for k in ["wall_ns", "state_wall_ns", "compute_ns"] {
+            for k in [
+                "wall_ns",
+                "state_wall_ns",
+                "compute_ns",
+                "started_wall_ns",
+                "applied_wall_ns",
+            ] {
                 o.remove(k);
             }
             all.push((m.channel.topic.clone(), m.log_time, v));

@@ -9,6 +9,7 @@ mod live;
 mod liveness;
 mod log_replay;
 mod python;
+mod realtime_integrity;
 mod replace_nodes;
 mod robots;
 mod run_cli;

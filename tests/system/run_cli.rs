@@ -61,9 +61,11 @@ fn lockstep_equals_sim_bit_for_bit() {
 #[test]
 fn short_realtime_run_reports_timing() {
     let dir = tempfile::tempdir().unwrap();
-    let out = ok(testbed()
-        .args(["run", "--duration", "1", "--json", "--runs-dir"])
-        .arg(dir.path()));
+    let out = crate::util::ran(
+        testbed()
+            .args(["run", "--duration", "1", "--json", "--runs-dir"])
+            .arg(dir.path()),
+    );
     let s = json(&out);
     assert_eq!(s["steps"], 1000);
     assert_eq!(s["finite"], true, "{s}");
@@ -414,9 +416,11 @@ fn realtime_nodes_are_placed_as_documented() {
     };
     let root = is_root();
     for (name, pid, _) in &nodes {
+        // Every node runs under SCHED_FIFO in real time (#25: the
+        // trajectory and the logger below the loop, on the other CPUs).
         let (want_cpus, fifo) = match name.as_str() {
             "plant" | "controller" => (&last, root),
-            _ => (&others, false),
+            _ => (&others, root),
         };
         assert!(
             placed(*pid, want_cpus, fifo),
@@ -425,7 +429,10 @@ fn realtime_nodes_are_placed_as_documented() {
             policy(*pid)
         );
     }
-    assert!(wait_bounded(&mut launcher, 30).success());
+    assert!(matches!(
+        wait_bounded(&mut launcher, 30).code(),
+        Some(0 | 3)
+    ));
 }
 
 /// Where the system refuses SCHED_FIFO, each loop node says so, naming
@@ -442,7 +449,7 @@ fn refused_realtime_scheduling_is_said_and_the_run_goes_on() {
         .args(["run", "--duration", "0.5", "--json", "--runs-dir"])
         .arg(dir.path())
         .current_dir(crate::util::repo_root());
-    let out = ok(&mut cmd);
+    let out = crate::util::ran(&mut cmd);
     let stderr = String::from_utf8_lossy(&out.stderr);
     for node in ["plant", "controller"] {
         assert!(
@@ -488,10 +495,61 @@ fn a_stopped_and_continued_realtime_run_goes_on() {
     std::io::Read::read_to_string(&mut launcher.stdout.take().unwrap(), &mut out).unwrap();
     let mut err = String::new();
     std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
+    // The pauses may degrade the verdict (late wake-ups, misses); the run
+    // itself is whole.
+    assert!(matches!(status.code(), Some(0 | 3)), "{err}");
+    let s: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(s["run_end"], "finished");
+    assert_ne!(s["timing"]["verdict"], "invalid", "{s}");
+    assert!(s["timing"]["late_wakeups"].as_u64().unwrap() > 0, "{s}");
+}
+
+/// Ctrl-Z then `fg` of a lockstep run (#25 item 5): a publisher waiting
+/// for room in a reader's buffer when the stop lands once failed its send
+/// ("send (testbed/timing): InternalError") about one time in two.
+#[test]
+fn a_stopped_and_continued_lockstep_run_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut launcher = testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--duration",
+            "200",
+            "--json",
+            "--runs-dir",
+        ])
+        .arg(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let nodes = wait_for_nodes(launcher.id());
+    wait_until_running(dir.path());
+    let mut pids: Vec<i32> = nodes.iter().map(|n| n.1 as i32).collect();
+    pids.push(launcher.id() as i32);
+    // Ten pauses; the sleeps are the stimulus, not waits. A pause after
+    // the run ended finds no process (ESRCH): ignored.
+    for _ in 0..10 {
+        for p in &pids {
+            let _ = kill(Pid::from_raw(*p), Signal::SIGSTOP);
+        }
+        std::thread::sleep(Duration::from_millis(100));
+        for p in &pids {
+            let _ = kill(Pid::from_raw(*p), Signal::SIGCONT);
+        }
+        std::thread::sleep(Duration::from_millis(150));
+    }
+    let status = wait_bounded(&mut launcher, 120);
+    let mut out = String::new();
+    std::io::Read::read_to_string(&mut launcher.stdout.take().unwrap(), &mut out).unwrap();
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
     assert!(status.success(), "{err}");
     let s: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(s["run_end"], "finished");
-    assert!(s["timing"]["late_wakeups"].as_u64().unwrap() > 0, "{s}");
+    assert_eq!(s["timing"]["verdict"], "clean", "{s}");
 }
 
 /// Waits (watchdog: 60 s) until a run under `runs` is under way: its log

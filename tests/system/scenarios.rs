@@ -133,17 +133,19 @@ fn seeded_effects_reproduce_exactly_across_processes_and_seeds_differ() {
 #[test]
 fn a_slower_reference_is_held_in_real_time() {
     let dir = tempfile::tempdir().unwrap();
-    let s = json(&ok(testbed()
-        .args([
-            "run",
-            "--scenario",
-            "saturation_slow_reference",
-            "--duration",
-            "1",
-            "--json",
-            "--runs-dir",
-        ])
-        .arg(dir.path())));
+    let s = json(&crate::util::ran(
+        testbed()
+            .args([
+                "run",
+                "--scenario",
+                "saturation_slow_reference",
+                "--duration",
+                "1",
+                "--json",
+                "--runs-dir",
+            ])
+            .arg(dir.path()),
+    ));
     assert_eq!(s["fault_steps"], 0, "{s}");
     assert_eq!(s["finite"], true, "{s}");
     assert_eq!(s["steps"], 1000);

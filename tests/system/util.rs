@@ -27,6 +27,20 @@ pub fn ok(cmd: &mut Command) -> Output {
     out
 }
 
+/// Runs a real-time `testbed run` where timing is not what is tested:
+/// exit 0 (verdict clean) or 3 (degraded: a loaded machine) both pass;
+/// anything else fails the test with stderr.
+pub fn ran(cmd: &mut Command) -> Output {
+    let out = cmd.output().expect("spawn testbed");
+    assert!(
+        matches!(out.status.code(), Some(0 | 3)),
+        "{cmd:?} exited {:?}\nstderr:\n{}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// Runs, expects a non-zero exit, and returns stderr.
 pub fn fails(cmd: &mut Command) -> String {
     let out = cmd.output().expect("spawn testbed");

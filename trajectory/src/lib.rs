@@ -105,6 +105,26 @@ pub struct ReferenceConfig {
     /// than the state, so a slower reference is held between samples.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rate_hz: Option<f64>,
+    /// In real time, how far ahead of its time each sample is published, s
+    /// (default [`DEFAULT_HORIZON_S`]). The reference is a known function
+    /// of time, so a trajectory process the machine delays by less than
+    /// this never makes the controller use a stale sample; 0 publishes each
+    /// sample just in time, as a live planner would.
+    #[serde(default = "default_horizon")]
+    pub horizon_s: f64,
+}
+
+/// The real-time publishing horizon of a scenario that sets none, s: far
+/// longer than the stalls a loaded machine gives a process it schedules
+/// (the trajectory also runs under SCHED_FIFO), far inside a subscriber's
+/// buffer.
+pub const DEFAULT_HORIZON_S: f64 = 0.05;
+
+/// Reference samples a horizon may span: half a subscriber's buffer.
+pub const MAX_HORIZON_SAMPLES: f64 = (wire::SUBSCRIBER_BUFFER / 2) as f64;
+
+fn default_horizon() -> f64 {
+    DEFAULT_HORIZON_S
 }
 
 impl ReferenceConfig {
@@ -126,6 +146,7 @@ impl ReferenceConfig {
                 },
             ],
             rate_hz: None,
+            horizon_s: DEFAULT_HORIZON_S,
         }
     }
 }

@@ -2,8 +2,9 @@
 //! publishing q_d, q̇_d, q̈_d, k_c and k̇_c.
 //!
 //! In real time it runs on its own absolute-deadline timer from the epoch
-//! the launcher gives, one period ahead of the plant, so the sample for t_k
-//! is there when state k arrives. In lockstep it runs up to [`AHEAD`]
+//! the launcher gives, publishing each sample a horizon ahead of its time
+//! (`reference.horizon_s`), so the sample for t_k is there when state k
+//! arrives even when the machine delays this process. In lockstep it runs up to [`AHEAD`]
 //! samples ahead of the plant's newest state: the controller waits for the
 //! sample it needs, which is almost always there already.
 
@@ -35,6 +36,8 @@ pub struct TrajectoryNodeConfig {
     pub period_ns: u64,
     /// Reference period, ns.
     pub reference_period_ns: u64,
+    /// Real time: each sample goes out this long before its time, ns.
+    pub horizon_ns: u64,
     /// Control steps in the run.
     pub steps: u64,
 }
@@ -93,11 +96,10 @@ pub fn run(
     match states {
         None => {
             clock::tighten_timer_slack();
-            publish(&mut m, 0)?;
-            for j in 1..=last {
-                // Each sample goes out one control period before its time.
-                let due = (j * m.period_ns()).saturating_sub(config.period_ns);
-                clock::sleep_until(epoch + due);
+            for j in 0..=last {
+                // Each sample goes out a horizon before its time (the
+                // first ones at once, before step 0).
+                clock::sleep_until((epoch + j * m.period_ns()).saturating_sub(config.horizon_ns));
                 publish(&mut m, j)?;
                 if j % 32 == 0 {
                     link.check()?;

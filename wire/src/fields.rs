@@ -32,6 +32,10 @@ pub trait FieldSource {
     fn f(&self, name: &str) -> Result<f64, String>;
     /// A per-joint array.
     fn j(&self, name: &str) -> Result<Joints, String>;
+    /// Whether the source has the field at all: a field added in a later
+    /// version of its message takes its documented default when an older
+    /// log lacks it.
+    fn has(&self, name: &str) -> bool;
 }
 
 /// A message whose fields can be listed and filled by name.
@@ -48,7 +52,9 @@ pub trait MessageFields: Sized + Copy + Default {
 /// list in one place: the log's codec ([`MessageFields`]) and its memory
 /// layout for other languages ([`crate::WireLayout`]) come from it. Doc
 /// comments come first, then `#[type_name("…")]`. Each field names its kind: `U32`, `U64`, `I64`,
-/// `F64`, `J` (per-joint, trimmed to `dof`) or `Pad` (layout only).
+/// `F64`, `J` (per-joint, trimmed to `dof`) or `Pad` (layout only). A field
+/// added after logs of its message were written ends in `| default`: the
+/// value a log without it decodes to (every other field is required).
 #[macro_export]
 macro_rules! data_message {
     (
@@ -56,7 +62,7 @@ macro_rules! data_message {
         #[type_name($type_name:literal)]
         pub struct $name:ident {
             $(#[$hmeta:meta])* header: Header,
-            $( $(#[$fmeta:meta])* $field:ident : $ty:ty => $kind:ident ),* $(,)?
+            $( $(#[$fmeta:meta])* $field:ident : $ty:ty => $kind:ident $(| $default:expr)? ),* $(,)?
         }
     ) => {
         #[repr(C)]
@@ -97,7 +103,7 @@ macro_rules! data_message {
                 source: &dyn $crate::FieldSource,
             ) -> Result<Self, String> {
                 let mut m = Self { header, ..Self::default() };
-                $( $crate::field_decode!($kind, m, $field, source); )*
+                $( $crate::field_decode!($kind, m, $field, source $(, $default)?); )*
                 Ok(m)
             }
         }
@@ -149,6 +155,13 @@ macro_rules! field_decode {
         $m.$f = $s.j(stringify!($f))?
     };
     (Pad, $m:ident, $f:ident, $s:ident) => {};
+    ($kind:ident, $m:ident, $f:ident, $s:ident, $default:expr) => {
+        if $s.has(stringify!($f)) {
+            $crate::field_decode!($kind, $m, $f, $s)
+        } else {
+            $m.$f = $default
+        }
+    };
 }
 
 #[cfg(test)]
@@ -181,6 +194,9 @@ mod tests {
             let v = &self.0.iter().find(|(n, _)| *n == name).ok_or("none")?.1;
             Ok(crate::joints(v))
         }
+        fn has(&self, name: &str) -> bool {
+            self.0.iter().any(|(n, _)| *n == name)
+        }
     }
 
     fn echo<M: MessageFields>(m: &M) -> Echo {
@@ -210,7 +226,7 @@ mod tests {
         s.disturbance[0] = -1.25;
         let e = echo(&s);
         let names: Vec<&str> = e.0.iter().map(|(n, _)| *n).collect();
-        assert_eq!(names.len(), 10, "{names:?}");
+        assert_eq!(names.len(), 12, "{names:?}");
         assert!(!names.contains(&"reserved") && !names.contains(&"header"));
         assert_eq!(e.0[2].1.len(), 3, "per-joint fields are trimmed to dof");
         assert_eq!(JointState::decode(s.header, &e).unwrap(), s);

@@ -50,7 +50,7 @@ pub use layout::{
 };
 pub use messages::*;
 pub use node::{HEARTBEAT, Mode, NodeError, NodeLink, SILENT_AFTER, ns_to_s};
-pub use reference::ReferenceWindow;
+pub use reference::{ReferenceWindow, is_stale};
 pub use topics::{
     Bus, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix, SUBSCRIBER_BUFFER,
     Topic, TopicPublisher, TopicSubscriber, WireError, monotonic_ns,

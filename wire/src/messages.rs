@@ -34,9 +34,14 @@ pub struct Header {
 /// `JointState::flags`: the last state of the run; no command is expected for it.
 pub const STATE_FINAL: u32 = 1;
 
+/// A sequence number or sim time that does not exist: no command applied
+/// yet ([`JointState::command_seq`]), no reference sample
+/// ([`Command::reference_t_ns`]).
+pub const NONE_U64: u64 = u64::MAX;
+
 crate::data_message! {
     /// The plant's state at step `header.seq` (t_k = k Δt).
-    #[type_name("testbed.JointState.v2")]
+    #[type_name("testbed.JointState.v3")]
     pub struct JointState {
         /// seq = k, t_ns = t_k.
         header: Header,
@@ -64,6 +69,13 @@ crate::data_message! {
         reserved: u32 => Pad,
         /// Deadline misses so far (real-time mode).
         deadline_misses: u64 => U64,
+        /// Seq of the command the plant applied over [t_{k−1}, t_k]
+        /// ([`NONE_U64`] at k = 0 or before any came). Anything but k − 1
+        /// is a deadline miss: the log recounts them from this.
+        command_seq: u64 => U64 | NONE_U64,
+        /// CLOCK_MONOTONIC when the plant took that command (its wake-up
+        /// for t_k in real time; its arrival in lockstep), ns; 0 if none.
+        applied_wall_ns: u64 => U64 | 0,
     }
 }
 
@@ -92,7 +104,7 @@ crate::data_message! {
 
 crate::data_message! {
     /// The controller's torque for the state with the same `header.seq`.
-    #[type_name("testbed.Command.v1")]
+    #[type_name("testbed.Command.v2")]
     pub struct Command {
         /// seq and t_ns of the state this answers; wall_ns when it was sent.
         header: Header,
@@ -106,6 +118,16 @@ crate::data_message! {
         state_wall_ns: u64 => U64,
         /// Controller compute time for this step, ns.
         compute_ns: u64 => U64,
+        /// CLOCK_MONOTONIC when the controller started on the state, ns:
+        /// minus the state's `wall_ns`, the state's age.
+        started_wall_ns: u64 => U64 | 0,
+        /// Sim time of the reference sample used ([`NONE_U64`]: none had
+        /// come). Older than the sample for the state's own time: a stale
+        /// reference.
+        reference_t_ns: u64 => U64 | NONE_U64,
+        /// Stale references so far, this step included: the controller's
+        /// own count, which the log's recount must equal.
+        stale_references: u64 => U64 | 0,
     }
 }
 

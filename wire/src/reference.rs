@@ -4,6 +4,11 @@
 //! so a run is deterministic whoever publishes the reference; in real time
 //! it takes what has arrived. Every controller node, the testbed's and a
 //! replacement, uses this one rule.
+//!
+//! A sample older than the one due at the state's time (the newest on the
+//! reference grid at or before it) is a *stale reference*; none at all is
+//! one too. The window counts them; the count travels in each
+//! [`crate::Command`] and the log recounts it from the samples' times.
 
 use std::collections::VecDeque;
 use std::time::Duration;
@@ -15,16 +20,26 @@ pub struct ReferenceWindow {
     sub: TopicSubscriber<ReferenceSample>,
     recent: VecDeque<ReferenceSample>,
     wait_for_final: bool,
+    period_ns: u64,
+    stale: u64,
 }
 
 impl ReferenceWindow {
-    /// Subscribes `link` to the reference topic for a run in `mode`.
-    pub fn new(link: &NodeLink, mode: Mode) -> Result<Self, NodeError> {
+    /// Subscribes `link` to the reference topic for a run in `mode` whose
+    /// reference samples come every `period_ns`.
+    pub fn new(link: &NodeLink, mode: Mode, period_ns: u64) -> Result<Self, NodeError> {
         Ok(Self {
             sub: link.bus.subscriber(Topic::Reference)?,
             recent: VecDeque::with_capacity(2048),
             wait_for_final: mode == Mode::Lockstep,
+            period_ns: period_ns.max(1),
+            stale: 0,
         })
+    }
+
+    /// Stale references so far (see the module's documentation).
+    pub fn stale_count(&self) -> u64 {
+        self.stale
     }
 
     /// The sample for sim time `t_ns`, if there is one (in lockstep, once
@@ -40,13 +55,22 @@ impl ReferenceWindow {
             }
             let settled = self.recent.back().is_some_and(|r| r.header.t_ns >= t_ns);
             if settled || !self.wait_for_final {
-                return Ok(pick(&mut self.recent, t_ns));
+                let picked = pick(&mut self.recent, t_ns);
+                self.stale += u64::from(is_stale(picked.as_ref(), t_ns, self.period_ns));
+                return Ok(picked);
             }
             // Only at the start, or when a replacement trajectory is slow.
             link.bus.wait(Duration::from_millis(1))?;
             link.check()?;
         }
     }
+}
+
+/// Whether `used` is older than the sample due at `t_ns` on a grid of
+/// `period_ns` (or missing).
+pub fn is_stale(used: Option<&ReferenceSample>, t_ns: u64, period_ns: u64) -> bool {
+    let due = t_ns / period_ns.max(1) * period_ns.max(1);
+    used.is_none_or(|r| r.header.t_ns < due)
 }
 
 /// Keeps `recent` in time order: samples from one publisher come in order,
@@ -106,6 +130,16 @@ mod tests {
             [3, 5]
         );
         assert!(pick(&mut arrived(&[7]), 6).is_none());
+    }
+
+    #[test]
+    fn a_sample_older_than_the_one_due_is_stale() {
+        assert!(!is_stale(Some(&sample(4)), 4, 1));
+        assert!(is_stale(Some(&sample(3)), 4, 1));
+        assert!(is_stale(None, 4, 1));
+        // On a coarser grid the sample at 4 serves every state until 8.
+        assert!(!is_stale(Some(&sample(4)), 7, 4));
+        assert!(is_stale(Some(&sample(4)), 8, 4));
     }
 
     /// Regression: with the plant 20 periods behind the trajectory, the

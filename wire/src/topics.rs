@@ -1,6 +1,7 @@
 //! Topics, their QoS, and the per-run prefix: the one place where service
 //! names and quality of service are decided.
 
+use std::cell::Cell;
 use std::fmt::Debug;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -8,12 +9,14 @@ use std::time::Duration;
 
 use iceoryx2::node::NodeWaitFailure;
 use iceoryx2::port::BackpressureAction;
+use iceoryx2::port::SendError;
 use iceoryx2::port::listener::{Listener, ListenerWaitError};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 
 use crate::connections::{CONNECTION_FAILED, degraded};
+use crate::{Header, MessageFields};
 use iceoryx2::prelude::*;
 
 /// A pub/sub topic and its paired event service (same name).
@@ -209,7 +212,7 @@ impl Debug for Bus {
 }
 
 /// A publisher with its notifier and a sequence counter.
-pub struct TopicPublisher<T: Debug + ZeroCopySend + Copy + 'static> {
+pub struct TopicPublisher<T: Debug + ZeroCopySend + MessageFields + 'static> {
     topic: Topic,
     publisher: Publisher<ipc::Service, T, ()>,
     /// None on topics without waiters.
@@ -223,11 +226,16 @@ type PubSubService<T> =
     iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>;
 
 /// A subscriber, with its listener unless it is read by polling.
-pub struct TopicSubscriber<T: Debug + ZeroCopySend + Copy + 'static> {
+pub struct TopicSubscriber<T: Debug + ZeroCopySend + MessageFields + 'static> {
     topic: Topic,
     subscriber: Subscriber<ipc::Service, T, ()>,
     listener: Option<Listener<ipc::Service>>,
+    /// The header of the last sample passed on, to drop a resent copy.
+    last: Cell<Option<Header>>,
 }
+
+/// Tries of one send that a signal interrupted ([`TopicPublisher::send`]).
+const SEND_ATTEMPTS: u32 = 3;
 
 /// SIGINT or SIGTERM seen by this process, kept by a handler of our own:
 /// iceoryx2 keeps only the last signal and clears it before some calls
@@ -282,7 +290,7 @@ impl Bus {
         }
     }
 
-    fn service<T: Debug + ZeroCopySend + Copy + 'static>(
+    fn service<T: Debug + ZeroCopySend + MessageFields + 'static>(
         &self,
         topic: Topic,
     ) -> Result<
@@ -327,7 +335,7 @@ impl Bus {
     }
 
     /// A publisher on `topic`.
-    pub fn publisher<T: Debug + ZeroCopySend + Copy + 'static>(
+    pub fn publisher<T: Debug + ZeroCopySend + MessageFields + 'static>(
         &self,
         topic: Topic,
         delivery: Delivery,
@@ -374,7 +382,7 @@ impl Bus {
     /// A subscriber on `topic` that can block until a sample arrives
     /// ([`TopicSubscriber::wait_event`]); only topics with waiters have
     /// wake-ups ([`Topic::has_waiters`]).
-    pub fn subscriber<T: Debug + ZeroCopySend + Copy + 'static>(
+    pub fn subscriber<T: Debug + ZeroCopySend + MessageFields + 'static>(
         &self,
         topic: Topic,
     ) -> Result<TopicSubscriber<T>, WireError> {
@@ -382,14 +390,14 @@ impl Bus {
     }
 
     /// A subscriber read by polling: no listener, so publishers do not wake it.
-    pub fn polling_subscriber<T: Debug + ZeroCopySend + Copy + 'static>(
+    pub fn polling_subscriber<T: Debug + ZeroCopySend + MessageFields + 'static>(
         &self,
         topic: Topic,
     ) -> Result<TopicSubscriber<T>, WireError> {
         self.subscriber_with(topic, false)
     }
 
-    fn subscriber_with<T: Debug + ZeroCopySend + Copy + 'static>(
+    fn subscriber_with<T: Debug + ZeroCopySend + MessageFields + 'static>(
         &self,
         topic: Topic,
         listen: bool,
@@ -415,22 +423,31 @@ impl Bus {
             topic,
             subscriber,
             listener,
+            last: Cell::new(None),
         })
     }
 }
 
-impl<T: Debug + ZeroCopySend + Copy + 'static> TopicPublisher<T> {
+impl<T: Debug + ZeroCopySend + MessageFields + 'static> TopicPublisher<T> {
     /// Publishes `value` and wakes the listeners. Returns how many
     /// subscribers received it.
     pub fn send(&self, value: T) -> Result<usize, WireError> {
-        let sample = self
-            .publisher
-            .loan_uninit()
-            .map_err(|e| ipc("loan", self.topic.name())(format!("{e:?}")))?;
-        let delivered = sample
-            .write_payload(value)
-            .send()
-            .map_err(|e| ipc("send", self.topic.name())(format!("{e:?}")))?;
+        let mut attempt = 1;
+        let delivered = loop {
+            let sample = self
+                .publisher
+                .loan_uninit()
+                .map_err(|e| ipc("loan", self.topic.name())(format!("{e:?}")))?;
+            match sample.write_payload(value).send() {
+                Ok(n) => break n,
+                // A lossless send waiting for room is cut short by a signal
+                // (Ctrl-Z and `fg`): iceoryx2 gives up with the sample
+                // delivered to some readers only. Sent again, the readers
+                // that have it drop the copy ([`TopicSubscriber::receive`]).
+                Err(SendError::InternalError) if attempt < SEND_ATTEMPTS => attempt += 1,
+                Err(e) => return Err(ipc("send", self.topic.name())(format!("{e:?}"))),
+            }
+        };
         if let Some(service) = &self.lossless {
             // A subscriber registered but not connected would miss every
             // sample without a word (iceoryx2 sometimes leaves a pair
@@ -450,13 +467,21 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicPublisher<T> {
     }
 }
 
-impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
-    /// The next buffered sample, if any.
+impl<T: Debug + ZeroCopySend + MessageFields + 'static> TopicSubscriber<T> {
+    /// The next buffered sample, if any; a copy of the sample before it
+    /// (same header: a send that was interrupted and made again) is dropped.
     pub fn receive(&self) -> Result<Option<T>, WireError> {
-        match self.subscriber.receive() {
-            Ok(Some(sample)) => Ok(Some(*sample)),
-            Ok(None) => Ok(None),
-            Err(e) => Err(ipc("receive", self.topic.name())(format!("{e:?}"))),
+        loop {
+            match self.subscriber.receive() {
+                Ok(Some(sample)) => {
+                    let header = MessageFields::header(&*sample);
+                    if self.last.replace(Some(header)) != Some(header) {
+                        return Ok(Some(*sample));
+                    }
+                }
+                Ok(None) => return Ok(None),
+                Err(e) => return Err(ipc("receive", self.topic.name())(format!("{e:?}"))),
+            }
         }
     }
 

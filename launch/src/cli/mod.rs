@@ -40,6 +40,13 @@ enum Command {
     /// Run the closed loop in one process, as fast as the machine allows.
     Sim(SimArgs),
     /// Run the stack as separate processes over iceoryx2 shared memory.
+    ///
+    /// Writes the run's folder (scenario, node configs, run.mcap) under
+    /// --runs-dir and prints the summary with a timing verdict. Exit
+    /// status: 0 ran, verdict clean; 1 could not run; 2 bad command line;
+    /// 3 ran, verdict degraded (missed commands, stale references, late
+    /// wake-ups); 4 ran, verdict invalid (rows or a node lost, the run
+    /// unfinished); 130 interrupted.
     Run(RunArgs),
     /// Describe an arm: joints in order, limits, masses, and the default
     /// scenario `--robot` would run on it; or why it cannot be used.
@@ -120,6 +127,11 @@ impl NodeName {
 
 /// Exit status of a run stopped by Ctrl-C (128 + SIGINT).
 pub(crate) const EXIT_INTERRUPTED: u8 = 130;
+/// Exit status of `run` when the run finished but its timing verdict is
+/// `degraded` (0: clean; 1: could not run; 2: bad command line).
+pub(crate) const EXIT_DEGRADED: u8 = 3;
+/// Exit status of `run` when the run's verdict is `invalid`.
+pub(crate) const EXIT_INVALID: u8 = 4;
 
 /// Parses the command line and runs it.
 pub fn run() -> Result<ExitCode> {

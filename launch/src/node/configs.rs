@@ -38,6 +38,7 @@ pub fn controller(plan: &Plan) -> ControllerNodeConfig {
         params: params.clone(),
         dof: plan.robot.model.dof(),
         period_ns: plan.period_ns,
+        reference_period_ns: plan.reference_period_ns,
         model: params.law.model_based().then(|| NodeModel {
             urdf: plan.robot.urdf.clone(),
             lock: plan.scenario.plant.lock.clone(),
@@ -55,6 +56,7 @@ pub fn trajectory(plan: &Plan) -> TrajectoryNodeConfig {
         joint_names: m.joint_names(),
         period_ns: plan.period_ns,
         reference_period_ns: plan.reference_period_ns,
+        horizon_ns: plan.reference_horizon_ns(),
         steps: plan.steps,
     }
 }

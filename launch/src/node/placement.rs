@@ -148,7 +148,12 @@ pub fn cpu_count() -> usize {
 /// with locked memory, the controller one level above the plant: a state
 /// the plant publishes then wakes the controller at once, even when the
 /// plant is catching up after the host stalled it, so the answer is there
-/// by the next tick (with the plant higher, every catch-up tick was a miss). In lockstep the
+/// by the next tick (with the plant higher, every catch-up tick was a miss).
+/// The trajectory (70) and the logger (60) run under SCHED_FIFO too, below
+/// the loop, on the other CPUs: a busy machine then delays neither the
+/// reference (published a horizon ahead) nor the log (whose buffers hold
+/// two seconds), where under the normal scheduler a CPU hog starved the
+/// trajectory for 420 ms and the logger dropped rows. In lockstep the
 /// pair keeps its CPU busy, and a FIFO task that never sleeps would only be
 /// throttled, so lockstep pins without raising priority.
 pub fn for_node(kind: NodeKind, mode: Mode, cpus: usize) -> Placement {
@@ -160,15 +165,19 @@ pub fn for_node(kind: NodeKind, mode: Mode, cpus: usize) -> Placement {
     } else {
         (0..cpus - 1).collect()
     };
-    let realtime = mode == Mode::Realtime && loop_node;
+    let fifo = match (mode, kind) {
+        (Mode::Lockstep, _) => None,
+        (Mode::Realtime, NodeKind::Controller) => Some(80),
+        (Mode::Realtime, NodeKind::Plant) => Some(79),
+        (Mode::Realtime, NodeKind::Trajectory) => Some(70),
+        (Mode::Realtime, NodeKind::Logger) => Some(60),
+    };
     Placement {
         cpus: cpu_list,
-        fifo: match (realtime, kind) {
-            (true, NodeKind::Controller) => Some(80),
-            (true, _) => Some(79),
-            _ => None,
-        },
-        lock_memory: realtime,
+        fifo,
+        // The logger's buffers (compression, live view) are large and
+        // its deadline is seconds away: not locked.
+        lock_memory: mode == Mode::Realtime && kind != NodeKind::Logger,
     }
 }
 
@@ -208,10 +217,13 @@ mod tests {
             l,
             Placement {
                 cpus: vec![0, 1, 2],
-                fifo: None,
+                fifo: Some(60),
                 lock_memory: false
             }
         );
+        let t = for_node(NodeKind::Trajectory, Mode::Realtime, 2);
+        assert_eq!((t.cpus.as_slice(), t.fifo), (&[0][..], Some(70)));
+        assert_eq!(for_node(NodeKind::Logger, Mode::Lockstep, 2).fifo, None);
         let lockstep = for_node(NodeKind::Plant, Mode::Lockstep, 2);
         assert_eq!((lockstep.fifo, lockstep.lock_memory), (None, false));
         assert!(for_node(NodeKind::Plant, Mode::Realtime, 1).cpus.is_empty());

@@ -1,6 +1,7 @@
 //! `testbed run`: the launcher. It turns a validated plan into running
 //! processes, starts them together, watches them, and stops them in order.
 
+pub mod data_path;
 mod error;
 mod files;
 mod nodes;
