@@ -364,6 +364,12 @@ fn timing_lines(out: &mut String, t: &TimingSummary) {
     for reason in &t.reasons {
         let _ = writeln!(out, "  - {reason}");
     }
+    if let Some(f) = t.floor_late_wakeups {
+        let _ = writeln!(
+            out,
+            "  timer floor beside the plant: {f} wake-ups late by a period"
+        );
+    }
     if let Some(n) = t.timing_faults_before_non_finite {
         let _ = writeln!(
             out,

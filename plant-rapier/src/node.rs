@@ -159,6 +159,7 @@ fn lockstep(link: &mut NodeLink, ports: &Ports, m: &mut PlantMachine) -> Result<
             },
             round_trip_ns: cmd.header.wall_ns as i64 - state.header.wall_ns as i64,
             controller_compute_ns: cmd.compute_ns as i64,
+            floor_late_wakeups: wire::NONE_U64,
             ..Timing::default()
         })?;
         state = m.state(k + 1, monotonic_ns());
@@ -216,6 +217,8 @@ fn realtime(
     epoch: u64,
 ) -> Result<(), LoopError> {
     clock::tighten_timer_slack();
+    // Started from this thread: the floor shares its CPU and priority.
+    let floor = clock::TimerFloor::start(epoch, m.period_ns(), m.steps());
     clock::sleep_until(epoch);
     let mut state = m.state(0, monotonic_ns());
     ports.state.send(state)?;
@@ -261,6 +264,7 @@ fn realtime(
             deadline_missed: u32::from(missed),
             reserved: 0,
             deadline_misses: m.misses,
+            floor_late_wakeups: floor.late_wakeups().unwrap_or(wire::NONE_U64),
         })?;
         state = m.state(k, monotonic_ns());
         state.applied_wall_ns = held.taken_wall_ns;

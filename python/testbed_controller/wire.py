@@ -178,15 +178,16 @@ class Timing(ctypes.Structure):
         ("deadline_missed", ctypes.c_uint32),
         ("reserved", ctypes.c_uint32),
         ("deadline_misses", ctypes.c_uint64),
+        ("floor_late_wakeups", ctypes.c_uint64),
     ]
-    SIZE = 72
+    SIZE = 80
     ALIGN = 8
-    OFFSETS = {"header": 0, "wake_late_ns": 24, "period_ns": 32, "round_trip_ns": 40, "controller_compute_ns": 48, "deadline_missed": 56, "reserved": 60, "deadline_misses": 64}
+    OFFSETS = {"header": 0, "wake_late_ns": 24, "period_ns": 32, "round_trip_ns": 40, "controller_compute_ns": 48, "deadline_missed": 56, "reserved": 60, "deadline_misses": 64, "floor_late_wakeups": 72}
     JOINT_FIELDS = ()
 
     @staticmethod
     def type_name() -> str:
-        return "testbed.Timing.v1"
+        return "testbed.Timing.v2"
 
 
 class Control(ctypes.Structure):

@@ -347,7 +347,11 @@ fn golden_logs_of_every_format_still_replay() {
     for key in ["joints", "metrics", "finite", "fault_steps"] {
         assert_eq!(v1[key], v2[key], "{key}");
     }
-    assert!(v1["timing"]["stale_references"].is_null(), "{}", v1["timing"]);
+    assert!(
+        v1["timing"]["stale_references"].is_null(),
+        "{}",
+        v1["timing"]
+    );
     assert!(v1["timing"].get("recount").is_none());
     assert_eq!(v2["timing"]["stale_references"], 0);
     assert_eq!(v2["timing"]["recount"]["deadline_misses"], 0);

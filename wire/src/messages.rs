@@ -200,7 +200,7 @@ crate::data_message! {
 
 crate::data_message! {
     /// Timing of one plant cycle (published by the plant, which is the clock).
-    #[type_name("testbed.Timing.v1")]
+    #[type_name("testbed.Timing.v2")]
     pub struct Timing {
         /// seq = cycle k, t_ns = t_k.
         header: Header,
@@ -218,6 +218,10 @@ crate::data_message! {
         reserved: u32 => Pad,
         /// Deadline misses so far.
         deadline_misses: u64 => U64,
+        /// Wake-ups late by a whole period so far of the timer floor, a
+        /// bare sleep loop beside the plant on its CPU and grid
+        /// ([`crate::clock::TimerFloor`]); [`NONE_U64`]: none ran.
+        floor_late_wakeups: u64 => U64 | NONE_U64,
     }
 }
 

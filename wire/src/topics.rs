@@ -516,3 +516,40 @@ impl<T: Debug + ZeroCopySend + MessageFields + 'static> TopicSubscriber<T> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::Timing;
+
+    /// A sample sent again after an interrupted send reaches each reader
+    /// once; a different sample right after it still arrives.
+    #[test]
+    fn a_resent_sample_is_received_once() {
+        let prefix = RunPrefix::unique();
+        let bus = Bus::new(&prefix, "resend-test").unwrap();
+        let publisher = bus
+            .publisher::<Timing>(Topic::Timing, Delivery::Lossless)
+            .unwrap();
+        let subscriber = bus.polling_subscriber::<Timing>(Topic::Timing).unwrap();
+        let sample = |seq| Timing {
+            header: Header {
+                seq,
+                t_ns: seq * 1000,
+                wall_ns: 77,
+            },
+            ..Timing::default()
+        };
+        for s in [sample(1), sample(1), sample(2)] {
+            publisher.send(s).unwrap();
+        }
+        let got: Vec<u64> = std::iter::from_fn(|| subscriber.receive().unwrap())
+            .map(|t| t.header.seq)
+            .collect();
+        assert_eq!(got, [1, 2]);
+        drop((publisher, subscriber, bus));
+        let _ = prefix.remove_domain_if_unused();
+        prefix.remove_leftover_files(true);
+    }
+}
