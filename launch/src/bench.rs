@@ -18,9 +18,9 @@ use serde::Serialize;
 
 use crate::mode::Mode;
 use crate::node::placement::{self, Placement};
-use crate::run::timing::{Percentiles, TimingStats};
 use crate::run::{self, RunError, RunOptions};
 use crate::sim::{self, StepCosts};
+use analysis::timing::{Percentiles, TimingStats};
 use wire::NodeKind;
 use wire::clock;
 

@@ -9,7 +9,7 @@ use serde::Serialize;
 use crate::bench::{
     BenchError, BenchOptions, Machine, RealtimeFigures, TimerFloor, load, machine, realtime_part,
 };
-use crate::run::timing::Percentiles;
+use analysis::timing::Percentiles;
 
 /// One controller's real-time figures.
 #[derive(Debug, Clone, Serialize)]

@@ -12,10 +12,10 @@ use rayon::prelude::*;
 use scenario::Plan;
 use serde::Serialize;
 
-use crate::law_info::LawInfo;
-use crate::run::timing::Percentiles;
 use crate::sim::{self, StepCosts};
-use crate::summary::{Summary, SummaryBuilder};
+use analysis::law_info::LawInfo;
+use analysis::summary::{Summary, SummaryBuilder};
+use analysis::timing::Percentiles;
 
 /// The laws `compare` runs when none are named: the paper's law, its
 /// ablations, the classic barrier law, PD, computed torque and PPC.

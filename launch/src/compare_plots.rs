@@ -9,7 +9,7 @@ use plotters::style::FontStyle;
 use scenario::Plan;
 
 use crate::compare::{Comparison, LawRow};
-use crate::plots::{COLORS, FAMILY, FONT, Line, Panel, PlotError, RED, category, err, save};
+use analysis::plots::{COLORS, FAMILY, FONT, Line, Panel, PlotError, RED, category, err, save};
 
 /// Writes `compare_errors` and `compare_bars` (PNG and SVG) into `dir`;
 /// returns how many figures.

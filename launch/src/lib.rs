@@ -1,30 +1,24 @@
 //! The `testbed` command's internals: the in-process run, the node
-//! dispatcher, the launcher, the analysis of a run and what is printed.
+//! dispatcher, the launcher and its supervision, and the experiments built
+//! on them (compare, sweep, bench).
 //!
 //! Where it sits: at the top. `testbed sim` loads a [`scenario::Plan`] and
 //! [`sim::run`] calls the role crates' step machines in order; `testbed run`
 //! writes each node its config ([`node::configs`]), spawns the nodes (whose
 //! code lives in the role crates; [`node`] only dispatches to them) and
 //! [`run`] supervises them. Either way the rows come from one
-//! [`assemble::RecordAssembler`] and feed a [`summary::SummaryBuilder`];
-//! [`analysis`] reads a run's log back for `run` and `replay`.
+//! [`analysis::assemble::RecordAssembler`] and feed a
+//! [`analysis::summary::SummaryBuilder`]; the `analysis` crate reads a
+//! run's log back for `run` and `replay`.
 
-pub mod analysis;
-pub mod assemble;
 pub mod bench;
 pub mod bench_controller;
 pub mod bench_peer;
 pub mod bindings;
 pub mod compare;
 pub mod compare_plots;
-pub mod csv_out;
-pub mod law_info;
 pub mod mode;
 pub mod node;
-pub mod plots;
-pub mod record;
 pub mod run;
 pub mod sim;
-pub mod summary;
 pub mod sweep;
-pub mod verify;

@@ -1,7 +1,7 @@
 //! `testbed`: run the paper's controller on a simulated arm.
 
+mod bench_table;
 mod cli;
-mod report;
 
 use std::process::ExitCode;
 

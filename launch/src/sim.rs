@@ -8,8 +8,8 @@ use plant_rapier::PlantError;
 use scenario::Plan;
 use trajectory::TrajectoryMachine;
 
-use crate::assemble::RecordAssembler;
-use crate::record::StepRecord;
+use analysis::assemble::RecordAssembler;
+use analysis::record::StepRecord;
 
 /// Why the loop stopped early.
 #[derive(Debug, thiserror::Error)]

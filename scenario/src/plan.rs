@@ -46,6 +46,25 @@ impl Plan {
         })
     }
 
+    /// What the controller node needs of this plan: gains and sizes, and
+    /// the URDF only for a model-based law.
+    pub fn controller_node_config(&self) -> controller::node::ControllerNodeConfig {
+        let params = &self.scenario.controller;
+        controller::node::ControllerNodeConfig {
+            params: params.clone(),
+            dof: self.robot.model.dof(),
+            period_ns: self.period_ns,
+            reference_period_ns: self.reference_period_ns,
+            model: params
+                .law
+                .model_based()
+                .then(|| controller::node::NodeModel {
+                    urdf: self.robot.urdf.clone(),
+                    lock: self.scenario.plant.lock.clone(),
+                }),
+        }
+    }
+
     /// Control period in seconds (exactly `period_ns` / 1e9).
     pub fn dt(&self) -> f64 {
         self.period_ns as f64 / 1e9

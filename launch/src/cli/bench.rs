@@ -7,7 +7,8 @@ use anyhow::Result;
 use launch::bench_controller::ControllerBench;
 
 use super::args::BenchArgs;
-use crate::report::{self, percentiles};
+use crate::bench_table;
+use analysis::report::percentiles;
 
 pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
     if !(args.realtime_s.is_finite() && args.realtime_s > 0.0) {
@@ -58,7 +59,7 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print!("{}", report::bench_table(&report));
+        print!("{}", bench_table::bench_table(&report));
     }
     Ok(ExitCode::SUCCESS)
 }

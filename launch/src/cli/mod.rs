@@ -20,7 +20,7 @@ use launch::node::{self, NodeArgs};
 use scenario::Overrides;
 use wire::NodeKind;
 
-use crate::report::{self, Report};
+use analysis::report::{self, Report};
 use args::{BenchArgs, CompareArgs, ReplayArgs, RunArgs, ScenarioArgs, SimArgs};
 
 /// Run the paper's RL neuroadaptive controller under deferred constraints on

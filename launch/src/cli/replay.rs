@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 
 use super::args::ReplayArgs;
 use super::print_report;
-use crate::report::Report;
+use analysis::report::Report;
 
 pub(crate) fn replay(args: ReplayArgs) -> Result<ExitCode> {
     let mut csv = match &args.csv {
@@ -24,9 +24,9 @@ pub(crate) fn replay(args: ReplayArgs) -> Result<ExitCode> {
         .as_ref()
         .map(|p| p.display().to_string())
         .unwrap_or_default();
-    let analysis = launch::analysis::analyse(
+    let analysis = analysis::analyse::analyse(
         &args.log,
-        launch::analysis::AnalyseOptions {
+        analysis::analyse::AnalyseOptions {
             csv: csv
                 .as_mut()
                 .map(|w| (csv_name.as_str(), w as &mut dyn Write)),
@@ -35,7 +35,7 @@ pub(crate) fn replay(args: ReplayArgs) -> Result<ExitCode> {
         },
     )?;
     if let (Some(dir), Some(series)) = (&args.plots, &analysis.series) {
-        let written = launch::plots::write_all(dir, series, &analysis.plan)
+        let written = analysis::plots::write_all(dir, series, &analysis.plan)
             .with_context(|| format!("writing figures to {}", dir.display()))?;
         eprintln!("testbed: wrote {} figures to {}", written, dir.display());
     }

@@ -3,13 +3,13 @@
 use std::io::IsTerminal;
 use std::process::ExitCode;
 
+use analysis::timing::Verdict;
 use anyhow::{Context, Result};
-use launch::run::timing::Verdict;
 use launch::run::{self, RunError, RunOptions};
 
 use super::args::RunArgs;
 use super::{EXIT_DEGRADED, EXIT_INTERRUPTED, EXIT_INVALID, load, print_report};
-use crate::report::Report;
+use analysis::report::Report;
 
 pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
     let plan = load(&args.common, args.rate)?;

@@ -5,12 +5,13 @@ use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use analysis::{csv_out, summary::SummaryBuilder};
 use anyhow::{Context, Result};
-use launch::{csv_out, sim as in_process, summary::SummaryBuilder};
+use launch::sim as in_process;
 
 use super::args::SimArgs;
 use super::{load, print_report};
-use crate::report::Report;
+use analysis::report::Report;
 
 pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
     let args = args.common;

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use controller::node::{ControllerNodeConfig, NodeModel};
+use controller::node::ControllerNodeConfig;
 use logger::live::LiveConfig;
 use logger::node::LoggerNodeConfig;
 use logger::{LogCompression, RunMetadata};
@@ -31,19 +31,10 @@ pub fn plant(plan: &Plan) -> PlantNodeConfig {
 }
 
 /// The controller's part: gains and sizes, and the URDF only for a
-/// model-based law.
+/// model-based law ([`Plan::controller_node_config`], which `replay
+/// --verify` rebuilds the controller from too).
 pub fn controller(plan: &Plan) -> ControllerNodeConfig {
-    let params = &plan.scenario.controller;
-    ControllerNodeConfig {
-        params: params.clone(),
-        dof: plan.robot.model.dof(),
-        period_ns: plan.period_ns,
-        reference_period_ns: plan.reference_period_ns,
-        model: params.law.model_based().then(|| NodeModel {
-            urdf: plan.robot.urdf.clone(),
-            lock: plan.scenario.plant.lock.clone(),
-        }),
-    }
+    plan.controller_node_config()
 }
 
 /// The trajectory's part.
@@ -99,7 +90,7 @@ pub fn metadata(plan: &Plan, mode: Mode, out: &Path, toml: &str) -> RunMetadata 
     let n = m.dof();
     let gains = |g: &controller::Gain| format!("{:?}", g.resolve("gain", n).unwrap_or_default());
     let (locked, mimic) = joint_roles(plan);
-    let law = crate::law_info::LawInfo::of(&plan.scenario.controller);
+    let law = analysis::law_info::LawInfo::of(&plan.scenario.controller);
     RunMetadata {
         law: law.law.to_string(),
         model_based: law.model_based,

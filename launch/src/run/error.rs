@@ -2,7 +2,7 @@
 
 use wire::{MAX_DOF, NodeKind, RunEnd, WireError};
 
-use crate::analysis::AnalysisError;
+use analysis::analyse::AnalysisError;
 
 /// Why a run failed.
 #[derive(Debug, thiserror::Error)]

@@ -1,12 +1,10 @@
 //! `testbed run`: the launcher. It turns a validated plan into running
 //! processes, starts them together, watches them, and stops them in order.
 
-pub mod data_path;
 mod error;
 mod files;
 mod nodes;
 pub mod spawn;
-pub mod timing;
 mod transport;
 
 pub use error::RunError;
@@ -24,8 +22,8 @@ use wire::{
     RunEnd, RunPrefix, Topic, WireError, monotonic_ns,
 };
 
-use crate::analysis::{AnalyseOptions, LogAnalysis, analyse};
 use crate::mode::Mode;
+use analysis::analyse::{AnalyseOptions, LogAnalysis, analyse};
 use files::RunFiles;
 use nodes::NodeStates;
 use spawn::{Children, describe};

@@ -6,8 +6,8 @@
 //! started again, from scratch, in a new domain. Lockstep runs are
 //! deterministic, so a run started again gives the same bits.
 
-use crate::analysis::LogAnalysis;
 use crate::mode::Mode;
+use analysis::analyse::LogAnalysis;
 
 use super::{RunError, RunOptions, RunOutcome};
 

@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 
 use super::report::{CellReport, SweepReport, quantile};
-use crate::plots::{COLORS, FAMILY, FONT, PlotError, category, err};
+use analysis::plots::{COLORS, FAMILY, FONT, PlotError, category, err};
 
 /// The metrics drawn as box plots.
 const BOXED: [(&str, &str); 2] = [

@@ -5,8 +5,8 @@
 use serde::Serialize;
 use wire::Timing;
 
-use super::data_path::DataPathSummary;
-use crate::mode::Mode;
+use crate::data_path::DataPathSummary;
+use wire::Mode;
 
 /// p50, p99 and max of one quantity, in microseconds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -350,8 +350,8 @@ mod tests {
 
 #[cfg(test)]
 mod verdict_tests {
-    use super::super::data_path::{DataPath, Recount};
     use super::*;
+    use crate::data_path::{DataPath, Recount};
 
     fn summary(misses: u64, late: u64, cycles: u64) -> TimingSummary {
         let mut s = TimingStats::new(1_000_000);

@@ -10,13 +10,16 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 use scenario::Plan;
 
-use crate::analysis::Series;
+use crate::analyse::Series;
 
-pub(crate) static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-pub(crate) const FAMILY: &str = "sans-serif";
+/// The embedded font every figure draws its text with.
+pub static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+/// The font family name the embedded font is registered under.
+pub const FAMILY: &str = "sans-serif";
 /// More points than a figure can show only make SVGs large.
 const MAX_POINTS: usize = 4000;
-pub(crate) const COLORS: [RGBColor; 9] = [
+/// The palette, one colour per joint or law.
+pub const COLORS: [RGBColor; 9] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -29,22 +32,29 @@ pub(crate) const COLORS: [RGBColor; 9] = [
 ];
 
 /// One curve.
-pub(crate) struct Line<'a> {
-    pub(crate) label: String,
-    pub(crate) y: &'a [f64],
-    pub(crate) color: RGBColor,
-    pub(crate) dashed: bool,
+pub struct Line<'a> {
+    /// Legend text.
+    pub label: String,
+    /// One value per time sample.
+    pub y: &'a [f64],
+    /// Its colour.
+    pub color: RGBColor,
+    /// Dashed (a bound or a reference) rather than solid.
+    pub dashed: bool,
 }
 
 /// One panel of a figure (one joint).
-pub(crate) struct Panel<'a> {
-    pub(crate) title: String,
-    pub(crate) y_label: &'static str,
-    pub(crate) lines: Vec<Line<'a>>,
+pub struct Panel<'a> {
+    /// Title above the panel.
+    pub title: String,
+    /// The y axis's label.
+    pub y_label: &'static str,
+    /// Its curves.
+    pub lines: Vec<Line<'a>>,
 }
 
 /// The name of the category at integer x (bar and box charts), else "".
-pub(crate) fn category(names: &[String], x: f64) -> String {
+pub fn category(names: &[String], x: f64) -> String {
     let i = x.round();
     if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
         names[i as usize].clone()
@@ -53,7 +63,8 @@ pub(crate) fn category(names: &[String], x: f64) -> String {
     }
 }
 
-pub(crate) fn err(e: impl std::fmt::Display) -> String {
+/// A drawing error as the text [`PlotError`] carries.
+pub fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
@@ -146,7 +157,7 @@ fn draw_panels<DB: DrawingBackend>(
 }
 
 /// Writes `name.png` and `name.svg`.
-pub(crate) fn save(
+pub fn save(
     dir: &Path,
     name: &str,
     title: &str,
@@ -182,7 +193,7 @@ fn bounds(a: &[f64], b: &[f64], sign: f64) -> Vec<f64> {
 /// A figure could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
-pub struct PlotError(pub(crate) String);
+pub struct PlotError(pub String);
 
 /// Writes every figure into `dir` (created if needed); returns how many.
 pub fn write_all(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, PlotError> {
@@ -213,7 +224,8 @@ fn line(label: String, y: &[f64], i: usize, dashed: bool) -> Line<'_> {
     }
 }
 
-pub(crate) const RED: RGBColor = RGBColor(214, 39, 40);
+/// The colour of a constraint bound.
+pub const RED: RGBColor = RGBColor(214, 39, 40);
 
 /// Fig. 1: q with q_d ± k_c.
 fn positions(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), String> {

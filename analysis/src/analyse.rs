@@ -11,14 +11,14 @@ use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
 
 use crate::assemble::RecordAssembler;
 use crate::csv_out;
-use crate::mode::Mode;
-use crate::run::data_path::DataPath;
-use crate::run::timing::{RunFacts, TimingStats, TimingSummary, judge};
+use crate::data_path::DataPath;
 use crate::summary::{Summary, SummaryBuilder};
+use crate::timing::{RunFacts, TimingStats, TimingSummary, judge};
 use crate::verify::Verifier;
 use logger::{
     DecodeError, LogContents, LogError, LogMessage, MessageError, read_log, read_log_head,
 };
+use wire::Mode;
 
 /// Why a log could not be analysed.
 #[derive(Debug, thiserror::Error)]
@@ -290,7 +290,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
     let n = plan.robot.model.dof();
     let verifier = if opts.verify {
         Some(Verifier::new(
-            crate::node::configs::controller(&plan)
+            plan.controller_node_config()
                 .machine()
                 .map_err(|e| meta_err(path, e.to_string()))?,
         ))
