@@ -5,13 +5,14 @@
 use arm_model::ArmModel;
 use arm_model::dynamics::Dynamics;
 
-use crate::law::{begin_plain_step, end_plain_step};
-use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, LawName};
+use crate::law_table::FeedbackKind;
+use crate::nac::{begin_plain_step, end_plain_step};
+use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics};
 
 /// `pd`, `pd-gravity` or `ctc` for n joints.
 #[derive(Debug, Clone)]
 pub struct Feedback {
-    law: LawName,
+    kind: FeedbackKind,
     n: usize,
     k1: Vec<f64>,
     k2: Vec<f64>,
@@ -22,10 +23,11 @@ pub struct Feedback {
 }
 
 impl Feedback {
-    /// The law `params.law` (one of pd, pd-gravity, ctc); the model-based
-    /// ones evaluate `model`, scaled by `params.model_scale`.
+    /// The law `kind` (`params.law`'s); the model-based ones evaluate
+    /// `model`, scaled by `params.model_scale`.
     pub fn new(
         params: &ControllerParams,
+        kind: FeedbackKind,
         dof: usize,
         model: Option<&ArmModel>,
     ) -> Result<Self, ControllerError> {
@@ -43,7 +45,7 @@ impl Feedback {
             (true, None) => return Err(ControllerError::NeedsModel(law)),
         };
         Ok(Self {
-            law,
+            kind,
             n: dof,
             k1: params.k1.resolve("controller.k1", dof)?,
             k2: params.k2.resolve("controller.k2", dof)?,
@@ -71,9 +73,11 @@ impl Feedback {
             out.wa_norm[i] = 0.0;
             // K_p = K1 K2, K_d = K2 (pd); K_p' = K1 K2, K_d' = K1 + K2 (ctc).
             let (k1, k2) = (self.k1[i], self.k2[i]);
-            match self.law {
-                LawName::Ctc => self.v[i] = input.qdd_d[i] - (k1 + k2) * ed - k1 * k2 * e,
-                _ => out.tau_feedback[i] = -k1 * k2 * e - k2 * ed,
+            match self.kind {
+                FeedbackKind::Ctc => self.v[i] = input.qdd_d[i] - (k1 + k2) * ed - k1 * k2 * e,
+                FeedbackKind::Pd | FeedbackKind::PdGravity => {
+                    out.tau_feedback[i] = -k1 * k2 * e - k2 * ed
+                }
             }
         }
         self.model_terms(input, out);
@@ -85,16 +89,19 @@ impl Feedback {
     /// feedback acts through M, so all of it is the model term.
     fn model_terms(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
         let n = self.n;
-        match (self.law, self.model.as_mut()) {
-            (LawName::PdGravity, Some(m)) => {
+        match (self.kind, self.model.as_mut()) {
+            (FeedbackKind::PdGravity, Some(m)) => {
                 out.tau_model.copy_from_slice(m.gravity(input.q));
             }
-            (LawName::Ctc, Some(m)) => {
+            (FeedbackKind::Ctc, Some(m)) => {
                 out.tau_model
                     .copy_from_slice(m.inverse(input.q, input.qd, &self.v));
                 out.tau_feedback.iter_mut().for_each(|x| *x = 0.0);
             }
-            _ => out.tau_model.iter_mut().for_each(|x| *x = 0.0),
+            // `new` refuses a model-based law without a model.
+            (FeedbackKind::Pd, _) | (FeedbackKind::PdGravity | FeedbackKind::Ctc, None) => {
+                out.tau_model.iter_mut().for_each(|x| *x = 0.0)
+            }
         }
         for i in 0..n {
             out.tau[i] = out.tau_model[i] + out.tau_feedback[i];

@@ -3,7 +3,8 @@
 #![allow(clippy::unwrap_used)]
 
 use super::*;
-use crate::Fault;
+use crate::law_table::LawKind;
+use crate::{Fault, LawName};
 use arm_model::TWO_LINK_URDF;
 
 const Q: [f64; 2] = [0.5, -0.5];
@@ -26,6 +27,18 @@ fn input() -> ControllerInput<'static> {
     }
 }
 
+/// The feedback law `p.law` names.
+fn new_feedback(
+    p: &ControllerParams,
+    dof: usize,
+    model: Option<&ArmModel>,
+) -> Result<Feedback, ControllerError> {
+    let LawKind::Feedback(kind) = p.law.kind() else {
+        panic!("{} is not a feedback law", p.law)
+    };
+    Feedback::new(p, kind, dof, model)
+}
+
 fn params(law: LawName) -> ControllerParams {
     ControllerParams {
         law,
@@ -36,7 +49,7 @@ fn params(law: LawName) -> ControllerParams {
 }
 
 fn step(law: LawName, model: Option<&ArmModel>) -> Diagnostics {
-    let mut f = Feedback::new(&params(law), 2, model).unwrap();
+    let mut f = new_feedback(&params(law), 2, model).unwrap();
     let mut d = Diagnostics::new(2);
     f.step(&input(), &mut d);
     d
@@ -84,7 +97,7 @@ fn ctc_is_the_models_inverse_dynamics_at_the_commanded_acceleration() {
         model_scale: 0.8,
         ..params(LawName::Ctc)
     };
-    let mut f = Feedback::new(&light, 2, Some(&model)).unwrap();
+    let mut f = new_feedback(&light, 2, Some(&model)).unwrap();
     let mut d8 = Diagnostics::new(2);
     f.step(&input(), &mut d8);
     for (a, b) in d8.tau.iter().zip(&want) {
@@ -94,14 +107,14 @@ fn ctc_is_the_models_inverse_dynamics_at_the_commanded_acceleration() {
 
 #[test]
 fn a_model_based_law_without_a_model_is_refused() {
-    let e = Feedback::new(&params(LawName::Ctc), 2, None).unwrap_err();
+    let e = new_feedback(&params(LawName::Ctc), 2, None).unwrap_err();
     assert_eq!(e, ControllerError::NeedsModel(LawName::Ctc));
     assert!(e.to_string().contains("'ctc' is model-based"));
 }
 
 #[test]
 fn a_non_finite_input_gives_zero_torque_and_a_fault() {
-    let mut f = Feedback::new(&params(LawName::Pd), 2, None).unwrap();
+    let mut f = new_feedback(&params(LawName::Pd), 2, None).unwrap();
     let mut d = Diagnostics::new(2);
     let q = [f64::NAN, 0.0];
     f.step(&ControllerInput { q: &q, ..input() }, &mut d);

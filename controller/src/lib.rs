@@ -33,12 +33,12 @@
 //! stays small and the loop behaves as feedback plus barrier. The
 //! `per-input` layout ([`RbfLayout`]) covers each input's range instead.
 
+mod dispatch;
 mod feedback;
 mod gain;
-mod law;
-mod law_name;
-mod laws;
+mod law_table;
 mod machine;
+mod nac;
 pub mod node;
 mod params;
 mod ppc;
@@ -46,12 +46,12 @@ mod rbf;
 mod shifting;
 mod weight_update;
 
+pub use dispatch::Law;
 pub use feedback::Feedback;
 pub use gain::Gain;
-pub use law::{Controller, ControllerInput, barrier_lyapunov};
-pub use law_name::LawName;
-pub use laws::Law;
+pub use law_table::{BarrierParts, FeedbackKind, LawDecl, LawKind, LawName};
 pub use machine::ControllerMachine;
+pub use nac::{Controller, ControllerInput, barrier_lyapunov};
 pub use params::{BarrierMode, ControllerParams, Integrator, MAX_NEURONS, RbfLayout};
 pub use ppc::{Ppc, XI_LIMIT};
 pub use rbf::Rbf;

@@ -3,7 +3,7 @@
 //! the run's envelope k_c by about T_c, so that it competes with the
 //! deferred constraint on the same task.
 
-use crate::law::{begin_plain_step, end_plain_step};
+use crate::nac::{begin_plain_step, end_plain_step};
 use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics};
 
 /// ξ is clamped to ±(1 − this) where the law is undefined (|ξ| ≥ 1).

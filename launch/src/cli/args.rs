@@ -20,10 +20,9 @@ pub(crate) struct ScenarioArgs {
     /// Run for this many seconds instead of the scenario's duration_s.
     #[arg(long, value_name = "S")]
     pub(crate) duration: Option<f64>,
-    /// Run this law instead of the scenario's (nac, nac-no-shift,
-    /// nac-no-critic, nac-no-networks, blf, pd, pd-gravity, ctc, ppc): T_c,
-    /// K1 and K2 are the scenario's, keys the law does not take are reset.
-    #[arg(long, value_name = "LAW")]
+    /// Run this law instead of the scenario's: T_c, K1 and K2 are the
+    /// scenario's, keys the law does not take are reset.
+    #[arg(long, value_name = "LAW", value_parser = law_parser())]
     pub(crate) law: Option<controller::LawName>,
     /// Print one JSON object instead of a table.
     #[arg(long)]
@@ -145,7 +144,7 @@ pub(crate) struct BenchArgs {
     pub(crate) log_compression: logger::LogCompression,
     /// Run this law instead of the scenarios' (with --controller-cmd: the
     /// law the testbed's controller runs, whose parameters the command gets).
-    #[arg(long, value_name = "LAW")]
+    #[arg(long, value_name = "LAW", value_parser = law_parser())]
     pub(crate) law: Option<controller::LawName>,
     /// Measure only this controller command against the testbed's own
     /// controller: real-time runs of the paper scenario at its rate, in
@@ -198,9 +197,8 @@ pub(crate) struct CompareArgs {
     /// Run for this many seconds instead of the scenario's duration_s.
     #[arg(long, value_name = "S")]
     pub(crate) duration: Option<f64>,
-    /// The laws, comma-separated [default: nac, nac-no-shift, nac-no-critic,
-    /// nac-no-networks, blf, pd, ctc, ppc; pd-gravity on request].
-    #[arg(long, value_name = "LAW,…", value_delimiter = ',')]
+    /// The laws, comma-separated [default: every law but pd-gravity].
+    #[arg(long, value_name = "LAW,…", value_delimiter = ',', value_parser = law_parser())]
     pub(crate) laws: Vec<controller::LawName>,
     /// Seeds per law: the scenario's seed, seed + 1, … (table: median and worst).
     #[arg(long, value_name = "N", default_value_t = 1)]
@@ -217,4 +215,12 @@ pub(crate) struct CompareArgs {
     /// Write the comparison figures (PNG and SVG) here.
     #[arg(long, value_name = "DIR")]
     pub(crate) plots: Option<PathBuf>,
+}
+
+/// `--law` and `--laws`: the names come from the law table, and `--help`
+/// lists them.
+fn law_parser() -> impl clap::builder::TypedValueParser<Value = controller::LawName> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(controller::LawName::ALL.iter().map(|l| l.as_str()))
+        .try_map(|s| s.parse::<controller::LawName>())
 }

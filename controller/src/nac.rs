@@ -1,7 +1,7 @@
 //! One control step of the paper's law (SPEC §4–§10), and of its ablations
 //! and the classic barrier law (BASELINES.md), which switch parts of it off.
 
-use crate::LawName;
+use crate::law_table::LawKind;
 use crate::params::{BarrierMode, ControllerParams, Integrator};
 use crate::rbf::Rbf;
 use crate::shifting::shifting;
@@ -46,41 +46,19 @@ struct Parts {
 
 impl Parts {
     fn of(p: &ControllerParams) -> Result<Self, ControllerError> {
-        let all = Parts {
-            shift: true,
-            networks: true,
-            critic: true,
-            beta: p.beta,
-        };
-        Ok(match p.law {
-            LawName::Nac => all,
-            LawName::NacNoShift => Parts {
-                shift: false,
-                ..all
-            },
-            LawName::NacNoCritic => Parts {
-                critic: false,
-                ..all
-            },
-            LawName::NacNoNetworks => Parts {
-                networks: false,
-                critic: false,
-                ..all
-            },
-            LawName::Blf => Parts {
-                shift: false,
-                networks: false,
-                critic: false,
-                beta: 1.0,
-            },
-            other => {
-                return Err(ControllerError::InvalidParameter {
-                    key: "controller.law".into(),
-                    value: other.to_string(),
-                    need: "the paper's law, an ablation of it, or blf".into(),
-                });
-            }
-        })
+        match p.law.kind() {
+            LawKind::Barrier(b) => Ok(Parts {
+                shift: b.shift,
+                networks: b.networks,
+                critic: b.critic,
+                beta: if b.classic_barrier { 1.0 } else { p.beta },
+            }),
+            LawKind::Feedback(_) | LawKind::Ppc => Err(ControllerError::InvalidParameter {
+                key: "controller.law".into(),
+                value: p.law.to_string(),
+                need: "the paper's law, an ablation of it, or blf".into(),
+            }),
+        }
     }
 }
 
@@ -436,5 +414,5 @@ pub fn barrier_lyapunov(z1g: &[f64], kc: &[f64], beta: f64, mode: BarrierMode) -
 }
 
 #[cfg(test)]
-#[path = "law_tests.rs"]
+#[path = "nac_tests.rs"]
 mod tests;

@@ -4,8 +4,9 @@
 use arm_model::ArmModel;
 
 use crate::feedback::Feedback;
+use crate::law_table::LawKind;
 use crate::ppc::Ppc;
-use crate::{Controller, ControllerError, ControllerInput, ControllerParams, Diagnostics, LawName};
+use crate::{Controller, ControllerError, ControllerInput, ControllerParams, Diagnostics};
 
 /// One of the laws of BASELINES.md, ready to step.
 #[derive(Debug, Clone)]
@@ -30,12 +31,12 @@ impl Law {
         if dof == 0 {
             return Err(ControllerError::NoJoints);
         }
-        Ok(match params.law {
-            l if l.is_nac() || l == LawName::Blf => {
-                Law::Nac(Box::new(Controller::new(params.clone(), dof)?))
+        Ok(match params.law.kind() {
+            LawKind::Barrier(_) => Law::Nac(Box::new(Controller::new(params.clone(), dof)?)),
+            LawKind::Feedback(kind) => {
+                Law::Feedback(Box::new(Feedback::new(params, kind, dof, model)?))
             }
-            LawName::Ppc => Law::Ppc(Ppc::new(params, dof)?),
-            _ => Law::Feedback(Box::new(Feedback::new(params, dof, model)?)),
+            LawKind::Ppc => Law::Ppc(Ppc::new(params, dof)?),
         })
     }
 
