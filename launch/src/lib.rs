@@ -14,7 +14,6 @@
 pub mod bench;
 pub mod bench_controller;
 pub mod bench_peer;
-pub mod bindings;
 pub mod compare;
 pub mod compare_plots;
 pub mod mode;

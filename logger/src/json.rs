@@ -210,7 +210,7 @@ mod tests {
             .split_whitespace()
             .collect::<Vec<_>>()
             .join(" ");
-        for (bit, name) in plant_rapier::Effects::all_names().enumerate() {
+        for (bit, name) in wire::Effects::all_names().enumerate() {
             assert!(
                 about.contains(&format!("{bit} {name}")),
                 "{bit} {name}: {about}"

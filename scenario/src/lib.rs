@@ -20,6 +20,7 @@ mod plan;
 mod posture;
 mod probe;
 mod robot;
+pub mod sweep_file;
 
 use controller::{ControllerError, ControllerParams};
 use plant_rapier::{PlantConfig, PlantError};

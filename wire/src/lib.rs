@@ -24,12 +24,17 @@
 //! ([`write_config`], [`read_config`]), each data message's field list
 //! ([`data_message!`], [`MessageFields`]) from which the log's codec is made,
 //! each type's memory layout ([`all_layouts`]) from which other languages'
-//! bindings are generated, and absolute-deadline sleeping ([`clock`]).
+//! bindings are generated ([`bindings`]), the codes messages carry (the
+//! plant's [`Effects`], the controller's [`Fault`]s), and absolute-deadline
+//! sleeping ([`clock`]).
 
+pub mod bindings;
 pub mod clock;
 mod config;
 mod connections;
 mod domain;
+mod effects;
+mod faults;
 mod fields;
 mod files;
 mod layout;
@@ -42,6 +47,8 @@ mod topics;
 pub use config::{ConfigError, read_config, write_config};
 pub use connections::{CONNECTION_FAILED, connection_failures};
 pub use domain::DomainNodes;
+pub use effects::Effects;
+pub use faults::Fault;
 pub use fields::{FieldRef, FieldSource, MessageFields};
 pub use files::{MAX_TEXT_FILE_BYTES, MAX_URDF_BYTES, read_regular_file, read_text_file};
 pub use iceoryx2::prelude::ZeroCopySend;

@@ -146,7 +146,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Sweep(cmd) => sweep::sweep(cmd),
         Command::Bindings { lang, out } => {
             let BindingsLang::Python = lang;
-            let text = launch::bindings::python();
+            let text = wire::bindings::python();
             match out {
                 Some(path) => std::fs::write(&path, text)
                     .with_context(|| format!("writing {}", path.display()))?,

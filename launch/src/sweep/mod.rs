@@ -8,7 +8,6 @@
 //! resubmitted Slurm array, does only what is missing. [`report`]
 //! aggregates a folder per cell; [`slurm`] writes the job array.
 
-pub mod file;
 pub mod plots;
 pub mod report;
 pub mod results;
@@ -21,12 +20,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use crate::compare;
-use file::{RunSpec, Sweep, cell_json};
 use results::{Manifest, ResultLine, ResultWriter};
+/// The sweep file (parsed and expanded in the scenario crate).
+pub use scenario::sweep_file as file;
+use scenario::sweep_file::{RunSpec, Sweep, cell_json};
 
-/// Files a sweep reads (sweep files, manifests, results) larger than this
-/// are refused rather than read.
-pub const MAX_FILE_BYTES: u64 = 1 << 30;
+pub use scenario::sweep_file::MAX_FILE_BYTES;
 
 /// Why a sweep could not be run or reported.
 #[derive(Debug, thiserror::Error)]
@@ -66,6 +65,17 @@ pub enum SweepError {
     /// A bad option.
     #[error("{0}")]
     Options(String),
+}
+
+impl From<scenario::sweep_file::SweepFileError> for SweepError {
+    fn from(e: scenario::sweep_file::SweepFileError) -> Self {
+        use scenario::sweep_file::SweepFileError as F;
+        match e {
+            F::File { file, reason } => SweepError::File { file, reason },
+            F::Scenario { file, cause } => SweepError::Scenario { file, cause },
+            F::Io { path, cause } => SweepError::Io { path, cause },
+        }
+    }
 }
 
 /// Reads a file of at most [`MAX_FILE_BYTES`], refusing special files.

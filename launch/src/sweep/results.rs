@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::SweepError;
-use super::file::{ManifestRun, Sweep, cell_json};
+use scenario::sweep_file::{ManifestRun, Sweep, cell_json};
 
 /// The manifest of a results folder.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]

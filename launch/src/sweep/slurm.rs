@@ -7,8 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use super::SweepError;
-use super::file::Sweep;
 use super::results::{Manifest, open_folder, read_results};
+use scenario::sweep_file::Sweep;
 
 /// How the job array is laid out.
 #[derive(Debug, Clone)]

@@ -6,13 +6,13 @@
 
 mod actuator;
 mod disturbance;
-mod flags;
 mod sensor;
 
 pub(crate) use actuator::Actuator;
 pub(crate) use disturbance::Disturbance;
-pub use flags::Effects;
 pub(crate) use sensor::Sensor;
+/// The effect bits are part of the wire contract.
+pub use wire::Effects;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -4,14 +4,45 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::{Overrides, Plan, RobotSource, Scenario};
 use controller::LawName;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use scenario::{Overrides, Plan, RobotSource, Scenario};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use super::SweepError;
+/// Files a sweep reads (sweep files, manifests, results) larger than this
+/// are refused rather than read.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// Why a sweep file cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepFileError {
+    /// The sweep file is malformed or names an unknown key.
+    #[error("{file}: {reason}")]
+    File {
+        /// The sweep file.
+        file: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A run's scenario is invalid.
+    #[error("{file}: {cause}")]
+    Scenario {
+        /// The sweep file.
+        file: String,
+        /// The cause.
+        cause: Box<crate::ScenarioError>,
+    },
+    /// Reading it failed.
+    #[error("{path}: {cause}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        cause: std::io::Error,
+    },
+}
 
 /// Sweeps larger than this are refused (the manifest lists every run).
 pub const MAX_RUNS: usize = 1_000_000;
@@ -127,8 +158,8 @@ pub struct Sweep {
 
 impl Axis {
     /// The axis's values; exactly one of values, range and random is given.
-    fn expand(&self, file: &str) -> Result<Vec<toml::Value>, SweepError> {
-        let bad = |reason: String| SweepError::File {
+    fn expand(&self, file: &str) -> Result<Vec<toml::Value>, SweepFileError> {
+        let bad = |reason: String| SweepFileError::File {
             file: file.to_string(),
             reason: format!("axis {}: {reason}", self.key),
         };
@@ -195,10 +226,13 @@ fn set_key(root: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), 
 
 /// Reads and expands the sweep file at `path`: every run's plan is built
 /// (and so validated) here.
-pub fn load(path: &Path) -> Result<Sweep, SweepError> {
+pub fn load(path: &Path) -> Result<Sweep, SweepFileError> {
     let file = path.display().to_string();
-    let text = super::read_limited(path)?;
-    let spec: SweepFile = toml::from_str(&text).map_err(|e| SweepError::File {
+    let text = wire::read_text_file(path, MAX_FILE_BYTES).map_err(|cause| SweepFileError::Io {
+        path: path.display().to_string(),
+        cause,
+    })?;
+    let spec: SweepFile = toml::from_str(&text).map_err(|e| SweepFileError::File {
         file: file.clone(),
         reason: e.to_string().trim_end().to_string(),
     })?;
@@ -221,7 +255,7 @@ pub fn load(path: &Path) -> Result<Sweep, SweepError> {
         spec.laws.clone()
     };
     if spec.seeds == 0 {
-        return Err(SweepError::File {
+        return Err(SweepFileError::File {
             file,
             reason: "seeds = 0: a sweep needs at least one seed".into(),
         });
@@ -232,7 +266,7 @@ pub fn load(path: &Path) -> Result<Sweep, SweepError> {
         .saturating_mul(laws.len())
         .saturating_mul(spec.seeds as usize);
     if total > MAX_RUNS {
-        return Err(SweepError::File {
+        return Err(SweepFileError::File {
             file,
             reason: format!("{total} runs: at most {MAX_RUNS} per sweep"),
         });
@@ -261,7 +295,7 @@ pub fn load(path: &Path) -> Result<Sweep, SweepError> {
     // The name becomes a folder name: letters, digits, '-', '_', '.' only.
     let plain = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.');
     if name.is_empty() || name.starts_with('.') || name.len() > 100 || !name.chars().all(plain) {
-        return Err(SweepError::File {
+        return Err(SweepFileError::File {
             file,
             reason: format!(
                 "name = {name:?}: use up to 100 letters, digits, '-', '_' or '.' (not first)"
@@ -277,20 +311,20 @@ pub fn load(path: &Path) -> Result<Sweep, SweepError> {
     })
 }
 
-fn base_plan(spec: &SweepFile, dir: &Path, file: &str) -> Result<Plan, SweepError> {
+fn base_plan(spec: &SweepFile, dir: &Path, file: &str) -> Result<Plan, SweepFileError> {
     let scenario = spec.scenario.as_ref().map(|s| {
         let p = dir.join(s);
         if p.exists() {
             p
         } else {
-            scenario::find_shipped(s).map_or(p, |sh| sh.path())
+            crate::find_shipped(s).map_or(p, |sh| sh.path())
         }
     });
     let overrides = Overrides {
         robot: spec.robot.as_ref().map(|r| dir.join(r)),
         ..Overrides::default()
     };
-    scenario::load(scenario.as_deref(), &overrides).map_err(|cause| SweepError::Scenario {
+    crate::load(scenario.as_deref(), &overrides).map_err(|cause| SweepFileError::Scenario {
         file: file.to_string(),
         cause: Box::new(cause),
     })
@@ -304,8 +338,8 @@ fn check_key(
     key: &str,
     value: toml::Value,
     file: &str,
-) -> Result<(), SweepError> {
-    let bad = |reason: String| SweepError::File {
+) -> Result<(), SweepFileError> {
+    let bad = |reason: String| SweepFileError::File {
         file: file.to_string(),
         reason: format!("{what} {key}: {reason}"),
     };
@@ -354,11 +388,11 @@ fn resolve(
     s: u64,
     dir: &Path,
     file: &str,
-) -> Result<Plan, SweepError> {
+) -> Result<Plan, SweepFileError> {
     let mut scenario = base.scenario.clone();
     scenario.controller = scenario.controller.for_law(law);
     scenario.seed = base.scenario.seed.wrapping_add(s);
-    let cannot = |e: String| SweepError::File {
+    let cannot = |e: String| SweepFileError::File {
         file: file.to_string(),
         reason: format!("cannot write the base scenario: {e}"),
     };
@@ -367,7 +401,7 @@ fn resolve(
         _ => return Err(cannot("not a table".into())),
     };
     let sets = spec.set.iter().map(|(k, v)| (k.clone(), v.clone()));
-    let what = |key: &str, reason: String| SweepError::File {
+    let what = |key: &str, reason: String| SweepFileError::File {
         file: file.to_string(),
         reason: format!("{key}: {reason}"),
     };
@@ -377,7 +411,7 @@ fn resolve(
     let label = format!("{file} ({law}, seed {})", scenario.seed);
     let toml_text = toml::to_string(&tree).map_err(|e| what("scenario", e.to_string()))?;
     let scenario =
-        Scenario::from_toml_str(&toml_text, &label).map_err(|cause| SweepError::Scenario {
+        Scenario::from_toml_str(&toml_text, &label).map_err(|cause| SweepFileError::Scenario {
             file: file.to_string(),
             cause: Box::new(cause),
         })?;
@@ -387,21 +421,21 @@ fn resolve(
         }
         _ => base.robot.relocked(&scenario.plant.lock),
     }
-    .map_err(|cause| SweepError::Scenario {
+    .map_err(|cause| SweepFileError::Scenario {
         file: file.to_string(),
         cause: Box::new(cause),
     })?;
-    scenario::plan(scenario, label, toml_text, robot).map_err(|cause| SweepError::Scenario {
+    crate::plan(scenario, label, toml_text, robot).map_err(|cause| SweepFileError::Scenario {
         file: file.to_string(),
         cause: Box::new(cause),
     })
 }
 
 /// A run's identity: SHA-256 of its resolved scenario and its URDF.
-fn run_key(plan: &Plan) -> Result<String, SweepError> {
+fn run_key(plan: &Plan) -> Result<String, SweepFileError> {
     let mut s = plan.scenario.clone();
     s.robot = None;
-    let text = toml::to_string(&s).map_err(|e| SweepError::File {
+    let text = toml::to_string(&s).map_err(|e| SweepFileError::File {
         file: plan.source.clone(),
         reason: format!("cannot write the scenario: {e}"),
     })?;

@@ -1,13 +1,13 @@
 //! `testbed bindings python`: the wire contract as a Python module of
 //! ctypes structures and constants, generated from the Rust definitions
-//! ([`wire::all_layouts`], the topics, the protocol codes), so that a
+//! ([`crate::all_layouts`], the topics, the protocol codes), so that a
 //! controller written in Python speaks exactly what the Rust nodes speak.
 //! The generated file is committed (`python/testbed_controller/wire.py`);
 //! a test fails when it no longer equals what this module writes.
 
 use std::fmt::Write;
 
-use wire::{FieldType, MAX_DOF, NodeKind, RunEnd, Topic, TypeLayout};
+use crate::{Fault, FieldType, MAX_DOF, NodeKind, RunEnd, Topic, TypeLayout};
 
 /// Where the Python package keeps the generated module, from the repository root.
 pub const PYTHON_WIRE_PATH: &str = "python/testbed_controller/wire.py";
@@ -17,7 +17,7 @@ pub fn python() -> String {
     let mut out = String::new();
     header(&mut out);
     constants(&mut out);
-    for t in wire::all_layouts() {
+    for t in crate::all_layouts() {
         structure(&mut out, &t);
     }
     topics(&mut out);
@@ -48,64 +48,64 @@ fn constants(out: &mut String) {
     c("MAX_DOF", MAX_DOF.to_string(), "joints a message carries");
     c(
         "SUBSCRIBER_BUFFER",
-        wire::SUBSCRIBER_BUFFER.to_string(),
+        crate::SUBSCRIBER_BUFFER.to_string(),
         "samples a subscriber holds",
     );
     c(
         "MAX_SUBSCRIBERS",
-        wire::MAX_SUBSCRIBERS.to_string(),
+        crate::MAX_SUBSCRIBERS.to_string(),
         "subscribers (and listeners) per topic",
     );
     c(
         "MAX_NODES",
-        wire::MAX_NODES.to_string(),
+        crate::MAX_NODES.to_string(),
         "nodes per service",
     );
     c(
         "LOSSLESS_TIMEOUT_S",
-        wire::LOSSLESS_TIMEOUT.as_secs().to_string(),
+        crate::LOSSLESS_TIMEOUT.as_secs().to_string(),
         "a lockstep publisher gives up on a full reader after this",
     );
     c(
         "HEARTBEAT_NS",
-        wire::HEARTBEAT.as_nanos().to_string(),
+        crate::HEARTBEAT.as_nanos().to_string(),
         "a node repeats its status at least this often while it runs",
     );
     c(
         "SILENT_AFTER_S",
-        wire::SILENT_AFTER.as_secs().to_string(),
+        crate::SILENT_AFTER.as_secs().to_string(),
         "the launcher names a node not heard from for this long",
     );
     c(
         "RUN_PREFIX_STEM",
-        format!("{:?}", wire::RunPrefix::STEM),
+        format!("{:?}", crate::RunPrefix::STEM),
         "every run's shared-memory prefix starts so",
     );
     c(
         "STATE_FINAL",
-        wire::STATE_FINAL.to_string(),
+        crate::STATE_FINAL.to_string(),
         "JointState.flags: the last state, no command expected",
     );
     c(
         "NONE_U64",
-        wire::NONE_U64.to_string(),
+        crate::NONE_U64.to_string(),
         "JointState.command_seq, Command.reference_t_ns: none",
     );
     c(
         "CONTROL_START",
-        wire::CONTROL_START.to_string(),
+        crate::CONTROL_START.to_string(),
         "Control.command",
     );
     c(
         "CONTROL_STOP",
-        wire::CONTROL_STOP.to_string(),
+        crate::CONTROL_STOP.to_string(),
         "Control.command",
     );
     for (name, v) in [
-        ("NODE_READY", wire::NODE_READY),
-        ("NODE_RUNNING", wire::NODE_RUNNING),
-        ("NODE_DONE", wire::NODE_DONE),
-        ("NODE_FAILED", wire::NODE_FAILED),
+        ("NODE_READY", crate::NODE_READY),
+        ("NODE_RUNNING", crate::NODE_RUNNING),
+        ("NODE_DONE", crate::NODE_DONE),
+        ("NODE_FAILED", crate::NODE_FAILED),
     ] {
         c(name, v.to_string(), "NodeStatus.state");
     }
@@ -113,7 +113,7 @@ fn constants(out: &mut String) {
         let name = format!("NODE_KIND_{}", k.name().to_uppercase());
         c(&name, (k as u32).to_string(), "NodeStatus.node");
     }
-    for m in [wire::Mode::Realtime, wire::Mode::Lockstep] {
+    for m in [crate::Mode::Realtime, crate::Mode::Lockstep] {
         let name = format!("MODE_{}", m.as_str().to_uppercase());
         c(&name, m.code().to_string(), "Control.code with START");
     }
@@ -130,7 +130,7 @@ fn constants(out: &mut String) {
         lost.to_string(),
         "Control.code with STOP: this + the lost node's kind",
     );
-    for f in controller::Fault::ALL {
+    for f in Fault::ALL {
         let name = format!("FAULT_{}", f.constant_name());
         c(&name, f.code().to_string(), "Command.fault (0: none)");
     }
@@ -206,7 +206,7 @@ fn topics(out: &mut String) {
         );
     }
     let _ = writeln!(out, "}}\n");
-    let names: Vec<String> = wire::all_layouts()
+    let names: Vec<String> = crate::all_layouts()
         .iter()
         .map(|t| format!("{:?}", t.name))
         .collect();
@@ -269,7 +269,7 @@ mod tests {
     #[test]
     fn every_message_and_topic_is_generated() {
         let py = python();
-        for t in wire::all_layouts() {
+        for t in crate::all_layouts() {
             assert!(py.contains(&format!("class {}(ctypes.Structure)", t.name)));
         }
         assert!(py.contains("return \"testbed.JointState.v3\""));
