@@ -231,3 +231,23 @@ fn euler_integrator_shows_the_instability_of_spec_9() {
     assert_eq!(s["finite"], false, "{s}");
     assert!(s["fault_steps"].as_u64().unwrap() > 0, "{s}");
 }
+
+/// The numbers the docs quote from deterministic runs are what the code
+/// gives today: `docs/regenerate.py --check` regenerates them with this
+/// build and compares (#28: regenerated, not copied by hand).
+#[test]
+fn the_docs_generated_numbers_are_current() {
+    let out = std::process::Command::new("python3")
+        .arg("docs/regenerate.py")
+        .arg("--check")
+        .env("TESTBED", env!("CARGO_BIN_EXE_testbed"))
+        .current_dir(crate::util::repo_root())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
