@@ -9,7 +9,7 @@
 //! ```
 //!
 //! It reads the controller's config (joints, period), follows the node
-//! protocol (`wire::NodeLink`), and for every joint state publishes a
+//! protocol (`bus::NodeLink`), and for every joint state publishes a
 //! command τ = −Kp (q − q_d) − Kd (q̇ − q̇_d) and the diagnostics the log
 //! and the summary are made from. Other arguments the launcher adds (CPU
 //! placement) are ignored.
@@ -17,11 +17,9 @@
 use std::process::ExitCode;
 use std::time::Duration;
 
+use bus::{NodeLink, ReferenceWindow, RunPrefix, monotonic_ns, read_config};
 use controller::node::ControllerNodeConfig;
-use wire::{
-    Command, ControllerDiagnostics, JointState, Mode, NodeKind, NodeLink, ReferenceWindow,
-    RunPrefix, STATE_FINAL, Topic, monotonic_ns, read_config,
-};
+use wire::{Command, ControllerDiagnostics, JointState, Mode, NodeKind, STATE_FINAL, Topic};
 
 const KP: f64 = 400.0;
 const KD: f64 = 40.0;

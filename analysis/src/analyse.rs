@@ -192,11 +192,9 @@ fn plan_from(contents: &LogContents) -> Result<(Plan, Mode), AnalysisError> {
         .map_err(|e| meta_err(path, e.to_string()))?,
         None => return Err(meta_err(path, "the log has no robot.urdf attachment")),
     };
-    let mode = match get("mode")?.as_str() {
-        "lockstep" => Mode::Lockstep,
-        "realtime" => Mode::Realtime,
-        other => return Err(meta_err(path, format!("unknown mode '{other}'"))),
-    };
+    let mode: Mode = get("mode")?
+        .parse()
+        .map_err(|e: String| meta_err(path, format!("testbed.run mode: {e}")))?;
     let plan = scenario::plan(scenario, label, toml.clone(), robot)
         .map_err(|e| meta_err(path, e.to_string()))?;
     Ok((plan, mode))
@@ -219,7 +217,7 @@ struct Analyser<'a, 'o> {
 impl Analyser<'_, '_> {
     fn on_message(&mut self, topic: &str, v: &[u8]) -> Result<(), MessageError> {
         match topic {
-            t if t == JointState::TOPIC => {
+            t if t == JointState::LOG_TOPIC => {
                 let s = JointState::parse(v)?;
                 check_dof(s.dof, self.n)?;
                 self.wall = (
@@ -232,7 +230,7 @@ impl Analyser<'_, '_> {
                 self.data_path.add_state(&s);
                 self.assembler.push_state(s);
             }
-            t if t == ControllerDiagnostics::TOPIC => {
+            t if t == ControllerDiagnostics::LOG_TOPIC => {
                 let d = ControllerDiagnostics::parse(v)?;
                 check_dof(d.dof, self.n)?;
                 if let Some(ver) = self.verifier.as_mut() {
@@ -240,15 +238,15 @@ impl Analyser<'_, '_> {
                 }
                 self.assembler.push_diag(d);
             }
-            t if t == Command::TOPIC => {
+            t if t == Command::LOG_TOPIC => {
                 let c = Command::parse(v)?;
                 self.data_path.add_command(&c);
                 if let Some(ver) = self.verifier.as_mut() {
                     ver.push_command(c);
                 }
             }
-            t if t == Timing::TOPIC => self.on_timing(&Timing::parse(v)?),
-            t if t == ReferenceSample::TOPIC => {
+            t if t == Timing::LOG_TOPIC => self.on_timing(&Timing::parse(v)?),
+            t if t == ReferenceSample::LOG_TOPIC => {
                 ReferenceSample::parse(v)?;
             }
             // The arm's frames and figure: not analysed, but a log whose

@@ -5,11 +5,9 @@
 
 use std::time::{Duration, Instant};
 
+use bus::{NodeError, NodeLink, ReferenceWindow, monotonic_ns};
 use serde::{Deserialize, Serialize};
-use wire::{
-    Command, ControllerDiagnostics, JointState, Mode, NodeError, NodeLink, ReferenceWindow,
-    STATE_FINAL, Topic, monotonic_ns,
-};
+use wire::{Command, ControllerDiagnostics, JointState, Mode, STATE_FINAL, Topic};
 
 use arm_model::{ArmModel, Locks};
 
@@ -83,8 +81,8 @@ pub enum ControllerNodeError {
     Controller(#[from] ControllerError),
 }
 
-impl From<wire::WireError> for ControllerNodeError {
-    fn from(e: wire::WireError) -> Self {
+impl From<bus::WireError> for ControllerNodeError {
+    fn from(e: bus::WireError) -> Self {
         Self::Node(e.into())
     }
 }

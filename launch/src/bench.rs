@@ -21,8 +21,8 @@ use crate::node::placement::{self, Placement};
 use crate::run::{self, RunError, RunOptions};
 use crate::sim::{self, StepCosts};
 use analysis::timing::{Percentiles, TimingStats};
+use bus::clock;
 use wire::NodeKind;
-use wire::clock;
 
 /// What to measure.
 #[derive(Debug, Clone)]

@@ -25,8 +25,8 @@ impl ChannelSpec {
     /// The channel of a wire message.
     pub fn of<M: LogMessage>() -> Self {
         Self {
-            topic: M::TOPIC,
-            schema_name: M::SCHEMA,
+            topic: M::LOG_TOPIC,
+            schema_name: M::LOG_SCHEMA,
             schema: M::schema(),
         }
     }

@@ -8,7 +8,7 @@
 
 use serde_json::{Map, Value, json};
 use wire::{
-    Command, ControllerDiagnostics, FieldRef, FieldSource, Header, JointState, MessageFields,
+    Bound, Command, ControllerDiagnostics, FieldRef, FieldSource, Header, JointState,
     ReferenceSample, Timing,
 };
 
@@ -18,11 +18,14 @@ use wire::{
 pub struct DecodeError(pub String);
 
 /// A message type as it appears in the log.
-pub trait LogMessage: MessageFields {
-    /// MCAP topic.
-    const TOPIC: &'static str;
-    /// Schema name.
-    const SCHEMA: &'static str;
+pub trait LogMessage: Bound {
+    /// MCAP topic: the message's log channel in the wire's binding table.
+    const LOG_TOPIC: &'static str = match <Self as Bound>::CHANNEL {
+        Some(c) => c,
+        None => "",
+    };
+    /// Schema name, from the same table.
+    const LOG_SCHEMA: &'static str = <Self as Bound>::SCHEMA;
     /// One-line description for the schema.
     const ABOUT: &'static str;
 
@@ -125,7 +128,7 @@ pub trait LogMessage: MessageFields {
         let required: Vec<Value> = props.keys().map(|k| Value::String(k.clone())).collect();
         json!({
             "$schema": "https://json-schema.org/draft/2020-12/schema",
-            "title": Self::SCHEMA,
+            "title": Self::LOG_SCHEMA,
             "description": Self::ABOUT,
             "type": "object",
             "properties": props,
@@ -167,8 +170,6 @@ fn number(x: f64) -> Value {
 }
 
 impl LogMessage for JointState {
-    const TOPIC: &'static str = "/joint_state";
-    const SCHEMA: &'static str = "testbed.JointState";
     const ABOUT: &'static str = "The plant's state at step seq (t = seq x period): q, qd true; \
         q_measured, qd_measured as the sensors report them; effects: bits 0 friction, \
         1 payload, 2 disturbance, 3 saturated, 4 sensor_noise, 5 quantised, 6 delayed, \
@@ -176,26 +177,18 @@ impl LogMessage for JointState {
 }
 
 impl LogMessage for ReferenceSample {
-    const TOPIC: &'static str = "/reference";
-    const SCHEMA: &'static str = "testbed.Reference";
     const ABOUT: &'static str = "The reference q_d and the constraint envelope k_c at time t.";
 }
 
 impl LogMessage for Command {
-    const TOPIC: &'static str = "/command";
-    const SCHEMA: &'static str = "testbed.Command";
     const ABOUT: &'static str = "The controller's torque for the state with the same seq.";
 }
 
 impl LogMessage for ControllerDiagnostics {
-    const TOPIC: &'static str = "/controller/diagnostics";
-    const SCHEMA: &'static str = "testbed.ControllerDiagnostics";
     const ABOUT: &'static str = "Everything the controller computed at step seq (SPEC section 12).";
 }
 
 impl LogMessage for Timing {
-    const TOPIC: &'static str = "/timing";
-    const SCHEMA: &'static str = "testbed.Timing";
     const ABOUT: &'static str = "Timing of the plant cycle that consumed the command for step seq.";
 }
 

@@ -8,11 +8,9 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Duration;
 
+use bus::{NodeError, NodeLink, TopicSubscriber};
 use serde::{Deserialize, Serialize};
-use wire::{
-    Command, ControllerDiagnostics, JointState, NodeError, NodeLink, ReferenceSample, Timing,
-    Topic, TopicSubscriber,
-};
+use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
 
 use crate::live::{LiveConfig, LiveError};
 use crate::outputs::Outputs;
@@ -56,8 +54,8 @@ pub enum LoggerNodeError {
     Live(#[from] LiveError),
 }
 
-impl From<wire::WireError> for LoggerNodeError {
-    fn from(e: wire::WireError) -> Self {
+impl From<bus::WireError> for LoggerNodeError {
+    fn from(e: bus::WireError) -> Self {
         Self::Node(e.into())
     }
 }
@@ -86,9 +84,10 @@ struct Sub<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> {
 }
 
 impl<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> Sub<M> {
-    fn new(link: &NodeLink, topic: Topic) -> Result<Self, LoggerNodeError> {
+    /// Subscribes to the message's topic (the wire's binding table).
+    fn new(link: &NodeLink) -> Result<Self, LoggerNodeError> {
         Ok(Self {
-            sub: link.bus.polling_subscriber(topic)?,
+            sub: link.bus.polling_subscriber(<M as wire::Bound>::TOPIC)?,
             count: TopicCount::default(),
         })
     }
@@ -106,7 +105,7 @@ impl<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> Sub<M> {
     }
 
     fn stats(&self, out: &mut BTreeMap<String, String>) {
-        let name = M::TOPIC.trim_start_matches('/');
+        let name = M::LOG_TOPIC.trim_start_matches('/');
         out.insert(format!("{name}.received"), self.count.received.to_string());
         out.insert(format!("{name}.dropped"), self.count.dropped.to_string());
     }
@@ -161,11 +160,11 @@ fn run_end(link: &NodeLink, result: &Result<(), LoggerNodeError>) -> String {
 /// Runs the logger node to the end of the run.
 pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerNodeError> {
     let mut subs = Subs {
-        state: Sub::new(link, Topic::JointState)?,
-        reference: Sub::new(link, Topic::Reference)?,
-        command: Sub::new(link, Topic::Command)?,
-        diag: Sub::new(link, Topic::Diagnostics)?,
-        timing: Sub::new(link, Topic::Timing)?,
+        state: Sub::new(link)?,
+        reference: Sub::new(link)?,
+        command: Sub::new(link)?,
+        diag: Sub::new(link)?,
+        timing: Sub::new(link)?,
     };
     let model = arm_model::ArmModel::from_urdf_str_locked(&config.urdf, &config.lock)?;
     // The live view first: a taken port fails the run before anything is

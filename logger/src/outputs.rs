@@ -57,7 +57,7 @@ impl Outputs {
     pub(crate) fn take<M: LogMessage>(&mut self, msg: &M) -> Result<(), LogError> {
         let json = self.log.write(msg)?;
         if let Some(live) = self.live.as_mut() {
-            live.offer(M::TOPIC, msg.header().t_ns, json);
+            live.offer(M::LOG_TOPIC, msg.header().t_ns, json);
         }
         Ok(())
     }

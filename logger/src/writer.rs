@@ -73,36 +73,30 @@ pub struct RunMetadata {
 pub const LOG_FORMAT: u32 = 2;
 
 impl RunMetadata {
-    fn to_map(&self) -> BTreeMap<String, String> {
-        BTreeMap::from([
-            ("log_format".into(), LOG_FORMAT.to_string()),
-            ("run_id".into(), self.run_id.clone()),
-            ("mode".into(), self.mode.clone()),
-            ("rate_hz".into(), format!("{:?}", self.rate_hz)),
-            ("scenario_toml".into(), self.scenario_toml.clone()),
-            ("scenario_source".into(), self.scenario_source.clone()),
-            ("robot".into(), self.robot.clone()),
-            ("joint_names".into(), self.joint_names.join(",")),
-            ("seed".into(), self.seed.to_string()),
-            ("plant_effects".into(), self.plant_effects.join(",")),
-            ("k1".into(), self.k1.clone()),
-            ("k2".into(), self.k2.clone()),
-            ("locked_joints".into(), self.locked_joints.clone()),
-            ("mimic_joints".into(), self.mimic_joints.clone()),
-            ("urdf_dynamics".into(), self.urdf_dynamics.to_string()),
-            ("law".into(), self.law.clone()),
-            ("model_based".into(), self.model_based.to_string()),
-            ("law_parameters".into(), self.law_parameters.clone()),
-            ("controller_cmd".into(), self.controller_cmd.clone()),
-            (
-                "start_time_unix_ns".into(),
-                self.start_time_unix_ns.to_string(),
-            ),
-            (
-                "software".into(),
-                format!("testbed {}", env!("CARGO_PKG_VERSION")),
-            ),
-        ])
+    /// The `testbed.run` record: every field as text (lists joined by
+    /// commas), from the struct's own serde form, plus the log format and
+    /// the software that wrote it.
+    fn to_map(&self) -> Result<BTreeMap<String, String>, serde_json::Error> {
+        let serde_json::Value::Object(fields) = serde_json::to_value(self)? else {
+            unreachable!("a struct serialises to an object");
+        };
+        let text = |v: serde_json::Value| match v {
+            serde_json::Value::String(s) => s,
+            serde_json::Value::Array(items) => items
+                .into_iter()
+                .map(|i| i.as_str().map_or_else(|| i.to_string(), String::from))
+                .collect::<Vec<_>>()
+                .join(","),
+            other => other.to_string(),
+        };
+        let mut map: BTreeMap<String, String> =
+            fields.into_iter().map(|(k, v)| (k, text(v))).collect();
+        map.insert("log_format".into(), LOG_FORMAT.to_string());
+        map.insert(
+            "software".into(),
+            format!("testbed {}", env!("CARGO_PKG_VERSION")),
+        );
+        Ok(map)
     }
 }
 
@@ -151,7 +145,11 @@ impl LogWriter {
         writer
             .write_metadata(&mcap::records::Metadata {
                 name: RUN_METADATA.into(),
-                metadata: meta.to_map(),
+                metadata: meta.to_map().map_err(|cause| LogError::Encode {
+                    path: path.display().to_string(),
+                    topic: RUN_METADATA,
+                    cause,
+                })?,
             })
             .map_err(mcap_err)?;
         writer
@@ -183,7 +181,7 @@ impl LogWriter {
 
     /// Registers the channel of `M` (done on first write otherwise).
     pub fn add_channel<M: LogMessage>(&mut self) -> Result<u16, LogError> {
-        match self.channels.get(M::TOPIC) {
+        match self.channels.get(M::LOG_TOPIC) {
             Some((id, _)) => Ok(*id),
             None => self.add_channel_spec(&ChannelSpec::of::<M>()),
         }
@@ -218,7 +216,7 @@ impl LogWriter {
         let mut data = std::mem::take(&mut self.scratch);
         data.clear();
         msg.encode(&mut data);
-        let res = self.write_json(M::TOPIC, h.t_ns, h.wall_ns, &data);
+        let res = self.write_json(M::LOG_TOPIC, h.t_ns, h.wall_ns, &data);
         self.scratch = data;
         res.map(|()| self.scratch.as_slice())
     }

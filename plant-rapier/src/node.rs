@@ -5,12 +5,10 @@
 
 use std::time::Duration;
 
+use bus::clock;
+use bus::{NodeError, NodeLink, TopicPublisher, TopicSubscriber, monotonic_ns};
 use serde::{Deserialize, Serialize};
-use wire::clock;
-use wire::{
-    Command, JointState, Mode, NODE_RUNNING, NodeError, NodeLink, Timing, Topic, TopicPublisher,
-    TopicSubscriber, monotonic_ns,
-};
+use wire::{Command, JointState, Mode, NODE_RUNNING, Timing, Topic};
 
 use crate::{ArmModel, PlantConfig, PlantError, PlantMachine};
 
@@ -70,8 +68,8 @@ pub enum PlantNodeError {
     },
 }
 
-impl From<wire::WireError> for PlantNodeError {
-    fn from(e: wire::WireError) -> Self {
+impl From<bus::WireError> for PlantNodeError {
+    fn from(e: bus::WireError) -> Self {
         Self::Node(e.into())
     }
 }
@@ -132,8 +130,8 @@ impl From<NodeError> for LoopError {
     }
 }
 
-impl From<wire::WireError> for LoopError {
-    fn from(e: wire::WireError) -> Self {
+impl From<bus::WireError> for LoopError {
+    fn from(e: bus::WireError) -> Self {
         LoopError::Node(e.into())
     }
 }

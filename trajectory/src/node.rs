@@ -10,9 +10,10 @@
 
 use std::time::Duration;
 
+use bus::clock;
+use bus::{NodeError, NodeLink, monotonic_ns};
 use serde::{Deserialize, Serialize};
-use wire::clock;
-use wire::{JointState, Mode, NodeError, NodeLink, ReferenceSample, Topic, monotonic_ns};
+use wire::{JointState, Mode, ReferenceSample, Topic};
 
 use crate::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError, TrajectoryMachine};
 
@@ -66,8 +67,8 @@ pub enum TrajectoryNodeError {
     Trajectory(#[from] TrajectoryError),
 }
 
-impl From<wire::WireError> for TrajectoryNodeError {
-    fn from(e: wire::WireError) -> Self {
+impl From<bus::WireError> for TrajectoryNodeError {
+    fn from(e: bus::WireError) -> Self {
         Self::Node(e.into())
     }
 }

@@ -78,7 +78,7 @@ fn constants(out: &mut String) {
     );
     c(
         "RUN_PREFIX_STEM",
-        format!("{:?}", crate::RunPrefix::STEM),
+        format!("{:?}", crate::RUN_PREFIX_STEM),
         "every run's shared-memory prefix starts so",
     );
     c(
@@ -199,7 +199,7 @@ fn topics(out: &mut String) {
             "    {:?}: ({:?}, {}, {}, {}, {}),",
             t.name().trim_start_matches("testbed/"),
             t.name(),
-            message_of(t),
+            crate::struct_of(t),
             t.max_publishers(),
             t.max_notifiers(),
             if t.has_waiters() { "True" } else { "False" },
@@ -232,18 +232,6 @@ def _check_layouts() -> None:
 
 _check_layouts()
 "#;
-
-fn message_of(t: Topic) -> &'static str {
-    match t {
-        Topic::JointState => "JointState",
-        Topic::Reference => "ReferenceSample",
-        Topic::Command => "Command",
-        Topic::Diagnostics => "ControllerDiagnostics",
-        Topic::Timing => "Timing",
-        Topic::Control => "Control",
-        Topic::Status => "NodeStatus",
-    }
-}
 
 #[cfg(test)]
 mod tests {

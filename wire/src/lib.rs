@@ -15,38 +15,30 @@
 //! carry a version (iceoryx2 only compares name, size and alignment, so a
 //! changed layout must change the name).
 //!
-//! Services live under a per-run prefix ([`RunPrefix`]), so two runs, or two
-//! tests, never see each other.
-//!
-//! Besides the messages and topics: the node protocol every process follows
-//! ([`NodeLink`]: READY, START, DONE, STOP), the typed config file through
-//! which the launcher hands each node its part of the plan
-//! ([`write_config`], [`read_config`]), each data message's field list
+//! Besides the messages and topics: the node protocol's constants
+//! ([`Mode`], [`HEARTBEAT`], [`SILENT_AFTER`]), the reference rule
+//! ([`is_stale`]), each data message's field list
 //! ([`data_message!`], [`MessageFields`]) from which the log's codec is made,
 //! each type's memory layout ([`all_layouts`]) from which other languages'
 //! bindings are generated ([`bindings`]), the codes messages carry (the
-//! plant's [`Effects`], the controller's [`Fault`]s), and absolute-deadline
-//! sleeping ([`clock`]).
+//! plant's [`Effects`], the controller's [`Fault`]s). This crate is the
+//! contract only: it opens no port and starts no thread. The runtime that
+//! puts these messages on iceoryx2 shared memory (ports, the node protocol,
+//! run prefixes, clocks) is the `bus` crate.
 
+mod binding;
 pub mod bindings;
-pub mod clock;
-mod config;
-mod connections;
-mod domain;
 mod effects;
 mod faults;
 mod fields;
 mod files;
 mod layout;
-mod leftovers;
 mod messages;
-mod node;
-mod reference;
-mod topics;
+mod protocol;
+mod reference_rule;
+mod topic;
 
-pub use config::{ConfigError, read_config, write_config};
-pub use connections::{CONNECTION_FAILED, connection_failures};
-pub use domain::DomainNodes;
+pub use binding::{Bound, struct_of};
 pub use effects::Effects;
 pub use faults::Fault;
 pub use fields::{FieldRef, FieldSource, MessageFields};
@@ -56,21 +48,9 @@ pub use layout::{
     FieldLayout, FieldType, TypeLayout, WireField, WireLayout, all_layouts, field_size,
 };
 pub use messages::*;
-pub use node::{HEARTBEAT, Mode, NodeError, NodeLink, SILENT_AFTER, ns_to_s};
-pub use reference::{ReferenceWindow, is_stale};
-pub use topics::{
-    Bus, Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RunPrefix, SUBSCRIBER_BUFFER,
-    Topic, TopicPublisher, TopicSubscriber, WireError, monotonic_ns,
+pub use protocol::{HEARTBEAT, Mode, SILENT_AFTER, ns_to_s};
+pub use reference_rule::is_stale;
+pub use topic::{
+    Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RUN_PREFIX_STEM, SUBSCRIBER_BUFFER,
+    Topic,
 };
-
-/// iceoryx2's own messages on stderr: only its errors unless `verbose`
-/// (then its information too). `IOX2_LOG_LEVEL` in the environment still
-/// decides when set.
-pub fn set_ipc_log_level(verbose: bool) {
-    use iceoryx2::prelude::{LogLevel, set_log_level, set_log_level_from_env_or};
-    if verbose {
-        set_log_level(LogLevel::Info);
-    } else {
-        set_log_level_from_env_or(LogLevel::Error);
-    }
-}

@@ -136,7 +136,7 @@ pub(crate) const EXIT_INVALID: u8 = 4;
 /// Parses the command line and runs it.
 pub fn run() -> Result<ExitCode> {
     let cli = Cli::parse();
-    wire::set_ipc_log_level(cli.verbose);
+    bus::set_ipc_log_level(cli.verbose);
     match cli.command {
         Command::Sim(args) => sim::sim(args),
         Command::Run(args) => run::run_stack(args, cli.verbose),

@@ -1,9 +1,10 @@
 //! The launcher's validated plan, cut into what each node needs: the one
 //! typed path from `testbed run` to its processes (written as JSON by
-//! [`wire::write_config`], read back by the node with the same type).
+//! [`bus::write_config`], read back by the node with the same type).
 
 use std::path::{Path, PathBuf};
 
+use bus::{ConfigError, write_config};
 use controller::node::ControllerNodeConfig;
 use logger::live::LiveConfig;
 use logger::node::LoggerNodeConfig;
@@ -11,7 +12,7 @@ use logger::{LogCompression, RunMetadata};
 use plant_rapier::node::PlantNodeConfig;
 use scenario::Plan;
 use trajectory::node::TrajectoryNodeConfig;
-use wire::{ConfigError, NodeKind, write_config};
+use wire::NodeKind;
 
 use crate::mode::Mode;
 

@@ -9,7 +9,8 @@ pub mod placement;
 
 use std::path::PathBuf;
 
-use wire::{NodeError, NodeKind, NodeLink, RunPrefix, read_config};
+use bus::{NodeError, NodeLink, RunPrefix, read_config};
+use wire::NodeKind;
 
 use crate::mode::Mode;
 
@@ -39,10 +40,10 @@ pub struct NodeArgs {
 pub enum NodeRunError {
     /// The config file is missing or is not this node's.
     #[error(transparent)]
-    Config(#[from] wire::ConfigError),
+    Config(#[from] bus::ConfigError),
     /// The bus could not be joined.
     #[error(transparent)]
-    Wire(#[from] wire::WireError),
+    Wire(#[from] bus::WireError),
     /// The plant node failed.
     #[error(transparent)]
     Plant(#[from] plant_rapier::node::PlantNodeError),

@@ -1,6 +1,7 @@
 //! Why a run failed, and how the log records each failure.
 
-use wire::{MAX_DOF, NodeKind, RunEnd, WireError};
+use bus::WireError;
+use wire::{MAX_DOF, NodeKind, RunEnd};
 
 use analysis::analyse::AnalysisError;
 

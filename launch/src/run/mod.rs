@@ -14,12 +14,13 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use bus::{Bus, RunPrefix, WireError, monotonic_ns};
 use logger::LogCompression;
 use logger::live::LiveConfig;
 use scenario::Plan;
 use wire::{
-    Bus, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, MAX_DOF, NodeKind, NodeStatus,
-    RunEnd, RunPrefix, Topic, WireError, monotonic_ns,
+    CONTROL_START, CONTROL_STOP, Control, Delivery, Header, MAX_DOF, NodeKind, NodeStatus, RunEnd,
+    Topic,
 };
 
 use crate::mode::Mode;
@@ -330,8 +331,8 @@ fn control_msg(command: u32, epoch_wall_ns: u64) -> Control {
 fn supervise(
     opts: &RunOptions,
     bus: &Bus,
-    status: &wire::TopicSubscriber<NodeStatus>,
-    control: &wire::TopicPublisher<Control>,
+    status: &bus::TopicSubscriber<NodeStatus>,
+    control: &bus::TopicPublisher<Control>,
     children: &mut Children,
 ) -> Result<f64, RunError> {
     let plan = &opts.plan;
@@ -403,7 +404,7 @@ fn supervise(
 fn wait_for_ready(
     opts: &RunOptions,
     bus: &Bus,
-    status: &wire::TopicSubscriber<NodeStatus>,
+    status: &bus::TopicSubscriber<NodeStatus>,
     children: &mut Children,
 ) -> Result<NodeStates, RunError> {
     let mut nodes = NodeStates::default();

@@ -23,7 +23,7 @@ pub(super) struct NodeStates {
 impl NodeStates {
     pub(super) fn read(
         &mut self,
-        status: &wire::TopicSubscriber<NodeStatus>,
+        status: &bus::TopicSubscriber<NodeStatus>,
     ) -> Result<(), RunError> {
         while let Some(s) = status.receive()? {
             let Some(kind) = NodeKind::from_u32(s.node) else {

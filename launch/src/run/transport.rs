@@ -2,7 +2,7 @@
 //! now and then leaves a pair of ports unconnected when a run starts,
 //! mostly without a word (the logger and one of the controller's topics,
 //! about once in 300 lockstep runs under load). A node then fails saying
-//! [`wire::CONNECTION_FAILED`], or a lockstep log lacks steps; the run is
+//! [`bus::CONNECTION_FAILED`], or a lockstep log lacks steps; the run is
 //! started again, from scratch, in a new domain. Lockstep runs are
 //! deterministic, so a run started again gives the same bits.
 
@@ -42,7 +42,7 @@ pub(super) fn with_retries(
 fn is_transport_failure(e: &RunError) -> bool {
     match e {
         RunError::LogIncomplete { .. } => true,
-        RunError::NodeFailed { stderr, .. } => stderr.contains(wire::CONNECTION_FAILED),
+        RunError::NodeFailed { stderr, .. } => stderr.contains(bus::CONNECTION_FAILED),
         _ => false,
     }
 }
@@ -100,7 +100,7 @@ mod tests {
         };
         assert!(is_transport_failure(&failed(&format!(
             "testbed: {} publisher 5 and subscriber 6 of testbed/joint_state",
-            wire::CONNECTION_FAILED
+            bus::CONNECTION_FAILED
         ))));
         assert!(!is_transport_failure(&failed("plant: NaN in the state")));
         assert!(!is_transport_failure(&RunError::Interrupted));

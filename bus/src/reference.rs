@@ -8,12 +8,13 @@
 //! A sample older than the one due at the state's time (the newest on the
 //! reference grid at or before it) is a *stale reference*; none at all is
 //! one too. The window counts them; the count travels in each
-//! [`crate::Command`] and the log recounts it from the samples' times.
+//! [`wire::Command`] and the log recounts it from the samples' times.
 
 use std::collections::VecDeque;
 use std::time::Duration;
 
-use crate::{Mode, NodeError, NodeLink, ReferenceSample, Topic, TopicSubscriber};
+use crate::{NodeError, NodeLink, TopicSubscriber};
+use wire::{Mode, ReferenceSample, Topic, is_stale};
 
 /// The reference topic and the samples received but not yet passed.
 pub struct ReferenceWindow {
@@ -66,13 +67,6 @@ impl ReferenceWindow {
     }
 }
 
-/// Whether `used` is older than the sample due at `t_ns` on a grid of
-/// `period_ns` (or missing).
-pub fn is_stale(used: Option<&ReferenceSample>, t_ns: u64, period_ns: u64) -> bool {
-    let due = t_ns / period_ns.max(1) * period_ns.max(1);
-    used.is_none_or(|r| r.header.t_ns < due)
-}
-
 /// Keeps `recent` in time order: samples from one publisher come in order,
 /// so this is a push at the back; a late one is put in its place.
 fn arrive(recent: &mut VecDeque<ReferenceSample>, r: ReferenceSample) {
@@ -102,13 +96,13 @@ mod tests {
 
     fn sample(t_ns: u64) -> ReferenceSample {
         ReferenceSample {
-            header: crate::Header {
+            header: wire::Header {
                 seq: t_ns,
                 t_ns,
                 wall_ns: 0,
             },
             dof: 1,
-            kc: [1.0; crate::MAX_DOF],
+            kc: [1.0; wire::MAX_DOF],
             ..ReferenceSample::default()
         }
     }

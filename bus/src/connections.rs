@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use iceoryx2::port::{DegradationAction, DegradationCause, DegradationInfo};
 
-use crate::Topic;
+use wire::Topic;
 
 /// What a node says on stderr when iceoryx2 cannot connect two ports: the
 /// launcher starts the run again when a node's last words hold it.

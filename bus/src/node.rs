@@ -7,61 +7,12 @@
 use std::time::Duration;
 
 use crate::{
-    Bus, CONNECTION_FAILED, CONTROL_START, CONTROL_STOP, Control, Delivery, Header, NODE_DONE,
-    NODE_FAILED, NODE_READY, NODE_RUNNING, NodeKind, NodeStatus, RunPrefix, Topic, TopicPublisher,
-    TopicSubscriber, WireError, monotonic_ns,
+    Bus, CONNECTION_FAILED, RunPrefix, TopicPublisher, TopicSubscriber, WireError, monotonic_ns,
 };
-
-/// Timing mode of a multi-process run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Mode {
-    /// The plant steps on an absolute-deadline grid at the scenario rate,
-    /// holding the latest command; a late command is a deadline miss.
-    Realtime,
-    /// The plant is the clock: it publishes state k and steps only when
-    /// command k has arrived. Deterministic, as fast as the machine allows.
-    Lockstep,
-}
-
-impl Mode {
-    /// The code START carries ([`crate::Control::code`]).
-    pub fn code(self) -> u32 {
-        match self {
-            Mode::Realtime => 1,
-            Mode::Lockstep => 2,
-        }
-    }
-
-    /// The command-line spelling.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Mode::Realtime => "realtime",
-            Mode::Lockstep => "lockstep",
-        }
-    }
-
-    /// What a publisher of this mode does with a full reader: wait
-    /// (lockstep: nothing is lost) or skip it (real time: never wait).
-    pub fn delivery(self) -> Delivery {
-        match self {
-            Mode::Lockstep => Delivery::Lossless,
-            Mode::Realtime => Delivery::DropWhenFull,
-        }
-    }
-}
-
-impl std::str::FromStr for Mode {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "realtime" => Ok(Mode::Realtime),
-            "lockstep" => Ok(Mode::Lockstep),
-            other => Err(format!("'{other}' is not a mode: realtime or lockstep")),
-        }
-    }
-}
+use wire::{
+    CONTROL_START, CONTROL_STOP, Control, Delivery, HEARTBEAT, Header, Mode, NODE_DONE,
+    NODE_FAILED, NODE_READY, NODE_RUNNING, NodeKind, NodeStatus, Topic,
+};
 
 /// Why a node stopped.
 #[derive(Debug, thiserror::Error)]
@@ -98,13 +49,6 @@ pub struct NodeLink {
     last_report: (u32, u64),
     last_report_ns: u64,
 }
-
-/// How often a node says it is alive (its last status again) while it
-/// checks in: the launcher names a node silent for [`SILENT_AFTER`].
-pub const HEARTBEAT: Duration = Duration::from_millis(100);
-/// A node whose status has not been heard for this long is stopped,
-/// spinning or deadlocked: the launcher ends the run and names it.
-pub const SILENT_AFTER: Duration = Duration::from_secs(3);
 
 impl NodeLink {
     /// Connects node `kind` of a `mode` run to the run under `prefix`; with
@@ -192,8 +136,8 @@ impl NodeLink {
     }
 
     /// How the launcher said the run ended, once STOP arrived.
-    pub fn run_end(&self) -> Option<crate::RunEnd> {
-        self.stop_outcome.map(crate::RunEnd::from_code)
+    pub fn run_end(&self) -> Option<wire::RunEnd> {
+        self.stop_outcome.map(wire::RunEnd::from_code)
     }
 
     /// Reports READY and blocks until START; returns the epoch of step 0.
@@ -269,12 +213,6 @@ impl NodeLink {
     }
 }
 
-/// Seconds from integer nanoseconds: the one conversion every process
-/// uses, so in-process and multi-process runs compute the same bits.
-pub fn ns_to_s(ns: u64) -> f64 {
-    ns as f64 / 1e9
-}
-
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -289,39 +227,18 @@ mod tests {
             None
         );
         for end in [
-            crate::RunEnd::Finished,
-            crate::RunEnd::Interrupted,
-            crate::RunEnd::Failed,
-            crate::RunEnd::LostNode(crate::NodeKind::Plant),
-            crate::RunEnd::LostNode(crate::NodeKind::Logger),
+            wire::RunEnd::Finished,
+            wire::RunEnd::Interrupted,
+            wire::RunEnd::Failed,
+            wire::RunEnd::LostNode(wire::NodeKind::Plant),
+            wire::RunEnd::LostNode(wire::NodeKind::Logger),
         ] {
-            assert_eq!(crate::RunEnd::from_code(end.code()), end);
+            assert_eq!(wire::RunEnd::from_code(end.code()), end);
         }
         assert_eq!(
-            crate::RunEnd::LostNode(crate::NodeKind::Plant).describe(),
+            wire::RunEnd::LostNode(wire::NodeKind::Plant).describe(),
             "lost the plant"
         );
         assert_ne!(Mode::Lockstep.code(), Mode::Realtime.code());
-    }
-
-    #[test]
-    fn modes_parse_from_their_spelling_only() {
-        for m in [Mode::Realtime, Mode::Lockstep] {
-            assert_eq!(m.as_str().parse::<Mode>().unwrap(), m);
-        }
-        assert!(
-            "real-time"
-                .parse::<Mode>()
-                .unwrap_err()
-                .contains("realtime or lockstep")
-        );
-        assert_eq!(Mode::Lockstep.delivery(), Delivery::Lossless);
-        assert_eq!(Mode::Realtime.delivery(), Delivery::DropWhenFull);
-    }
-
-    #[test]
-    fn seconds_from_nanoseconds_are_exact_on_the_grid() {
-        assert_eq!(ns_to_s(1_000_000), 1e-3);
-        assert_eq!(ns_to_s(20_000_000_000), 20.0);
     }
 }
