@@ -111,13 +111,18 @@ fn gains(plan: &Plan) -> Gains {
 }
 
 impl Report {
-    /// For an in-process run; `compute_ns` is each controller step's time.
-    pub fn from_sim(plan: &Plan, summary: Summary, wall_time_s: f64, compute_ns: &[u64]) -> Self {
+    /// For an in-process run; `compute_us` is the controller steps' time.
+    pub fn from_sim(
+        plan: &Plan,
+        summary: Summary,
+        wall_time_s: f64,
+        compute_us: Percentiles,
+    ) -> Self {
         let sim_s = summary.steps as f64 * summary.dt_s;
         let g = gains(plan);
         Self {
             law: LawInfo::of(&plan.scenario.controller),
-            compute_us: Percentiles::of(compute_ns.iter().map(|n| *n as f64 / 1e3).collect()),
+            compute_us,
             scenario: plan.scenario.name.clone(),
             scenario_source: plan.source.clone(),
             robot: plan.robot.label(),

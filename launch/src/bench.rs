@@ -160,10 +160,6 @@ pub fn median(mut v: Vec<f64>) -> f64 {
     v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
-fn median_us(v: &[u64]) -> f64 {
-    median(v.iter().map(|x| *x as f64 / 1e3).collect())
-}
-
 /// Reads what /proc says about this machine.
 pub fn machine() -> Machine {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
@@ -367,8 +363,8 @@ fn bench_arm(
         lockstep_wall_s: lockstep,
         lockstep_realtime_factor: sim_s / lockstep.max(1e-9),
         lockstep_to_inprocess_ratio: lockstep / inprocess.max(1e-9),
-        controller_step_us: median_us(&costs.controller_ns),
-        plant_step_us: median_us(&costs.plant_ns),
+        controller_step_us: costs.controller_us.finish().p50,
+        plant_step_us: costs.plant_us.finish().p50,
         realtime,
         timer_floor: floor,
         peak_rss_kb: rss,

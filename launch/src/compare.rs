@@ -329,13 +329,7 @@ fn run_inner(plan: &Plan, keep_series: bool, stop: &AtomicBool) -> (LawRun, bool
         seed: plan.scenario.seed,
         failure: result.err().map(|e| e.to_string()),
         summary: summary.finish(),
-        compute_us: Percentiles::of(
-            costs
-                .controller_ns
-                .iter()
-                .map(|n| *n as f64 / 1e3)
-                .collect(),
-        ),
+        compute_us: costs.controller_us.finish(),
         series,
     };
     (run, stop.load(Ordering::Relaxed))

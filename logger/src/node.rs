@@ -173,6 +173,16 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
         Some(live) => Some(crate::live::start(live, &crate::channels())?),
         None => None,
     };
+    if let Some(l) = &live {
+        // Said and kept, so a viewer can find a port the system chose.
+        let addr = l.address();
+        eprintln!("testbed node logger: live view at ws://{addr}");
+        if let Some(dir) = config.out.parent()
+            && let Err(e) = std::fs::write(dir.join("live-address.txt"), format!("ws://{addr}\n"))
+        {
+            eprintln!("testbed node logger: warning: cannot write live-address.txt: {e}");
+        }
+    }
     let mut meta = config.metadata.clone();
     meta.start_time_unix_ns = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)

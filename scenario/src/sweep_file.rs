@@ -47,6 +47,10 @@ pub enum SweepFileError {
 /// Sweeps larger than this are refused (the manifest lists every run).
 pub const MAX_RUNS: usize = 1_000_000;
 
+/// Parts a dotted scenario key may have: the deepest scenario key has 3
+/// (`plant.payload.mass`); a longer one is refused before it is built.
+pub const MAX_KEY_PARTS: usize = 8;
+
 /// A sweep file as written.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -157,6 +161,17 @@ pub struct Sweep {
 }
 
 impl Axis {
+    /// How many values the axis has, read without making them (None:
+    /// not exactly one of values, range and random).
+    fn count(&self) -> Option<usize> {
+        match (&self.values, &self.range, &self.random) {
+            (Some(v), None, None) => Some(v.len()),
+            (None, Some(r), None) => Some(r.num),
+            (None, None, Some(d)) => Some(d.draws),
+            _ => None,
+        }
+    }
+
     /// The axis's values; exactly one of values, range and random is given.
     fn expand(&self, file: &str) -> Result<Vec<toml::Value>, SweepFileError> {
         let bad = |reason: String| SweepFileError::File {
@@ -192,16 +207,20 @@ impl Axis {
         if out.is_empty() {
             return Err(bad("no values".into()));
         }
+        // Two equal values would be two identical cells.
+        for (i, v) in out.iter().enumerate() {
+            if out[..i].contains(v) {
+                return Err(bad(format!("value {v} is listed twice")));
+            }
+        }
         Ok(out)
     }
 }
 
 /// Sets the dotted `key` in a scenario's TOML tree, creating tables.
 fn set_key(root: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
+    check_key_shape(key)?;
     let parts: Vec<&str> = key.split('.').collect();
-    if parts.iter().any(|p| p.is_empty()) {
-        return Err(format!("'{key}' is not a dotted scenario key"));
-    }
     let mut table = root;
     for (i, part) in parts.iter().enumerate() {
         if i + 1 == parts.len() {
@@ -224,6 +243,97 @@ fn set_key(root: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), 
     Ok(())
 }
 
+/// A dotted scenario key of at most [`MAX_KEY_PARTS`] non-empty parts.
+fn check_key_shape(key: &str) -> Result<(), String> {
+    let parts = key.split('.').take(MAX_KEY_PARTS + 1).collect::<Vec<_>>();
+    if parts.len() > MAX_KEY_PARTS {
+        let shown: String = key.chars().take(40).collect();
+        return Err(format!(
+            "'{shown}…' has more than {MAX_KEY_PARTS} dotted parts; scenario keys have at most 3"
+        ));
+    }
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err(format!("'{key}' is not a dotted scenario key"));
+    }
+    Ok(())
+}
+
+/// Refuses what would make runs that are not what their labels say, or
+/// identical runs counted as distinct: a law fixed beside `laws`, a seed
+/// fixed beside `seeds`, a law or an axis given twice.
+fn check_distinct(spec: &SweepFile, file: &str) -> Result<(), SweepFileError> {
+    let bad = |reason: String| SweepFileError::File {
+        file: file.to_string(),
+        reason,
+    };
+    let fixed = |key: &str| {
+        spec.set.contains_key(key)
+            || spec
+                .set
+                .get(key.split('.').next().unwrap_or(key))
+                .and_then(|t| t.as_table())
+                .is_some_and(|t| key.split('.').nth(1).is_some_and(|k| t.contains_key(k)))
+            || spec.axis.iter().any(|a| a.key == key)
+    };
+    if !spec.laws.is_empty() && fixed("controller.law") {
+        return Err(bad(
+            "controller.law is set (in [set] or an axis) beside laws = [...]: give the laws in \
+             one place"
+                .into(),
+        ));
+    }
+    if spec.seeds > 1 && fixed("seed") {
+        return Err(bad(format!(
+            "seed is set (in [set] or an axis) beside seeds = {}: every seed would run the \
+             same; drop one of them",
+            spec.seeds
+        )));
+    }
+    for (i, law) in spec.laws.iter().enumerate() {
+        if spec.laws[..i].contains(law) {
+            return Err(bad(format!("laws lists {law} twice")));
+        }
+    }
+    for (i, a) in spec.axis.iter().enumerate() {
+        check_key_shape(&a.key).map_err(|e| bad(format!("axis: {e}")))?;
+        if spec.axis[..i].iter().any(|b| b.key == a.key) {
+            return Err(bad(format!("axis {} is given twice", a.key)));
+        }
+    }
+    for key in spec.set.keys() {
+        check_key_shape(key).map_err(|e| bad(format!("set: {e}")))?;
+    }
+    Ok(())
+}
+
+/// The number of runs, counted before anything is made.
+fn count_runs(spec: &SweepFile, laws: usize, file: &str) -> Result<usize, SweepFileError> {
+    let mut total = laws
+        .max(1)
+        .saturating_mul(usize::try_from(spec.seeds).unwrap_or(usize::MAX));
+    for a in &spec.axis {
+        let n = a.count().ok_or_else(|| SweepFileError::File {
+            file: file.to_string(),
+            reason: format!("axis {}: give exactly one of values, range, random", a.key),
+        })?;
+        total = total.saturating_mul(n);
+    }
+    if total > MAX_RUNS {
+        return Err(SweepFileError::File {
+            file: file.to_string(),
+            reason: format!(
+                "{} runs: at most {MAX_RUNS} per sweep",
+                if total == usize::MAX {
+                    "too many".to_string()
+                } else {
+                    total.to_string()
+                }
+            ),
+        });
+    }
+    Ok(total)
+}
+
 /// Reads and expands the sweep file at `path`: every run's plan is built
 /// (and so validated) here.
 pub fn load(path: &Path) -> Result<Sweep, SweepFileError> {
@@ -236,6 +346,14 @@ pub fn load(path: &Path) -> Result<Sweep, SweepFileError> {
         file: file.clone(),
         reason: e.to_string().trim_end().to_string(),
     })?;
+    if spec.seeds == 0 {
+        return Err(SweepFileError::File {
+            file,
+            reason: "seeds = 0: a sweep needs at least one seed".into(),
+        });
+    }
+    check_distinct(&spec, &file)?;
+    count_runs(&spec, spec.laws.len(), &file)?;
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let base = base_plan(&spec, &base_dir, &file)?;
     let mut axes_values = Vec::new();
@@ -254,12 +372,6 @@ pub fn load(path: &Path) -> Result<Sweep, SweepFileError> {
     } else {
         spec.laws.clone()
     };
-    if spec.seeds == 0 {
-        return Err(SweepFileError::File {
-            file,
-            reason: "seeds = 0: a sweep needs at least one seed".into(),
-        });
-    }
     let cells = cartesian(&axes_values);
     let total = cells
         .len()
@@ -281,11 +393,25 @@ pub fn load(path: &Path) -> Result<Sweep, SweepFileError> {
                     index,
                     key: run_key(&plan)?,
                     cell: cell.clone(),
-                    law,
+                    // The law that runs, whatever set it.
+                    law: plan.scenario.controller.law,
                     seed: plan.scenario.seed,
                     plan,
                 });
             }
+        }
+    }
+    let mut seen = std::collections::HashMap::new();
+    for r in &runs {
+        if let Some(first) = seen.insert(r.key.as_str(), r.index) {
+            return Err(SweepFileError::File {
+                file,
+                reason: format!(
+                    "runs {first} and {} are the same run (same scenario, law and seed): \
+                     an axis or [set] value changes nothing",
+                    r.index
+                ),
+            });
         }
     }
     let name = spec.name.clone().unwrap_or_else(|| {
@@ -470,4 +596,81 @@ pub struct ManifestRun {
     pub seed: u64,
     /// Its cell.
     pub cell: serde_json::Map<String, serde_json::Value>,
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// `load` of a sweep file with `text`; the error's text.
+    fn refused(text: &str) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.toml");
+        std::fs::write(&path, text).unwrap();
+        let e = load(&path).map(|s| s.runs.len()).unwrap_err().to_string();
+        assert!(e.contains("s.toml"), "{e}");
+        e
+    }
+
+    #[test]
+    fn huge_axes_are_counted_before_they_are_made() {
+        // #31 row 1: these once aborted allocating their values.
+        let e = refused(
+            "[[axis]]\nkey = \"controller.k1\"\nrange = { start = 1.0, stop = 2.0, num = 1000000000 }\n",
+        );
+        assert!(e.contains("at most 1000000 per sweep"), "{e}");
+        let axis = |k: &str| {
+            format!("[[axis]]\nkey = \"{k}\"\nrange = {{ start = 1.0, stop = 2.0, num = 1000 }}\n")
+        };
+        let e =
+            refused(&(axis("controller.k1") + &axis("controller.k2") + &axis("controller.beta")));
+        assert!(e.contains("1000000000 runs"), "{e}");
+    }
+
+    #[test]
+    fn a_key_of_thousands_of_parts_is_refused_at_once() {
+        // #31 row 2: 20 000 parts once took 2.8 GB or overflowed the stack.
+        let key = vec!["a"; 20_000].join(".");
+        let e = refused(&format!("[set]\n\"{key}\" = 1.0\n"));
+        assert!(e.contains("more than 8 dotted parts"), "{e}");
+    }
+
+    #[test]
+    fn a_law_fixed_beside_laws_is_refused() {
+        // #31 row 3: ctc ran, labelled nac and pd.
+        let e = refused("laws = [\"nac\", \"pd\"]\n[set]\n\"controller.law\" = \"ctc\"\n");
+        assert!(e.contains("controller.law is set"), "{e}");
+        let e = refused(
+            "laws = [\"nac\"]\n[[axis]]\nkey = \"controller.law\"\nvalues = [\"pd\", \"ctc\"]\n",
+        );
+        assert!(e.contains("controller.law is set"), "{e}");
+    }
+
+    #[test]
+    fn without_laws_the_label_is_the_law_that_runs() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.toml");
+        std::fs::write(
+            &path,
+            "[set]\nduration_s = 0.01\n\"controller.law\" = \"ctc\"\n",
+        )
+        .unwrap();
+        let s = load(&path).unwrap();
+        assert_eq!(s.runs[0].law, LawName::Ctc);
+    }
+
+    #[test]
+    fn duplicates_are_refused_and_named() {
+        // #31 row 4: identical runs counted as distinct seeds.
+        let e = refused("seeds = 4\n[set]\nseed = 7\n");
+        assert!(e.contains("seed is set"), "{e}");
+        let e = refused("laws = [\"pd\", \"pd\"]\n");
+        assert!(e.contains("laws lists pd twice"), "{e}");
+        let e = refused("[[axis]]\nkey = \"controller.k1\"\nvalues = [2.0, 3.0, 2.0]\n");
+        assert!(e.contains("value 2.0 is listed twice"), "{e}");
+        let axis = "[[axis]]\nkey = \"controller.k1\"\nvalues = [2.0, 3.0]\n";
+        let e = refused(&format!("{axis}{axis}"));
+        assert!(e.contains("given twice"), "{e}");
+    }
 }

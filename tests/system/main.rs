@@ -4,6 +4,7 @@
 
 mod compare;
 mod hardening;
+mod hardening3;
 mod leftovers;
 mod live;
 mod liveness;

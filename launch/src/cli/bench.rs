@@ -40,26 +40,26 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
         let python = super::args::command_words(&args.peer_python)?;
         let report = launch::bench_peer::run(&opts, &python, progress)?;
         if args.json {
-            println!("{}", serde_json::to_string_pretty(&report)?);
+            super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&report)?))?;
         } else {
-            print!("{}", peer_table(&report));
+            super::write_stdout(&peer_table(&report))?;
         }
         return Ok(ExitCode::SUCCESS);
     }
     if let Some(command) = command {
         let report = launch::bench_controller::run(&opts, &command, progress)?;
         if args.json {
-            println!("{}", serde_json::to_string_pretty(&report)?);
+            super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&report)?))?;
         } else {
-            print!("{}", controller_table(&report));
+            super::write_stdout(&controller_table(&report))?;
         }
         return Ok(ExitCode::SUCCESS);
     }
     let report = launch::bench::run(&opts, progress)?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&report)?))?;
     } else {
-        print!("{}", bench_table::bench_table(&report));
+        super::write_stdout(&bench_table::bench_table(&report))?;
     }
     Ok(ExitCode::SUCCESS)
 }

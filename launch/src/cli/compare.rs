@@ -9,9 +9,21 @@ use launch::compare::{self, CompareOptions, Comparison, METRICS};
 
 use super::args::{CompareArgs, ScenarioArgs};
 
+/// Seeds per law `compare` takes: a table of medians and intervals needs
+/// far fewer; a larger study is a sweep, which streams its results.
+const MAX_SEEDS: u64 = 10_000;
+
 pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     if args.seeds == 0 {
         bail!("--seeds 0: compare needs at least one seed");
+    }
+    // Checked before anything is allocated: each run keeps its summary
+    // (and its series with --plots).
+    if args.seeds > MAX_SEEDS {
+        bail!(
+            "--seeds {}: at most {MAX_SEEDS} seeds per law (use a sweep for more)",
+            args.seeds
+        );
     }
     if args.threads == Some(0) {
         bail!("--threads 0: compare needs at least one thread");
@@ -42,7 +54,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     let opts = CompareOptions {
         laws,
         seeds: args.seeds,
-        threads: args.threads,
+        threads: super::worker_threads(args.threads),
         series: args.plots.is_some(),
     };
     let result =
@@ -59,9 +71,9 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
         eprintln!("testbed: wrote {n} figures to {}", dir.display());
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&result)?);
+        super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&result)?))?;
     } else {
-        print!("{}", table(&result));
+        super::write_stdout(&table(&result))?;
     }
     let failed: Vec<String> = result
         .laws

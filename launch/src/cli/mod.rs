@@ -150,7 +150,7 @@ pub fn run() -> Result<ExitCode> {
             match out {
                 Some(path) => std::fs::write(&path, text)
                     .with_context(|| format!("writing {}", path.display()))?,
-                None => print!("{text}"),
+                None => write_stdout(&text)?,
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -159,16 +159,16 @@ pub fn run() -> Result<ExitCode> {
             match out {
                 Some(path) => std::fs::write(&path, text)
                     .with_context(|| format!("writing {}", path.display()))?,
-                None => print!("{text}"),
+                None => write_stdout(&text)?,
             }
             Ok(ExitCode::SUCCESS)
         }
         Command::Scenarios => {
-            print!("{}", scenarios::scenario_list());
+            write_stdout(&scenarios::scenario_list())?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Robot { path } => {
-            print!("{}", robot::describe(&path)?);
+            write_stdout(&robot::describe(&path)?)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Node { name, args } => {
@@ -204,9 +204,9 @@ fn resolve_scenario(arg: &std::path::Path) -> PathBuf {
 
 pub(crate) fn print_report(report: &Report, json: bool) -> Result<()> {
     if json {
-        println!("{}", serde_json::to_string_pretty(report)?);
+        write_stdout(&format!("{}\n", serde_json::to_string_pretty(report)?))?;
     } else {
-        print!("{}", report::table(report));
+        write_stdout(&report::table(report))?;
     }
     if !report.summary.finite {
         eprintln!("testbed: warning: the run produced non-finite values or controller faults");
@@ -215,4 +215,40 @@ pub(crate) fn print_report(report: &Report, json: bool) -> Result<()> {
         eprintln!("testbed: warning: {w}");
     }
     Ok(())
+}
+
+/// Worker threads for `compare` and `sweep run`: at most four per CPU
+/// (more only queue; twenty thousand once kept a run from ending for over
+/// a minute), said on stderr when the request is cut.
+pub(crate) fn worker_threads(requested: Option<usize>) -> Option<usize> {
+    let cpus = launch::node::placement::cpu_count();
+    let cap = 4 * cpus;
+    match requested {
+        Some(n) if n > cap => {
+            eprintln!("testbed: --threads {n} is more than 4 per CPU; using {cap} ({cpus} CPUs)");
+            Some(cap)
+        }
+        other => other,
+    }
+}
+
+/// Standard output was closed by its reader (`… | head`): the command ends
+/// quietly with 141, the status a shell gives a process SIGPIPE ended.
+#[derive(Debug, thiserror::Error)]
+#[error("standard output was closed")]
+pub(crate) struct StdoutClosed;
+
+/// Exit status after [`StdoutClosed`].
+pub(crate) const EXIT_STDOUT_CLOSED: u8 = 141;
+
+/// Writes `text` to standard output: a closed pipe is [`StdoutClosed`],
+/// any other failure (a full device) a named error; never a panic.
+pub(crate) fn write_stdout(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut o = std::io::stdout().lock();
+    match o.write_all(text.as_bytes()).and_then(|()| o.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(StdoutClosed.into()),
+        Err(e) => Err(anyhow::Error::new(e).context("writing to standard output")),
+    }
 }

@@ -48,7 +48,7 @@ pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     result.with_context(|| format!("running {}", plan.source))?;
-    let report = Report::from_sim(&plan, summary.finish(), wall, &costs.controller_ns);
+    let report = Report::from_sim(&plan, summary.finish(), wall, costs.controller_us.finish());
     print_report(&report, args.json)?;
     Ok(ExitCode::SUCCESS)
 }

@@ -110,7 +110,7 @@ fn run(a: SweepRunArgs) -> Result<ExitCode> {
             .context("installing the Ctrl-C handler")?;
     }
     let opts = RunOptions {
-        threads: a.threads,
+        threads: super::worker_threads(a.threads),
         share: a.index.zip(a.tasks),
         progress: !a.no_progress,
     };
@@ -145,9 +145,9 @@ fn report_cmd(a: SweepReportArgs) -> Result<ExitCode> {
         eprintln!("testbed: wrote {n} figures to {}", dir.display());
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&r)?);
+        super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&r)?))?;
     } else {
-        print!("{}", report::table(&r));
+        super::write_stdout(&report::table(&r))?;
     }
     if r.found_runs < r.total_runs {
         eprintln!(
@@ -175,7 +175,7 @@ fn slurm_cmd(a: SweepSlurmArgs) -> Result<ExitCode> {
         testbed,
     };
     let w = slurm::write(&s, &dir, &opts)?;
-    println!("{}", w.path.display());
+    super::write_stdout(&format!("{}\n", w.path.display()))?;
     eprintln!(
         "testbed: {} runs in {} array tasks, {} missing; submit with: sbatch {}",
         s.runs.len(),

@@ -218,6 +218,13 @@ fn check_up_front(opts: &RunOptions) -> Result<(), RunError> {
         File::create(path).map_err(|e| RunError::Output(path.display().to_string(), e))?;
     }
     if let Some(live) = &opts.live {
+        if !live.addr.ip().is_loopback() {
+            eprintln!(
+                "testbed: warning: the live view listens on {}, beyond this machine: anyone \
+                 who can reach it can watch the run (127.0.0.1 keeps it local)",
+                live.addr
+            );
+        }
         // Taken now, it would fail the logger after the others started.
         // (Released at once: the logger binds it; a thief in between makes
         // the logger fail, named.)

@@ -63,6 +63,8 @@ pub trait LiveView {
     /// Offers one message of `topic` (its JSON) stamped `t_ns`: sent if its
     /// topic is due and someone subscribed, skipped otherwise.
     fn offer(&mut self, topic: &str, t_ns: u64, json: &[u8]);
+    /// The address the server listens on (the port chosen when asked for 0).
+    fn address(&self) -> std::net::SocketAddr;
     /// Stops the server; what was sent, for the log's stats record.
     fn finish(self: Box<Self>) -> BTreeMap<String, String>;
 }

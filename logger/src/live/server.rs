@@ -123,13 +123,18 @@ impl Live {
             .iter()
             .map(|spec| open(&ctx, spec))
             .collect::<Result<Vec<_>, _>>()?;
+        // Port 0 asks the system for one: record the one it gave.
+        let bound = std::net::SocketAddr::new(addr.ip(), server.port());
         Ok(Self {
             _context: ctx,
             server: Some(server),
             topics,
             period_ns: (1e9 / config.rate_hz) as u64,
             book,
-            config: config.clone(),
+            config: LiveConfig {
+                addr: bound,
+                ..config.clone()
+            },
             clock_topic: channels.first().map_or("", |c| c.topic),
         })
     }
@@ -164,6 +169,10 @@ impl Live {
 }
 
 impl LiveView for Live {
+    fn address(&self) -> std::net::SocketAddr {
+        self.config.addr
+    }
+
     fn offer(&mut self, topic: &str, t_ns: u64, json: &[u8]) {
         let Some(t) = self.topics.iter_mut().find(|t| t.name == topic) else {
             return;
