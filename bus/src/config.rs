@@ -38,13 +38,19 @@ pub fn write_config<T: Serialize>(path: &Path, config: &T) -> Result<(), ConfigE
     std::fs::write(path, text).map_err(|cause| ConfigError::Io { path: p, cause })
 }
 
-/// Reads a config written by [`write_config`].
+/// Configs larger than this are refused unread: the largest holds a URDF
+/// ([`wire::MAX_URDF_BYTES`]) and the scenario.
+pub const MAX_CONFIG_BYTES: u64 = 4 * wire::MAX_URDF_BYTES;
+
+/// Reads a config written by [`write_config`]: a regular file of at most
+/// [`MAX_CONFIG_BYTES`] (`/dev/zero` once read until memory ran out).
 pub fn read_config<T: DeserializeOwned>(path: &Path) -> Result<T, ConfigError> {
     let p = path.display().to_string();
-    let text = std::fs::read(path).map_err(|cause| ConfigError::Io {
-        path: p.clone(),
-        cause,
-    })?;
+    let text =
+        wire::read_regular_file(path, Some(MAX_CONFIG_BYTES)).map_err(|cause| ConfigError::Io {
+            path: p.clone(),
+            cause,
+        })?;
     serde_json::from_slice(&text).map_err(|cause| ConfigError::Json { path: p, cause })
 }
 

@@ -52,8 +52,16 @@ impl ControllerNodeConfig {
         }
     }
 
-    /// The step machine this configuration describes.
+    /// The step machine this configuration describes (a config written by
+    /// hand is checked like a scenario: sizes first).
     pub fn machine(&self) -> Result<ControllerMachine, ControllerError> {
+        if self.dof == 0 || self.dof > wire::MAX_DOF || self.period_ns == 0 {
+            return Err(ControllerError::InvalidParameter {
+                key: "dof".into(),
+                value: format!("{} joints, period {} ns", self.dof, self.period_ns),
+                need: format!("1 to {} joints and a period above 0", wire::MAX_DOF),
+            });
+        }
         let model = match &self.model {
             Some(m) => Some(
                 ArmModel::from_urdf_str_locked(&m.urdf, &m.lock).map_err(|e| {

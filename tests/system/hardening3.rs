@@ -72,3 +72,121 @@ fn a_live_view_on_port_0_says_its_port() {
     let kept = std::fs::read_to_string(run.join("live-address.txt")).unwrap();
     assert_eq!(kept.trim(), format!("ws://127.0.0.1:{port}"));
 }
+
+/// Row 18: values pasted into `#SBATCH` lines are checked, not pasted: a
+/// line break in `--partition` once injected shell lines.
+#[test]
+fn slurm_options_cannot_inject_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = dir.path().join("s.toml");
+    std::fs::write(&sweep, "[set]\nduration_s = 0.01\n").unwrap();
+    for (flag, value) in [
+        ("--partition", "x\necho X"),
+        ("--time", "1:00\n#SBATCH --x"),
+    ] {
+        let out = dir.path().join(flag.trim_start_matches('-'));
+        let err = crate::util::fails(
+            testbed()
+                .args(["sweep", "slurm"])
+                .arg(&sweep)
+                .arg("--out")
+                .arg(&out)
+                .args([flag, value]),
+        );
+        assert!(err.contains(flag), "{err}");
+        assert!(!out.join("sweep.sbatch").exists());
+    }
+}
+
+/// Row 19: a node's config is checked like a scenario, and read only if it
+/// is a regular file of a sane size.
+#[test]
+fn node_configs_are_checked_and_bounded() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("controller.json");
+    std::fs::write(
+        &config,
+        r#"{"params": {}, "dof": 100, "period_ns": 1000000}"#,
+    )
+    .unwrap();
+    let prefix = format!("cfgtest{}_", std::process::id());
+    let node = |config: &std::path::Path| {
+        crate::util::fails(
+            testbed()
+                .args([
+                    "node",
+                    "controller",
+                    "--mode",
+                    "lockstep",
+                    "--prefix",
+                    &prefix,
+                    "--config",
+                ])
+                .arg(config),
+        )
+    };
+    let err = node(&config);
+    assert!(err.contains("dof") && err.contains("100 joints"), "{err}");
+    let err = node(std::path::Path::new("/dev/zero"));
+    assert!(
+        err.contains("/dev/zero") && err.contains("not a regular file"),
+        "{err}"
+    );
+    assert!(crate::util::shm_files(&prefix).is_empty());
+}
+
+/// Rows 8 and 9: a controller command that leaves a helper behind (which
+/// holds its stderr open) and writes a line that is not UTF-8: the run
+/// ends, the helper ends with it, and the launcher does not wait on the
+/// stray pipe.
+#[test]
+fn a_controllers_helper_ends_with_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let marker = format!(
+        "{}.{}",
+        300 + std::process::id() % 600,
+        std::process::id() % 97
+    );
+    let script = dir.path().join("ctl.sh");
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/sh\nsleep {marker} &\nprintf 'bytes \\377\\376 not utf-8\\n' >&2\nexec {} \"$@\"\n",
+            env!("CARGO_BIN_EXE_example-pd-controller")
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&script, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    let mut run = testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--duration",
+            "0.5",
+            "--law",
+            "pd",
+        ])
+        .arg("--controller-cmd")
+        .arg(&script)
+        .arg("--runs-dir")
+        .arg(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Watchdog: the launcher must end long before the helper would.
+    let status = crate::util::wait_bounded(&mut run, 60);
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut run.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(status.success(), "{err}");
+    assert!(
+        err.contains("[controller] bytes \u{fffd}\u{fffd} not utf-8"),
+        "{err}"
+    );
+    let helpers = std::process::Command::new("pgrep")
+        .args(["-f", &format!("sleep {marker}")])
+        .output()
+        .unwrap();
+    assert!(helpers.stdout.is_empty(), "the helper outlived the run");
+}

@@ -20,6 +20,12 @@ use nix::unistd::Pid;
 use wire::NodeKind;
 
 const TAIL_LINES: usize = 20;
+/// A node's stderr line longer than this is cut (a 300 MB line once sat in
+/// the launcher's memory whole).
+const MAX_LINE_BYTES: usize = 64 * 1024;
+/// How long the launcher waits for a node's stderr to close after the node
+/// exited.
+const FORWARDER_WAIT: Duration = Duration::from_secs(1);
 
 /// One running node process.
 pub struct Child {
@@ -60,9 +66,20 @@ impl Child {
         self.exited
     }
 
+    /// Waits for the forwarder to pass on what the node wrote before it
+    /// exited, but not for ever: a helper the node started may hold its
+    /// stderr open; the node's group is ended first, and after a moment the
+    /// forwarder is left to finish alone.
     fn join_forwarder(&mut self) {
+        self.signal_group(Signal::SIGKILL);
         if let Some(h) = self.forwarder.take() {
-            let _ = h.join();
+            let start = Instant::now();
+            while !h.is_finished() && start.elapsed() < FORWARDER_WAIT {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            if h.is_finished() {
+                let _ = h.join();
+            }
         }
     }
 }
@@ -134,7 +151,8 @@ fn spawn_program(
         let tail = Arc::clone(&tail);
         let name = kind.name();
         std::thread::spawn(move || {
-            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let mut reader = BufReader::new(stderr);
+            while let Some(line) = read_line_bounded(&mut reader) {
                 eprintln!("[{name}] {line}");
                 if let Ok(mut t) = tail.lock() {
                     if t.len() == TAIL_LINES {
@@ -152,6 +170,46 @@ fn spawn_program(
         forwarder,
         exited: None,
     })
+}
+
+/// The next line of `r` as text: bytes that are not UTF-8 are replaced
+/// (one such line once stopped the forwarder, and the node's next write
+/// failed), and a line longer than [`MAX_LINE_BYTES`] is cut, the rest of
+/// it skipped. None at the end of the stream.
+fn read_line_bounded(r: &mut impl BufRead) -> Option<String> {
+    let mut line = Vec::new();
+    let mut cut = false;
+    loop {
+        let buf = match r.fill_buf() {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(_) => &[],
+        };
+        if buf.is_empty() {
+            return (!line.is_empty() || cut).then(|| finish_line(&line, cut));
+        }
+        let (chunk, done) = match buf.iter().position(|b| *b == b'\n') {
+            Some(i) => (&buf[..i], i + 1),
+            None => (buf, buf.len()),
+        };
+        let room = MAX_LINE_BYTES.saturating_sub(line.len());
+        line.extend_from_slice(&chunk[..chunk.len().min(room)]);
+        cut |= chunk.len() > room;
+        let newline = done > chunk.len();
+        r.consume(done);
+        if newline {
+            return Some(finish_line(&line, cut));
+        }
+    }
+}
+
+fn finish_line(bytes: &[u8], cut: bool) -> String {
+    let text = String::from_utf8_lossy(bytes);
+    if cut {
+        format!("{text} … (line cut at {} KiB)", MAX_LINE_BYTES / 1024)
+    } else {
+        text.into_owned()
+    }
 }
 
 /// How a process ended, in words.
@@ -286,4 +344,26 @@ pub fn cpu_ns(pid: u32) -> Option<u64> {
         total += stat.split_whitespace().next()?.parse::<u64>().ok()?;
     }
     Some(total)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_are_forwarded_lossily_and_bounded() {
+        let mut input: Vec<u8> = b"plain\n\xff\xfe bytes\n".to_vec();
+        input.extend(std::iter::repeat_n(b'x', 3 * MAX_LINE_BYTES));
+        input.extend_from_slice(b"\nlast");
+        let mut r = std::io::BufReader::with_capacity(1000, input.as_slice());
+        assert_eq!(read_line_bounded(&mut r).as_deref(), Some("plain"));
+        assert_eq!(
+            read_line_bounded(&mut r).as_deref(),
+            Some("\u{fffd}\u{fffd} bytes")
+        );
+        let long = read_line_bounded(&mut r).unwrap_or_default();
+        assert!(long.len() < MAX_LINE_BYTES + 100 && long.ends_with("(line cut at 64 KiB)"));
+        assert_eq!(read_line_bounded(&mut r).as_deref(), Some("last"));
+        assert_eq!(read_line_bounded(&mut r), None);
+    }
 }

@@ -45,6 +45,7 @@ pub fn write(sweep: &Sweep, dir: &Path, opts: &SlurmOptions) -> Result<SlurmScri
             "--tasks, --max-running and --cpus-per-task must be at least 1".into(),
         ));
     }
+    check_values(opts, dir)?;
     open_folder(dir, &Manifest::of(sweep))?;
     let (done, _) = read_results(dir)?;
     let missing = sweep
@@ -96,6 +97,40 @@ pub fn write(sweep: &Sweep, dir: &Path, opts: &SlurmOptions) -> Result<SlurmScri
 }
 
 /// A job name Slurm takes as written.
+/// The values pasted into `#SBATCH` lines, which a shell quote cannot
+/// protect: each must be what Slurm takes (a line break once injected
+/// shell lines and dropped `--time`).
+fn check_values(opts: &SlurmOptions, dir: &Path) -> Result<(), SweepError> {
+    let ok = |v: &str, extra: &[char]| {
+        !v.is_empty()
+            && v.len() <= 200
+            && v.chars()
+                .all(|c| c.is_ascii_alphanumeric() || extra.contains(&c))
+    };
+    if let Some(p) = &opts.partition
+        && !ok(p, &['_', '-', '.', ','])
+    {
+        return Err(SweepError::Options(format!(
+            "--partition {p:?}: a partition name (letters, digits, '_', '-', '.'; several \
+             separated by commas)"
+        )));
+    }
+    if let Some(t) = &opts.time
+        && !ok(t, &[':', '-'])
+    {
+        return Err(SweepError::Options(format!(
+            "--time {t:?}: a Slurm time limit such as 30, 2:00:00 or 1-12:00:00"
+        )));
+    }
+    if dir.to_string_lossy().chars().any(char::is_control) {
+        return Err(SweepError::Options(format!(
+            "--out {}: a folder name with a control character cannot go into #SBATCH --output",
+            dir.display()
+        )));
+    }
+    Ok(())
+}
+
 fn sanitize(name: &str) -> String {
     name.chars()
         .map(|c| {
