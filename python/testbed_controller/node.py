@@ -268,8 +268,28 @@ def run(controller: Controller, argv: Optional[Sequence[str]] = None) -> None:
     sys.exit(main(controller, argv))
 
 
+def die_with_parent(parent_pid: Optional[int]) -> None:
+    """Ends this process when the launcher dies, even in the middle of a
+    `step()` that never returns (the periodic check of the launcher cannot
+    run then): the kernel sends SIGKILL (Linux), and the next run removes
+    what this process left in shared memory."""
+    if parent_pid is None or not sys.platform.startswith("linux"):
+        return
+    import ctypes
+    import signal
+
+    pr_set_pdeathsig = 1
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(pr_set_pdeathsig, int(signal.SIGKILL), 0, 0, 0)
+    try:
+        os.kill(parent_pid, 0)
+    except ProcessLookupError:
+        raise SystemExit(f"controller: the launcher (pid {parent_pid}) is gone") from None
+
+
 def main(controller: Controller, argv: Optional[Sequence[str]] = None) -> int:
     args = parse_args(argv)
+    die_with_parent(args.parent_pid)
     for refused in apply_placement(args.cpus, args.fifo, args.lock_memory):
         print(f"controller: warning: {refused}", file=sys.stderr)
     info = read_run_info(args.config, args.mode)

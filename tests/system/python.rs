@@ -200,7 +200,7 @@ fn python_controller_of(launcher: u32) -> u32 {
             };
             let cmdline = std::fs::read(e.path().join("cmdline")).unwrap_or_default();
             let text = String::from_utf8_lossy(&cmdline).replace('\0', " ");
-            if text.contains("pd.py") && text.contains(&format!("--parent-pid {launcher}")) {
+            if text.contains(".py") && text.contains(&format!("--parent-pid {launcher}")) {
                 return pid;
             }
         }
@@ -238,6 +238,49 @@ fn kill_9_of_a_python_controller_is_named_and_leaves_nothing() {
         "{err}"
     );
     assert!(shm_files(&format!("tbrun{launcher:x}x")).is_empty());
+}
+
+/// #31 row 10: kill -9 of the launcher while a Python controller is stuck
+/// inside `step()` (where its own check of the launcher cannot run): the
+/// controller ends all the same (the kernel's parent-death signal).
+#[test]
+fn kill_9_of_the_launcher_ends_a_python_controller_stuck_in_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("pd.py");
+    std::fs::write(
+        &script,
+        "import time, numpy as np\nimport testbed_controller as tc\n\
+         class Stuck(tc.Controller):\n    def setup(self, run):\n        self.n = run.dof\n\
+         \x20   def step(self, state, ref):\n        time.sleep(600)\n        return np.zeros(self.n)\n\
+         \x20   def diagnostics(self):\n        return {}\n\
+         tc.run(Stuck())\n",
+    )
+    .unwrap();
+    let cmd = format!("{} {}", python(), script.display());
+    let mut child = testbed()
+        .args(["run", "--law", "pd", "--duration", "30", "--runs-dir"])
+        .arg(dir.path())
+        .args(["--controller-cmd", &cmd])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let controller = python_controller_of(child.id());
+    crate::run_cli::wait_until_running(dir.path());
+    child.kill().unwrap();
+    let _ = child.wait();
+    // Watchdog: the controller must go long before its sleep would end.
+    let start = std::time::Instant::now();
+    while std::path::Path::new(&format!("/proc/{controller}")).exists()
+        && !std::fs::read_to_string(format!("/proc/{controller}/stat"))
+            .is_ok_and(|s| s.contains(") Z "))
+    {
+        assert!(
+            start.elapsed().as_secs() < 30,
+            "the controller outlived its launcher"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
 }
 
 #[test]

@@ -56,6 +56,9 @@ pub enum NodeRunError {
     /// The logger node failed.
     #[error(transparent)]
     Logger(#[from] logger::node::LoggerNodeError),
+    /// The launcher was gone before the node started.
+    #[error(transparent)]
+    Node(#[from] NodeError),
 }
 
 impl NodeRunError {
@@ -78,6 +81,14 @@ impl NodeRunError {
 
 /// Runs node `kind` to completion.
 pub fn run(kind: NodeKind, args: &NodeArgs) -> Result<(), NodeRunError> {
+    if let Some(parent) = args.parent_pid {
+        // SIGTERM when the launcher dies, however it dies: the node then
+        // stops as on Ctrl-C, even where its own checks would come late.
+        let _ = nix::sys::prctl::set_pdeathsig(nix::sys::signal::Signal::SIGTERM);
+        if nix::sys::signal::kill(nix::unistd::Pid::from_raw(parent as i32), None).is_err() {
+            return Err(NodeError::ParentGone(parent).into());
+        }
+    }
     for refused in args.placement.apply() {
         eprintln!("testbed node {}: warning: {refused}", kind.name());
     }

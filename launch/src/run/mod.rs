@@ -363,6 +363,17 @@ fn supervise(
         tick(bus)?;
         nodes.read(status)?;
         if nodes.done.contains(&NodeKind::Plant) && wall.is_none() {
+            // A run cut short is never a finished one.
+            if nodes.plant_step < plan.steps {
+                return Err(RunError::NodeFailed {
+                    node: NodeKind::Plant.name(),
+                    how: format!(
+                        "reported DONE after {} of {} steps",
+                        nodes.plant_step, plan.steps
+                    ),
+                    stderr: String::new(),
+                });
+            }
             wall = Some(started.elapsed().as_secs_f64());
         }
         if let Some(w) = wall
@@ -414,7 +425,7 @@ fn wait_for_ready(
     status: &bus::TopicSubscriber<NodeStatus>,
     children: &mut Children,
 ) -> Result<NodeStates, RunError> {
-    let mut nodes = NodeStates::default();
+    let mut nodes = NodeStates::with_pids(children.pids());
     let limit = if opts.external.is_empty() {
         START_TIMEOUT
     } else {

@@ -245,6 +245,11 @@ impl Children {
         None
     }
 
+    /// Each child's process id.
+    pub fn pids(&self) -> Vec<(NodeKind, u32)> {
+        self.0.iter().map(|c| (c.kind, c.pid())).collect()
+    }
+
     /// Peak resident memory (VmHWM, kB) of each child still running.
     pub fn peak_rss_kb(&self) -> Vec<(NodeKind, u64)> {
         self.0
