@@ -94,6 +94,30 @@ impl RunPrefix {
         &self.0
     }
 
+    /// Takes write access from other users on this run's files in
+    /// /dev/shm: iceoryx2 makes its `global_mgmt` file writable by anyone
+    /// (0666), and every process of a run is the same user. Best effort: a
+    /// file that is not ours, or gone, is left as it is.
+    fn close_shared_files(&self) {
+        use std::os::unix::fs::PermissionsExt;
+        let Ok(dir) = std::fs::read_dir("/dev/shm") else {
+            return;
+        };
+        for entry in dir.flatten() {
+            let name = entry.file_name();
+            if !name.to_string_lossy().starts_with(self.as_str()) {
+                continue;
+            }
+            if let Ok(meta) = entry.metadata()
+                && meta.permissions().mode() & 0o022 != 0
+            {
+                let mode = meta.permissions().mode() & !0o022;
+                let _ =
+                    std::fs::set_permissions(entry.path(), std::fs::Permissions::from_mode(mode));
+            }
+        }
+    }
+
     /// The iceoryx2 configuration for this run.
     pub fn config(&self) -> Result<Config, WireError> {
         let mut config = Config::default();
@@ -178,6 +202,7 @@ impl Bus {
             .create::<ipc::Service>()
             .map_err(|e| ipc("create node", name)(format!("{e:?}")))?;
         terminated();
+        prefix.close_shared_files();
         Ok(Self {
             node,
             prefix: prefix.clone(),

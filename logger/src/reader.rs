@@ -126,7 +126,13 @@ fn read(
         let record = match record {
             Ok(r) => r,
             Err(e) => {
-                out.cut_short = Some(format!("the file ends inside a record ({e})"));
+                out.cut_short = Some(if e.to_lowercase().contains("crc") {
+                    format!(
+                        "a chunk is damaged (its checksum does not match: {e}); it and what follows are left out"
+                    )
+                } else {
+                    format!("the file ends inside a record ({e})")
+                });
                 break;
             }
         };

@@ -28,6 +28,10 @@ impl<'a> Records<'a> {
             reader: LinearReader::new_with_options(
                 LinearReaderOptions::default()
                     .with_skip_end_magic(true)
+                    // A chunk is checked before any of its records is used:
+                    // a flipped byte once changed a summary without a word.
+                    .with_prevalidate_chunk_crcs(true)
+                    .with_validate_data_section_crc(true)
                     .with_record_length_limit(MAX_RECORD_BYTES),
             ),
         }

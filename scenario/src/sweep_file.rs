@@ -361,10 +361,12 @@ pub fn load(path: &Path) -> Result<Sweep, SweepFileError> {
         axes_values.push((axis.key.clone(), axis.expand(&file)?));
     }
     let sets = spec.set.iter().map(|(k, v)| ("set", k.clone(), v.clone()));
-    let firsts = axes_values
+    // Every axis value, not only the first: a bad one is named here, at
+    // the user's file, not at a line of a generated scenario.
+    let values = axes_values
         .iter()
-        .map(|(k, v)| ("axis", k.clone(), v[0].clone()));
-    for (what, key, value) in sets.chain(firsts) {
+        .flat_map(|(k, v)| v.iter().map(move |x| ("axis", k.clone(), x.clone())));
+    for (what, key, value) in sets.chain(values) {
         check_key(&base, what, &key, value, &file)?;
     }
     let laws = if spec.laws.is_empty() {
@@ -672,5 +674,29 @@ mod tests {
         let axis = "[[axis]]\nkey = \"controller.k1\"\nvalues = [2.0, 3.0]\n";
         let e = refused(&format!("{axis}{axis}"));
         assert!(e.contains("given twice"), "{e}");
+    }
+}
+
+#[cfg(test)]
+mod later_values {
+    #![allow(clippy::unwrap_used)]
+
+    /// #31 row 20: a bad value that is not an axis's first is named at the
+    /// user's file and key, not at a line of a generated scenario.
+    #[test]
+    fn a_bad_later_axis_value_is_named_at_the_sweep_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.toml");
+        std::fs::write(
+            &path,
+            "[[axis]]\nkey = \"controller.integrator\"\nvalues = [\"exact\", \"rk9\"]\n",
+        )
+        .unwrap();
+        let e = super::load(&path).map(|_| ()).unwrap_err().to_string();
+        assert!(e.starts_with(&path.display().to_string()), "{e}");
+        assert!(
+            e.contains("axis controller.integrator") && e.contains("rk9"),
+            "{e}"
+        );
     }
 }

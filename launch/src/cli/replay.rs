@@ -34,6 +34,14 @@ pub(crate) fn replay(args: ReplayArgs) -> Result<ExitCode> {
             series: args.plots.is_some(),
         },
     )?;
+    // Re-driving nothing proves nothing: a difference of 0 over 0 steps
+    // is not a verification.
+    if matches!(analysis.verify, Some((_, 0))) {
+        anyhow::bail!(
+            "{}: --verify found no step to re-drive (the log holds no complete step)",
+            args.log.display()
+        );
+    }
     if let (Some(dir), Some(series)) = (&args.plots, &analysis.series) {
         let written = analysis::plots::write_all(dir, series, &analysis.plan)
             .with_context(|| format!("writing figures to {}", dir.display()))?;

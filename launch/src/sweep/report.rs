@@ -56,7 +56,8 @@ pub struct CellReport {
     /// Results that failed or diverged.
     pub not_ok: usize,
     /// Share of the found runs that kept the envelope after T_c, finite.
-    pub success_rate: f64,
+    /// (None: no run reached T_c, so none is judged.)
+    pub success_rate: Option<f64>,
     /// Every metric.
     pub metrics: Vec<MetricStats>,
 }
@@ -119,6 +120,15 @@ pub fn report(dir: &Path) -> Result<SweepReport, SweepError> {
     })
 }
 
+/// Whether a run counts toward the success rate: it failed, or it reached
+/// T_c (a run that ends before T_c says nothing about the constraint).
+fn is_judged(l: &ResultLine) -> bool {
+    l.status != "ok"
+        || l.summary["joints"]
+            .as_array()
+            .is_some_and(|j| j.iter().any(|x| !x["min_margin_after_tc"].is_null()))
+}
+
 fn cell_report(
     cell: serde_json::Map<String, serde_json::Value>,
     law: String,
@@ -164,10 +174,9 @@ fn cell_report(
         runs: lines.len(),
         found: found.len(),
         not_ok: found.iter().filter(|l| l.status != "ok").count(),
-        success_rate: if found.is_empty() {
-            0.0
-        } else {
-            kept as f64 / found.len() as f64
+        success_rate: {
+            let judged = found.iter().filter(|l| is_judged(l)).count();
+            (judged > 0).then(|| kept as f64 / judged as f64)
         },
         metrics,
     }
@@ -216,7 +225,7 @@ pub fn csv(r: &SweepReport) -> String {
             c.law.clone(),
             c.runs.to_string(),
             c.found.to_string(),
-            num(c.success_rate),
+            c.success_rate.map_or_else(String::new, num),
         ]);
         for m in &c.metrics {
             row.extend([num(m.median), num(m.q1), num(m.q3), num(m.worst)]);
@@ -272,11 +281,12 @@ pub fn table(r: &SweepReport) -> String {
         let eff = get("effort_after_tc").map_or_else(String::new, |m| f(m.median));
         let _ = writeln!(
             out,
-            "{:<40} {:<14} {:>6} {:>7.0}%  {:>28}  {:>20}  {:>10}",
+            "{:<40} {:<14} {:>6} {:>8}  {:>28}  {:>20}  {:>10}",
             cell.join(" "),
             c.law,
             format!("{}/{}", c.found, c.runs),
-            100.0 * c.success_rate,
+            c.success_rate
+                .map_or_else(|| "not judged".into(), |r| format!("{:.0}%", 100.0 * r)),
             iae,
             maxe,
             eff
