@@ -337,15 +337,34 @@ fn count_runs(spec: &SweepFile, laws: usize, file: &str) -> Result<usize, SweepF
 /// Reads and expands the sweep file at `path`: every run's plan is built
 /// (and so validated) here.
 pub fn load(path: &Path) -> Result<Sweep, SweepFileError> {
-    let file = path.display().to_string();
     let text = wire::read_text_file(path, MAX_FILE_BYTES).map_err(|cause| SweepFileError::Io {
         path: path.display().to_string(),
         cause,
     })?;
-    let spec: SweepFile = toml::from_str(&text).map_err(|e| SweepFileError::File {
-        file: file.clone(),
+    from_text(path, text)
+}
+
+/// How many runs the sweep file `text` (at `path`) makes, counted without
+/// making them.
+pub fn planned_runs(path: &Path, text: &str) -> Result<usize, SweepFileError> {
+    let file = path.display().to_string();
+    let spec = parse(text, &file)?;
+    check_distinct(&spec, &file)?;
+    count_runs(&spec, spec.laws.len(), &file)
+}
+
+fn parse(text: &str, file: &str) -> Result<SweepFile, SweepFileError> {
+    toml::from_str(text).map_err(|e| SweepFileError::File {
+        file: file.to_string(),
         reason: e.to_string().trim_end().to_string(),
-    })?;
+    })
+}
+
+/// [`load`] of a sweep file's `text`, read from `path` (which relative
+/// paths in it start from).
+pub fn from_text(path: &Path, text: String) -> Result<Sweep, SweepFileError> {
+    let file = path.display().to_string();
+    let spec = parse(&text, &file)?;
     if spec.seeds == 0 {
         return Err(SweepFileError::File {
             file,

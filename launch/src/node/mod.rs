@@ -84,7 +84,11 @@ pub fn run(kind: NodeKind, args: &NodeArgs) -> Result<(), NodeRunError> {
     if let Some(parent) = args.parent_pid {
         // SIGTERM when the launcher dies, however it dies: the node then
         // stops as on Ctrl-C, even where its own checks would come late.
-        let _ = nix::sys::prctl::set_pdeathsig(nix::sys::signal::Signal::SIGTERM);
+        // Not the logger: it notices by itself within 10 ms and must
+        // finish the log, saying the launcher vanished.
+        if kind != NodeKind::Logger {
+            let _ = nix::sys::prctl::set_pdeathsig(nix::sys::signal::Signal::SIGTERM);
+        }
         if nix::sys::signal::kill(nix::unistd::Pid::from_raw(parent as i32), None).is_err() {
             return Err(NodeError::ParentGone(parent).into());
         }
