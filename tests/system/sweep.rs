@@ -236,3 +236,22 @@ fn sweep_errors_name_the_file_and_key_and_run_nothing() {
     );
     assert!(e.contains("manifest.json"), "{e}");
 }
+
+/// #31 row 5: the results folder removed while the sweep runs: the loss is
+/// noticed and the sweep fails, instead of "results in …" with nothing kept.
+#[test]
+fn a_results_folder_removed_mid_sweep_fails_the_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("long.toml");
+    // Long enough (400 runs of 3 s) that the removal lands mid-sweep.
+    std::fs::write(&file, "name = \"long\"\nseeds = 400\n[set]\nduration_s = 3.0\n").unwrap();
+    let out = dir.path().join("res");
+    let mut child = start(&file, &out);
+    wait_for_lines(&out, 1, &mut child);
+    std::fs::remove_dir_all(&out).unwrap();
+    let status = crate::util::wait_bounded(&mut child, 120);
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(!status.success(), "{err}");
+    assert!(err.contains("removed or replaced while the sweep ran"), "{err}");
+}

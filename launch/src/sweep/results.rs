@@ -182,7 +182,29 @@ impl ResultWriter {
         self.file
             .write_all(text.as_bytes())
             .and_then(|_| self.file.flush())
-            .map_err(|cause| io(&self.path, cause))
+            .map_err(|cause| io(&self.path, cause))?;
+        self.check_still_there()
+    }
+
+    /// Whether the file written to is still the one at its path: a results
+    /// folder removed (or replaced) while the sweep ran once left every
+    /// result in an unlinked file and the sweep said "results in …".
+    fn check_still_there(&self) -> Result<(), SweepError> {
+        use std::os::unix::fs::MetadataExt;
+        let same = match (std::fs::metadata(&self.path), self.file.metadata()) {
+            (Ok(on_disk), Ok(open)) => on_disk.dev() == open.dev() && on_disk.ino() == open.ino(),
+            _ => false,
+        };
+        if same {
+            Ok(())
+        } else {
+            Err(SweepError::Folder {
+                dir: self.path.display().to_string(),
+                reason: "was removed or replaced while the sweep ran: the results written \
+                         since are lost (run the sweep again; it does only what is missing)"
+                    .into(),
+            })
+        }
     }
 }
 
