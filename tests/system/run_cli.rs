@@ -463,42 +463,59 @@ fn refused_realtime_scheduling_is_said_and_the_run_goes_on() {
     assert_eq!(json(&out)["steps"], 500);
 }
 
-/// Ctrl-Z then `fg` (every process stopped, then continued) is survived in
-/// real time: the run goes on and the gap shows as late wake-ups (#18 row 2).
-#[test]
-fn a_stopped_and_continued_realtime_run_goes_on() {
+/// Runs `testbed run ARGS --json`, stops and continues every process of the
+/// run `pauses` times (`stop` then `go` each), and returns the exit status
+/// and the summary. The sleeps are the stimulus, not waits; a pause after
+/// the run ended finds no process (ESRCH), which is ignored.
+fn run_with_pauses(
+    args: &[&str],
+    pauses: usize,
+    (stop, go): (Duration, Duration),
+) -> (std::process::ExitStatus, serde_json::Value, String) {
     let dir = tempfile::tempdir().unwrap();
     let mut launcher = testbed()
-        .args(["run", "--duration", "6", "--json", "--runs-dir"])
+        .arg("run")
+        .args(args)
+        .args(["--json", "--runs-dir"])
         .arg(dir.path())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
     let nodes = wait_for_nodes(launcher.id());
+    wait_until_running(dir.path());
     let mut pids: Vec<i32> = nodes.iter().map(|n| n.1 as i32).collect();
     pids.push(launcher.id() as i32);
-    // Five pauses: one lands inside a listener's wait, which a stop and
-    // continue interrupts (EINTR). The sleeps are the stimulus, not waits.
-    for _ in 0..5 {
+    for _ in 0..pauses {
         for p in &pids {
-            kill(Pid::from_raw(*p), Signal::SIGSTOP).unwrap();
+            let _ = kill(Pid::from_raw(*p), Signal::SIGSTOP);
         }
-        std::thread::sleep(Duration::from_millis(300));
+        std::thread::sleep(stop);
         for p in &pids {
-            kill(Pid::from_raw(*p), Signal::SIGCONT).unwrap();
+            let _ = kill(Pid::from_raw(*p), Signal::SIGCONT);
         }
-        std::thread::sleep(Duration::from_millis(200));
+        std::thread::sleep(go);
     }
-    let status = wait_bounded(&mut launcher, 60);
+    let status = wait_bounded(&mut launcher, 120);
     let mut out = String::new();
     std::io::Read::read_to_string(&mut launcher.stdout.take().unwrap(), &mut out).unwrap();
     let mut err = String::new();
     std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
+    let summary = serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {err}"));
+    (status, summary, err)
+}
+
+/// Ctrl-Z then `fg` (every process stopped, then continued) is survived in
+/// real time: the run goes on and the gap shows as late wake-ups (#18 row 2).
+/// Five pauses: one lands inside a listener's wait, which a stop and
+/// continue interrupts (EINTR).
+#[test]
+fn a_stopped_and_continued_realtime_run_goes_on() {
+    let pause = (Duration::from_millis(300), Duration::from_millis(200));
+    let (status, s, err) = run_with_pauses(&["--duration", "6"], 5, pause);
     // The pauses may degrade the verdict (late wake-ups, misses); the run
     // itself is whole.
     assert!(matches!(status.code(), Some(0 | 3)), "{err}");
-    let s: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(s["run_end"], "finished");
     assert_ne!(s["timing"]["verdict"], "invalid", "{s}");
     assert!(s["timing"]["late_wakeups"].as_u64().unwrap() > 0, "{s}");
@@ -509,45 +526,10 @@ fn a_stopped_and_continued_realtime_run_goes_on() {
 /// ("send (testbed/timing): InternalError") about one time in two.
 #[test]
 fn a_stopped_and_continued_lockstep_run_goes_on() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut launcher = testbed()
-        .args([
-            "run",
-            "--mode",
-            "lockstep",
-            "--duration",
-            "200",
-            "--json",
-            "--runs-dir",
-        ])
-        .arg(dir.path())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let nodes = wait_for_nodes(launcher.id());
-    wait_until_running(dir.path());
-    let mut pids: Vec<i32> = nodes.iter().map(|n| n.1 as i32).collect();
-    pids.push(launcher.id() as i32);
-    // Ten pauses; the sleeps are the stimulus, not waits. A pause after
-    // the run ended finds no process (ESRCH): ignored.
-    for _ in 0..10 {
-        for p in &pids {
-            let _ = kill(Pid::from_raw(*p), Signal::SIGSTOP);
-        }
-        std::thread::sleep(Duration::from_millis(100));
-        for p in &pids {
-            let _ = kill(Pid::from_raw(*p), Signal::SIGCONT);
-        }
-        std::thread::sleep(Duration::from_millis(150));
-    }
-    let status = wait_bounded(&mut launcher, 120);
-    let mut out = String::new();
-    std::io::Read::read_to_string(&mut launcher.stdout.take().unwrap(), &mut out).unwrap();
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut launcher.stderr.take().unwrap(), &mut err).unwrap();
+    let pause = (Duration::from_millis(100), Duration::from_millis(150));
+    let args = ["--mode", "lockstep", "--duration", "200"];
+    let (status, s, err) = run_with_pauses(&args, 10, pause);
     assert!(status.success(), "{err}");
-    let s: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(s["run_end"], "finished");
     assert_eq!(s["timing"]["verdict"], "clean", "{s}");
 }

@@ -244,7 +244,11 @@ fn a_results_folder_removed_mid_sweep_fails_the_sweep() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("long.toml");
     // Long enough (400 runs of 3 s) that the removal lands mid-sweep.
-    std::fs::write(&file, "name = \"long\"\nseeds = 400\n[set]\nduration_s = 3.0\n").unwrap();
+    std::fs::write(
+        &file,
+        "name = \"long\"\nseeds = 400\n[set]\nduration_s = 3.0\n",
+    )
+    .unwrap();
     let out = dir.path().join("res");
     let mut child = start(&file, &out);
     wait_for_lines(&out, 1, &mut child);
@@ -253,5 +257,8 @@ fn a_results_folder_removed_mid_sweep_fails_the_sweep() {
     let mut err = String::new();
     std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
     assert!(!status.success(), "{err}");
-    assert!(err.contains("removed or replaced while the sweep ran"), "{err}");
+    assert!(
+        err.contains("removed or replaced while the sweep ran"),
+        "{err}"
+    );
 }

@@ -30,22 +30,9 @@ pub use scenario::sweep_file::MAX_FILE_BYTES;
 /// Why a sweep could not be run or reported.
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
-    /// The sweep file is malformed or names an unknown key.
-    #[error("{file}: {reason}")]
-    File {
-        /// The sweep file.
-        file: String,
-        /// What is wrong.
-        reason: String,
-    },
-    /// A run's scenario is invalid.
-    #[error("{file}: {cause}")]
-    Scenario {
-        /// The sweep file.
-        file: String,
-        /// The cause.
-        cause: Box<scenario::ScenarioError>,
-    },
+    /// The sweep file cannot be used.
+    #[error(transparent)]
+    File(#[from] scenario::sweep_file::SweepFileError),
     /// A results folder cannot be used.
     #[error("{dir}: {reason}")]
     Folder {
@@ -65,17 +52,6 @@ pub enum SweepError {
     /// A bad option.
     #[error("{0}")]
     Options(String),
-}
-
-impl From<scenario::sweep_file::SweepFileError> for SweepError {
-    fn from(e: scenario::sweep_file::SweepFileError) -> Self {
-        use scenario::sweep_file::SweepFileError as F;
-        match e {
-            F::File { file, reason } => SweepError::File { file, reason },
-            F::Scenario { file, cause } => SweepError::Scenario { file, cause },
-            F::Io { path, cause } => SweepError::Io { path, cause },
-        }
-    }
 }
 
 /// Reads a file of at most [`MAX_FILE_BYTES`], refusing special files.
