@@ -9,11 +9,11 @@ use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
 fuzz_target!(|data: &[u8]| {
     let mut decode = |topic: &str, v: &[u8]| {
         let _ = match topic {
-            t if t == JointState::TOPIC => JointState::parse(v).map(|_| ()),
-            t if t == ReferenceSample::TOPIC => ReferenceSample::parse(v).map(|_| ()),
-            t if t == Command::TOPIC => Command::parse(v).map(|_| ()),
-            t if t == ControllerDiagnostics::TOPIC => ControllerDiagnostics::parse(v).map(|_| ()),
-            t if t == Timing::TOPIC => Timing::parse(v).map(|_| ()),
+            t if t == JointState::LOG_TOPIC => JointState::parse(v).map(|_| ()),
+            t if t == ReferenceSample::LOG_TOPIC => ReferenceSample::parse(v).map(|_| ()),
+            t if t == Command::LOG_TOPIC => Command::parse(v).map(|_| ()),
+            t if t == ControllerDiagnostics::LOG_TOPIC => ControllerDiagnostics::parse(v).map(|_| ()),
+            t if t == Timing::LOG_TOPIC => Timing::parse(v).map(|_| ()),
             _ => Ok(()),
         };
         Ok(())
