@@ -135,19 +135,23 @@ def compare_page() -> str:
         lines += [
             f"## `{name}`",
             "",
-            "| law | kept | IAE | max \\|e\\| | violation (whole run) | effort after T_c | ∫τ̇² | breaches | actor peak \\|τ\\| | finite |",
+            "| law | kept | IAE | max \\|e\\| | violation (whole run) | effort after T_c | ∫τ̇² | breaches | actor peak \\|τ\\| | failed |",
             "|---|---|---|---|---|---|---|---|---|---|",
         ]
         for law in c["laws"]:
             name_ = law["law"]["law"] + (" (URDF)" if law["law"]["model_based"] else "")
             m = law["worst"]
-            run = law["runs"][0]["summary"]
             kept = "yes" if law["kept_envelope"] else "**no**"
-            finite = "yes" if run["finite"] else "**no**"
+            why = law["runs"][0]["failed"]
+            failed = f"**failed**: {why}" if why else "no"
+            if why:
+                # A failed run's metrics count as the worst: shown as such.
+                lines.append(f"| {name_} | {kept} | – | – | – | – | – | – | – | {failed} |")
+                continue
             lines.append(
                 f"| {name_} | {kept} | {g(m['iae'])} | {g(m['max_abs_error'], 3)} | "
                 f"{g(m['violation_s'], 3)} s | {g(m['effort_after_tc'])} | {g(m['torque_rate'], 3)} | "
-                f"{int(m['breaches'])} | {g(m['peak_actor_torque'], 3)} | {finite} |"
+                f"{int(m['breaches'])} | {g(m['peak_actor_torque'], 3)} | {failed} |"
             )
         lines.append("")
     return "\n".join(lines)

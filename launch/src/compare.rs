@@ -87,6 +87,9 @@ pub struct LawRun {
     pub seed: u64,
     /// Why the run stopped early, if it did (the summary covers the steps before).
     pub failure: Option<String>,
+    /// Why the run failed, if it did ([`failed_because`]): a failed run's
+    /// metrics count as the worst, whatever their values.
+    pub failed: Option<String>,
     /// The run's summary, as `testbed sim --law` prints it.
     pub summary: Summary,
     /// Controller compute per step, µs.
@@ -325,10 +328,13 @@ fn run_inner(plan: &Plan, keep_series: bool, stop: &AtomicBool) -> (LawRun, bool
         }
         Ok(())
     });
+    let failure = result.err().map(|e| e.to_string());
+    let summary = summary.finish();
     let run = LawRun {
         seed: plan.scenario.seed,
-        failure: result.err().map(|e| e.to_string()),
-        summary: summary.finish(),
+        failed: failed_because(failure.as_deref(), &summary),
+        failure,
+        summary,
         compute_us: costs.controller_us.finish(),
         series,
     };
@@ -346,7 +352,40 @@ fn value(metric: &Metric, run: &LawRun) -> f64 {
     } else {
         f64::NEG_INFINITY
     };
+    if run.failed.is_some() {
+        // A faulted run's "effort 0" is not the best effort (#26).
+        return bad;
+    }
     (metric.get)(run).filter(|x| !x.is_nan()).unwrap_or(bad)
+}
+
+/// Barrier breaches a run may have and still count: a few steps of the
+/// guard acting are the law at work; more is a law fighting its barrier.
+pub const BREACHES_ALLOWED: u64 = 100;
+
+/// Why a run failed, if it did: it stopped early, went non-finite or
+/// faulted, breached its barrier more than [`BREACHES_ALLOWED`] steps, or
+/// left the envelope after T_c. (A run that ends before T_c is not judged
+/// on the constraint.)
+pub fn failed_because(failure: Option<&str>, s: &Summary) -> Option<String> {
+    let mut why = Vec::new();
+    if let Some(f) = failure {
+        why.push(format!("stopped: {f}"));
+    }
+    if !s.finite {
+        why.push(format!(
+            "non-finite signals or faults ({} fault steps)",
+            s.fault_steps
+        ));
+    }
+    if s.barrier_breached_steps > BREACHES_ALLOWED {
+        why.push(format!("{} barrier breaches", s.barrier_breached_steps));
+    }
+    let judged = s.joints.iter().any(|j| j.min_margin_after_tc.is_some());
+    if judged && !s.constraint_satisfied_after_tc {
+        why.push("left the envelope after T_c".into());
+    }
+    (!why.is_empty()).then(|| why.join("; "))
 }
 
 fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
@@ -365,8 +404,8 @@ fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
     }
     let kept = runs
         .iter()
-        .filter(|r| r.failure.is_none())
-        .filter(|r| r.summary.constraint_satisfied_after_tc && r.summary.finite)
+        .filter(|r| r.failed.is_none())
+        .filter(|r| r.summary.constraint_satisfied_after_tc)
         .count() as u64;
     LawRow {
         law,

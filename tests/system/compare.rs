@@ -241,3 +241,47 @@ fn bad_law_names_and_foreign_keys_are_named() {
         .args(["sim", "--duration", "0.1", "--law", "pd", "--scenario"])
         .arg(&f));
 }
+
+/// #26 item 1: a faulted run is a failure in the table, the JSON and the
+/// CSV, with its reason, and never scores as best (nac-no-shift on the
+/// per-input centres once showed "effort 0.0", the best of the table).
+#[test]
+fn a_faulted_run_is_a_failure_everywhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("c.csv");
+    let args = [
+        "compare",
+        "--scenario",
+        "paper_per_input",
+        "--laws",
+        "nac,nac-no-shift",
+    ];
+    let c = json(&ok(testbed().args(args).arg("--json")));
+    let laws = c["laws"].as_array().unwrap();
+    let why = laws[1]["runs"][0]["failed"].as_str().unwrap_or_default();
+    assert!(
+        why.contains("fault steps") && why.contains("left the envelope"),
+        "{why}"
+    );
+    assert!(laws[0]["runs"][0]["failed"].is_null());
+    assert!(
+        laws[1]["median"]["effort_after_tc"].is_null()
+            || laws[1]["median"]["effort_after_tc"]
+                .as_f64()
+                .is_none_or(f64::is_infinite)
+    );
+    let table = String::from_utf8(ok(testbed().args(args).arg("--csv").arg(&csv)).stdout).unwrap();
+    assert!(
+        table.contains("FAILED") && table.contains("nac-no-shift seed 0"),
+        "{table}"
+    );
+    let rows = std::fs::read_to_string(&csv).unwrap();
+    let shift = rows
+        .lines()
+        .find(|l| l.starts_with("nac-no-shift,"))
+        .unwrap();
+    assert!(
+        shift.starts_with("nac-no-shift,false,0,true,false,"),
+        "{shift}"
+    );
+}

@@ -164,6 +164,24 @@ pub(crate) fn table(c: &Comparison) -> String {
         "\nkept: runs with |e| < k_c for every t >= T_c; enter: when every joint was inside for good; \
          breach: steps the barrier's guard or the funnel's clamp acted"
     );
+    let failed: Vec<String> = c
+        .laws
+        .iter()
+        .flat_map(|l| {
+            l.runs.iter().filter_map(move |r| {
+                r.failed
+                    .as_ref()
+                    .map(|why| format!("  {} seed {}: {why}", l.law.law, r.seed))
+            })
+        })
+        .collect();
+    if !failed.is_empty() {
+        let _ = writeln!(
+            out,
+            "FAILED (their metrics count as the worst, never the best):\n{}",
+            failed.join("\n")
+        );
+    }
     out
 }
 
@@ -189,16 +207,14 @@ fn write_csv(w: &mut impl std::io::Write, c: &Comparison) -> std::io::Result<()>
                     }
                 })
                 .collect();
-            let kept = run.failure.is_none()
-                && run.summary.constraint_satisfied_after_tc
-                && run.summary.finite;
+            let kept = run.failed.is_none() && run.summary.constraint_satisfied_after_tc;
             writeln!(
                 w,
                 "{},{},{},{},{},{}",
                 row.law.law,
                 row.law.model_based,
                 run.seed,
-                run.failure.is_some(),
+                run.failed.is_some(),
                 kept,
                 values.join(",")
             )?;
