@@ -8,6 +8,7 @@ mod leftovers;
 mod live;
 mod liveness;
 mod log_replay;
+mod many_joints;
 mod python;
 mod realtime_integrity;
 mod replace_nodes;

@@ -32,6 +32,17 @@ pub fn describe(path: &Path) -> Result<String> {
         cause,
     })?;
     default_scenario(&mut out, &d);
+    let controlled = d.gains.joints.len();
+    if controlled > wire::MAX_DOF {
+        // Described all the same: the joint list is what the user needs to
+        // choose which joints to lock.
+        let _ = writeln!(
+            out,
+            "\nwarning: {controlled} controlled joints; the wire carries at most {}: sim and run refuse this arm until {} joints are locked in [plant.lock]",
+            wire::MAX_DOF,
+            controlled - wire::MAX_DOF
+        );
+    }
     Ok(out)
 }
 
