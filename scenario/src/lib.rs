@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 use trajectory::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError};
 
 pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
-pub use default_for_arm::ArmDefault;
+pub use default_for_arm::{ArmDefault, GRIPPER_LOCK};
 pub use gains::{GainChoice, JointGain};
 pub use plan::{Overrides, Plan, load, plan};
 pub use probe::Probe;

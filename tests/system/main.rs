@@ -5,6 +5,7 @@
 mod compare;
 mod hardening;
 mod leftovers;
+mod light_arms;
 mod live;
 mod liveness;
 mod log_replay;
