@@ -94,8 +94,12 @@ pub(super) fn declare_undeclared(text: &str) -> (Cow<'_, str>, Vec<String>) {
                 }
             }
             if j == a0 {
-                // A stray character: step over it rather than loop.
+                // A stray character: step over it (whole, never into a
+                // UTF-8 sequence) rather than loop.
                 j += 1;
+                while j < b.len() && !text.is_char_boundary(j) {
+                    j += 1;
+                }
             }
         }
         i = j.min(b.len());
@@ -132,6 +136,20 @@ fn note_prefix<'a>(name: &'a str, used: &mut BTreeSet<&'a str>) {
 mod tests {
     use super::*;
 
+    proptest::proptest! {
+        /// Any text, markup-like or not: no panic, and only prefixes the
+        /// text really has are declared.
+        #[test]
+        fn any_text_is_scanned_without_panic(text in "[<>/='\" a-zé:!?-]{0,80}") {
+            let (out, added) = declare_undeclared(&text);
+            for p in &added {
+                let used = format!("{p}:");
+                proptest::prop_assert!(text.contains(&used), "{} not in {}", used, text);
+            }
+            proptest::prop_assert!(out.len() >= text.len());
+        }
+    }
+
     #[test]
     fn undeclared_prefixes_are_declared_on_the_root_only() {
         let text = r#"<?xml version="1.0"?>
@@ -144,6 +162,20 @@ mod tests {
         let (out, added) = declare_undeclared(text);
         assert_eq!(added, ["drake", "gz"]);
         assert!(out.contains(r#"<robot xmlns:drake="urn:testbed:undeclared:drake" xmlns:gz="urn:testbed:undeclared:gz" name="r""#), "{out}");
+        // Not XML, or cut short, or not ASCII: no panic, and nothing added
+        // that was not used.
+        for odd in [
+            "<",
+            "<a b=",
+            "<a b='x",
+            "<é:x/>",
+            "<a é=\"1\" /é>",
+            "<!--",
+            "<a/><b:c",
+        ] {
+            let (_, added) = declare_undeclared(odd);
+            assert!(added.len() <= 1, "{odd}: {added:?}");
+        }
         // Nothing to add: the text is untouched.
         let plain = r#"<robot name="r"><link name="a"/></robot>"#;
         let (out, added) = declare_undeclared(plain);
