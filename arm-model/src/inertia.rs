@@ -10,6 +10,11 @@ use crate::ModelError;
 /// negligible: real URDFs use 1e-9 kg for frames that are not bodies.
 pub(super) const NEGLIGIBLE_MASS_RATIO: f64 = 1e-6;
 
+/// A link lighter than this fraction of the heaviest moving link whose
+/// inertia is malformed is a placeholder, taken as massless (said) rather
+/// than refused.
+pub(super) const PLACEHOLDER_MASS_RATIO: f64 = 1e-2;
+
 /// The rigid transform of a URDF `<origin>`.
 pub fn iso(o: &Origin) -> Isometry3<f64> {
     Isometry3::from_parts(
@@ -94,14 +99,14 @@ pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Option<String>, 
     let scale = ev[2].abs().max(f64::MIN_POSITIVE);
     if ev[0] < -1e-9 * scale {
         return bad(format!(
-            "the inertia tensor is not positive semi-definite (principal moments {:.3e}, {:.3e}, {:.3e})",
+            "the inertia tensor is not positive semi-definite (principal moments {:.3e}, {:.3e}, {:.3e}): correct the tensor (its diagonal, and off-diagonal terms smaller than the moments they join)",
             ev[0], ev[1], ev[2]
         ));
     }
     let short = (ev[2] - ev[0] - ev[1]) / scale;
     if short > TRIANGLE_SLACK {
         return bad(format!(
-            "principal moments {:.3e}, {:.3e}, {:.3e} break the triangle inequality",
+            "principal moments {:.3e}, {:.3e}, {:.3e} break the triangle inequality (the largest must not exceed the sum of the other two): correct the tensor, or give a placeholder link mass 0",
             ev[0], ev[1], ev[2]
         ));
     }

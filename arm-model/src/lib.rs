@@ -11,7 +11,11 @@
 //! the format is in practice: a link of zero or negligible mass contributes
 //! nothing whatever inertia it lists, the fixed root's mass properties are
 //! irrelevant, `<mimic>` joints become coupled joints, and joints a scenario
-//! locks become fixed ones.
+//! locks become fixed ones. Undeclared XML namespace prefixes are read as
+//! declared, a joint hanging from an undefined `world` link hangs from the
+//! fixed world, and a placeholder link (under 1 % of the heaviest link's
+//! mass) whose inertia is malformed is taken as massless; each is said in
+//! [`ArmModel::notes`] or [`ArmModel::ignored`].
 //!
 //! ```
 //! use arm_model::{ArmModel, TWO_LINK_URDF, dynamics::Dynamics};
@@ -25,6 +29,7 @@ pub mod dynamics;
 mod error;
 mod inertia;
 mod parse;
+mod prefixes;
 mod tree;
 
 use std::collections::BTreeMap;
@@ -223,9 +228,24 @@ impl ArmModel {
     /// Parses and checks a URDF document with the joints in `locks` held
     /// at the given positions.
     pub fn from_urdf_str_locked(text: &str, locks: &Locks) -> Result<Self, ModelError> {
+        let (text, undeclared) = prefixes::declare_undeclared(text);
         let robot =
-            urdf_rs::read_from_string(text).map_err(|e| ModelError::Parse(e.to_string()))?;
-        tree::build(&robot, locks)
+            urdf_rs::read_from_string(&text).map_err(|e| ModelError::Parse(e.to_string()))?;
+        let mut model = tree::build(&robot, locks)?;
+        if !undeclared.is_empty() {
+            model.notes.insert(
+                0,
+                format!(
+                    "XML namespace prefix {} used without an xmlns declaration: read as declared (what it marks is ignored, as other URDF readers do)",
+                    undeclared
+                        .iter()
+                        .map(|p| format!("'{p}'"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            );
+        }
+        Ok(model)
     }
 
     /// The link called `name` (a merged one too): the index of the body it

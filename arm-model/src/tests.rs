@@ -303,3 +303,86 @@ fn link_poses_place_the_two_link_arm_as_drawn() {
     assert!((tip - Point3::new(0.31, 0.0, 0.35)).norm() < 1e-12, "{tip}");
     assert_eq!(poses[m.root], nalgebra::Isometry3::identity());
 }
+
+/// Issue 27: what Pinocchio and MuJoCo read, this reads too, and says so.
+#[test]
+fn an_undeclared_namespace_prefix_is_read_as_declared() {
+    let limit =
+        r#"<limit lower="-1" upper="1" effort="10" velocity="1" drake:acceleration="8.0"/>"#;
+    let j = J1
+        .replace(
+            r#"<limit lower="-1" upper="1" effort="10" velocity="1"/>"#,
+            limit,
+        )
+        .replace("</joint>", "<drake:rotor_inertia value=\"0.1\"/></joint>");
+    let m = ArmModel::from_urdf_str(&arm(&j, "")).unwrap();
+    assert_eq!(m.joint_names(), ["j1"]);
+    assert_eq!(m.joints[m.actuated[0]].effort, Some(10.0));
+    assert!(
+        m.notes[0].contains("prefix 'drake' used without an xmlns declaration"),
+        "{:?}",
+        m.notes
+    );
+    // Declared: no note.
+    let declared = arm(&j, "").replace(
+        "<robot name=\"t\">",
+        "<robot name=\"t\" xmlns:drake=\"http://drake.mit.edu\">",
+    );
+    assert!(ArmModel::from_urdf_str(&declared).unwrap().notes.is_empty());
+}
+
+/// A Drake-style root joint from an undefined `world` link: the world is
+/// the fixed root, said in a note; a fixed weld folds the base into it.
+#[test]
+fn a_world_parent_without_a_world_link_is_the_fixed_root() {
+    let weld =
+        r#"<joint name="weld" type="fixed"><parent link="world"/><child link="base"/></joint>"#;
+    let m = ArmModel::from_urdf_str(&arm(&format!("{weld}{J1}"), "")).unwrap();
+    assert_eq!(m.links[m.root].name, "world");
+    assert_eq!(m.joint_names(), ["j1"]);
+    assert!(
+        m.notes.iter().any(
+            |n| n.contains("joint 'weld' hangs from link 'world'") && n.contains("fixed world")
+        ),
+        "{:?}",
+        m.notes
+    );
+    // A revolute first joint from the world moves too.
+    let from_world = J1.replace("<parent link=\"base\"/>", "<parent link=\"world\"/>");
+    let text = arm(&from_world, "").replace("<link name=\"base\"/>", "");
+    let m = ArmModel::from_urdf_str(&text).unwrap();
+    assert_eq!((m.links[m.root].name.as_str(), m.dof()), ("world", 1));
+    // Another missing parent is still an error, naming it.
+    let ghost = J1.replace("<parent link=\"base\"/>", "<parent link=\"ghost\"/>");
+    assert_eq!(
+        err(&arm(&ghost, "")),
+        "joint 'j1': parent link 'ghost' does not exist"
+    );
+}
+
+/// A 3.8 g fingertip with moments (0, 0, 1e-6), which no body has, on a
+/// 1 kg arm: a placeholder, taken as massless and listed; the same tensor
+/// on a link of real mass is refused, naming the link and the remedy.
+#[test]
+fn a_placeholder_link_with_malformed_inertia_is_massless() {
+    let bad = r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="1e-6""#;
+    let jb = J1.replace("j1", "tip_joint").replace("\"a\"", "\"tip\"");
+    let jb = jb.replace("<parent link=\"base\"/>", "<parent link=\"a\"/>");
+    let text = arm(&format!("{J1}{jb}"), &link("tip", "0.0038", bad));
+    let m = ArmModel::from_urdf_str(&text).unwrap();
+    assert_eq!(m.ignored.len(), 1, "{:?}", m.ignored);
+    assert_eq!(m.ignored[0].name, "tip");
+    assert!(
+        m.ignored[0].reason.contains("placeholder") && m.ignored[0].reason.contains("massless"),
+        "{}",
+        m.ignored[0].reason
+    );
+    assert_eq!(m.joints_moving_no_mass(), ["tip_joint"]);
+    let heavy = arm(&format!("{J1}{jb}"), &link("tip", "0.5", bad));
+    let e = err(&heavy);
+    assert!(
+        e.starts_with("link 'tip': principal moments")
+            && e.contains("give a placeholder link mass 0"),
+        "{e}"
+    );
+}

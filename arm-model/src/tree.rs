@@ -5,7 +5,9 @@ use std::collections::HashMap;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use super::inertia::{NEGLIGIBLE_MASS_RATIO, check_inertia, iso, merge_mass, origin_of};
+use super::inertia::{
+    NEGLIGIBLE_MASS_RATIO, PLACEHOLDER_MASS_RATIO, check_inertia, iso, merge_mass, origin_of,
+};
 use super::parse::{joint_info, link_info};
 use super::{
     ArmModel, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks, MergedLink,
@@ -37,6 +39,24 @@ pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, M
     if links.is_empty() {
         return Err(ModelError::NoLinks);
     }
+    let mut notes = Vec::new();
+    // Drake and Gazebo models weld their base to a `world` they never
+    // define; that world is the fixed root every other reader assumes.
+    if !index.contains_key(WORLD)
+        && let Some(j) = robot.joints.iter().find(|j| j.parent.link == WORLD)
+    {
+        index.insert(WORLD.to_string(), links.len());
+        links.push(LinkInfo {
+            name: WORLD.to_string(),
+            mass: 0.0,
+            inertial_origin: super::Origin::default(),
+            inertia: [0.0; 6],
+        });
+        notes.push(format!(
+            "joint '{}' hangs from link '{WORLD}', which the URDF does not define: taken as the fixed world (the root)",
+            j.name
+        ));
+    }
     let mut joints = Vec::with_capacity(robot.joints.len());
     let mut parent_of: Vec<Option<usize>> = vec![None; links.len()];
     let mut joint_names = HashMap::new();
@@ -62,12 +82,16 @@ pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, M
     depth_first(&links, &joints, root)?;
     let leaders = resolve_mimics(&joints)?;
     let locked = apply_locks(&mut joints, &leaders, locks)?;
-    let (ignored, notes) = settle_masses(&mut links, &joints, root)?;
+    let (ignored, inertia_notes) = settle_masses(&mut links, &joints, root)?;
+    notes.extend(inertia_notes);
     let folded = merge_fixed(links, joints);
     let mut model = finish(robot.name.clone(), folded, &leaders, locked, ignored)?;
     model.notes = notes;
     Ok(model)
 }
+
+/// The link a fixed-base model's root joint conventionally hangs from.
+const WORLD: &str = "world";
 
 fn find_root(links: &[LinkInfo], joints: &[JointInfo]) -> Result<usize, ModelError> {
     let mut has_parent = vec![false; links.len()];
@@ -301,7 +325,28 @@ fn settle_masses(
             l.inertia = [0.0; 6];
             continue;
         }
-        notes.extend(check_inertia(&l.name, &l.inertia)?);
+        match check_inertia(&l.name, &l.inertia) {
+            Ok(note) => notes.extend(note),
+            // A placeholder (a fingertip frame of a few grams) with a
+            // tensor no body has: what it adds is below what the arm's
+            // own rounding moves, so it is dropped rather than refused.
+            Err(ModelError::BadInertia { reason, .. })
+                if l.mass < PLACEHOLDER_MASS_RATIO * heaviest =>
+            {
+                ignored.push(IgnoredLink {
+                    name: l.name.clone(),
+                    mass: l.mass,
+                    reason: format!(
+                        "a placeholder ({:e} kg, under {} % of the heaviest link's {heaviest} kg) whose inertia is malformed ({reason}): treated as massless",
+                        l.mass,
+                        100.0 * PLACEHOLDER_MASS_RATIO
+                    ),
+                });
+                l.mass = 0.0;
+                l.inertia = [0.0; 6];
+            }
+            Err(e) => return Err(e),
+        }
     }
     Ok((ignored, notes))
 }

@@ -74,6 +74,12 @@ pub enum ControllerError {
     /// Zero joints.
     #[error("the controller needs at least one joint")]
     NoJoints,
+    /// More joints than the wire's messages carry.
+    #[error(
+        "the controller was given {0} joints; the wire carries at most {max} (lock the others in [plant.lock])",
+        max = wire::MAX_DOF
+    )]
+    TooManyJoints(usize),
     /// A key set that the chosen law does not take.
     #[error("{key} is not a parameter of law '{law}' (it takes {takes})")]
     NotAParameter {

@@ -26,6 +26,10 @@ impl ControllerMachine {
         period_ns: u64,
         model: Option<&ArmModel>,
     ) -> Result<Self, ControllerError> {
+        // `step` slices the wire's fixed arrays to `dof`.
+        if dof > wire::MAX_DOF {
+            return Err(ControllerError::TooManyJoints(dof));
+        }
         let law = Law::new(params, dof, model)?;
         Ok(Self {
             diag: Diagnostics::new(dof),

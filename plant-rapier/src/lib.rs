@@ -88,6 +88,12 @@ pub enum PlantError {
         /// Entries given.
         got: usize,
     },
+    /// More controlled joints than the wire's messages carry.
+    #[error(
+        "the arm has {0} controlled joints; the wire carries at most {max}: lock the others in [plant.lock]",
+        max = wire::MAX_DOF
+    )]
+    TooManyJoints(usize),
     /// A plant setting out of range.
     #[error("{key} = {value} is invalid: it must be {need}")]
     InvalidConfig {

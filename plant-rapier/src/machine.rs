@@ -34,6 +34,10 @@ impl PlantMachine {
         steps: u64,
         (q0, qd0): (&[f64], &[f64]),
     ) -> Result<Self, PlantError> {
+        // A state carries at most MAX_DOF joints; more would be cut off.
+        if model.dof() > MAX_DOF {
+            return Err(PlantError::TooManyJoints(model.dof()));
+        }
         let mut rig = Rig::new(model, config, seed, period_ns)?;
         rig.set_state(q0, qd0)?;
         let n = rig.dof();

@@ -146,8 +146,9 @@ fn dry_friction_holds_below_its_level_and_slips_above_it() {
     }
 }
 
-/// The substep bound: a damped light link would make one RK4 step per
-/// millisecond unstable; the engine takes more and stays bounded.
+/// A damped light link would make one explicit RK4 step per millisecond
+/// unstable; its damping is integrated exactly, so one step per period
+/// stays bounded.
 #[test]
 fn stiff_damping_stays_stable() {
     let model = ArmModel::from_urdf_str(ARMS[5].1).unwrap();

@@ -11,7 +11,7 @@ matches the Rust types, and importing it checks every size and offset.
 # fmt: off
 import ctypes
 
-MAX_DOF = 12  # joints a message carries
+MAX_DOF = 32  # joints a message carries
 SUBSCRIBER_BUFFER = 2048  # samples a subscriber holds
 MAX_SUBSCRIBERS = 4  # subscribers (and listeners) per topic
 MAX_NODES = 10  # nodes per service
@@ -73,14 +73,14 @@ class JointState(ctypes.Structure):
         ("command_seq", ctypes.c_uint64),
         ("applied_wall_ns", ctypes.c_uint64),
     ]
-    SIZE = 640
+    SIZE = 1600
     ALIGN = 8
-    OFFSETS = {"header": 0, "dof": 24, "flags": 28, "q": 32, "qd": 128, "q_measured": 224, "qd_measured": 320, "tau_applied": 416, "disturbance": 512, "effects": 608, "reserved": 612, "deadline_misses": 616, "command_seq": 624, "applied_wall_ns": 632}
+    OFFSETS = {"header": 0, "dof": 24, "flags": 28, "q": 32, "qd": 288, "q_measured": 544, "qd_measured": 800, "tau_applied": 1056, "disturbance": 1312, "effects": 1568, "reserved": 1572, "deadline_misses": 1576, "command_seq": 1584, "applied_wall_ns": 1592}
     JOINT_FIELDS = ("q", "qd", "q_measured", "qd_measured", "tau_applied", "disturbance")
 
     @staticmethod
     def type_name() -> str:
-        return "testbed.JointState.v3"
+        return "testbed.JointState.v4"
 
 
 class ReferenceSample(ctypes.Structure):
@@ -94,14 +94,14 @@ class ReferenceSample(ctypes.Structure):
         ("kc", ctypes.c_double * MAX_DOF),
         ("kc_dot", ctypes.c_double * MAX_DOF),
     ]
-    SIZE = 512
+    SIZE = 1312
     ALIGN = 8
-    OFFSETS = {"header": 0, "dof": 24, "reserved": 28, "q_d": 32, "qd_d": 128, "qdd_d": 224, "kc": 320, "kc_dot": 416}
+    OFFSETS = {"header": 0, "dof": 24, "reserved": 28, "q_d": 32, "qd_d": 288, "qdd_d": 544, "kc": 800, "kc_dot": 1056}
     JOINT_FIELDS = ("q_d", "qd_d", "qdd_d", "kc", "kc_dot")
 
     @staticmethod
     def type_name() -> str:
-        return "testbed.Reference.v1"
+        return "testbed.Reference.v2"
 
 
 class Command(ctypes.Structure):
@@ -116,14 +116,14 @@ class Command(ctypes.Structure):
         ("reference_t_ns", ctypes.c_uint64),
         ("stale_references", ctypes.c_uint64),
     ]
-    SIZE = 168
+    SIZE = 328
     ALIGN = 8
-    OFFSETS = {"header": 0, "dof": 24, "fault": 28, "tau": 32, "state_wall_ns": 128, "compute_ns": 136, "started_wall_ns": 144, "reference_t_ns": 152, "stale_references": 160}
+    OFFSETS = {"header": 0, "dof": 24, "fault": 28, "tau": 32, "state_wall_ns": 288, "compute_ns": 296, "started_wall_ns": 304, "reference_t_ns": 312, "stale_references": 320}
     JOINT_FIELDS = ("tau",)
 
     @staticmethod
     def type_name() -> str:
-        return "testbed.Command.v2"
+        return "testbed.Command.v3"
 
 
 class ControllerDiagnostics(ctypes.Structure):
@@ -158,14 +158,14 @@ class ControllerDiagnostics(ctypes.Structure):
         ("tau_model", ctypes.c_double * MAX_DOF),
         ("wa_norm", ctypes.c_double * MAX_DOF),
     ]
-    SIZE = 1728
+    SIZE = 4448
     ALIGN = 8
-    OFFSETS = {"header": 0, "dof": 24, "fault": 28, "barrier_breached": 32, "reserved": 36, "compute_ns": 40, "gamma": 48, "gamma_dot": 56, "j_hat": 64, "delta": 72, "r": 80, "wc_norm": 88, "q_d": 96, "qd_d": 192, "qdd_d": 288, "kc_in": 384, "kc_dot": 480, "z1": 576, "z1g": 672, "z2": 768, "alpha": 864, "kc": 960, "d": 1056, "tau": 1152, "tau_actor": 1248, "tau_feedback": 1344, "tau_barrier": 1440, "tau_model": 1536, "wa_norm": 1632}
+    OFFSETS = {"header": 0, "dof": 24, "fault": 28, "barrier_breached": 32, "reserved": 36, "compute_ns": 40, "gamma": 48, "gamma_dot": 56, "j_hat": 64, "delta": 72, "r": 80, "wc_norm": 88, "q_d": 96, "qd_d": 352, "qdd_d": 608, "kc_in": 864, "kc_dot": 1120, "z1": 1376, "z1g": 1632, "z2": 1888, "alpha": 2144, "kc": 2400, "d": 2656, "tau": 2912, "tau_actor": 3168, "tau_feedback": 3424, "tau_barrier": 3680, "tau_model": 3936, "wa_norm": 4192}
     JOINT_FIELDS = ("q_d", "qd_d", "qdd_d", "kc_in", "kc_dot", "z1", "z1g", "z2", "alpha", "kc", "d", "tau", "tau_actor", "tau_feedback", "tau_barrier", "tau_model", "wa_norm")
 
     @staticmethod
     def type_name() -> str:
-        return "testbed.ControllerDiagnostics.v2"
+        return "testbed.ControllerDiagnostics.v3"
 
 
 class Timing(ctypes.Structure):

@@ -6,13 +6,20 @@
 //! middle of its range, an envelope of about 0.25 rad, an initial state
 //! outside the envelope so the deferred constraint is exercised, and gains
 //! K1_i, K2_i chosen from what the plant reports (the controller itself
-//! still gets no model; see [`crate::gains`]).
+//! still gets no model; see [`crate::gains`]). A joint no gain holds at the
+//! rate against the barrier term (a feather-light link) gets armature, or is
+//! locked if it moves under 1 % of the arm's mass; [`ArmDefault`] says which
+//! and why, with any gravity load beyond an effort limit.
 
-use plant_rapier::{ArmModel, JointKind, Locks, PlantError};
+use plant_rapier::{ArmModel, JointKind, Locks, PerJoint, PlantError};
 use trajectory::{EnvelopeConfig, ReferenceConfig, Sinusoid};
 
 use crate::gains::{GainChoice, choose_gains};
+use crate::probe::Probe;
 use crate::{Initial, Scenario};
+
+/// Why a gripper or finger joint is locked (the start of its reason).
+pub const GRIPPER_LOCK: &str = "a gripper or finger joint: the controller drives the arm";
 
 /// Joint names that mark a gripper or a finger (compared in lower case).
 const GRIPPER_WORDS: [&str; 6] = ["finger", "gripper", "grip", "hand", "jaw", "claw"];
@@ -24,8 +31,13 @@ pub struct ArmDefault {
     pub scenario: Scenario,
     /// Joints the scenario locks, with the reason.
     pub locked: Vec<(String, String)>,
+    /// Armature the scenario adds per joint (kg m² or kg), with the reason.
+    pub armature: Vec<(String, f64, String)>,
     /// The gains and the reasons for them.
     pub gains: GainChoice,
+    /// What a user should know: loads beyond effort limits, joints the
+    /// scenario could not hold, envelopes it widened.
+    pub warnings: Vec<String>,
 }
 
 /// Whether a joint's name says it belongs to a gripper or a hand.
@@ -47,7 +59,7 @@ fn default_locks(full: &ArmModel) -> Vec<(String, f64, String)> {
     for &ji in &full.actuated {
         let j = &full.joints[ji];
         let why = if is_gripper(&j.name) {
-            "a gripper or finger joint: the controller drives the arm"
+            GRIPPER_LOCK
         } else if massless.contains(&j.name) {
             "it moves no mass, so its acceleration is undefined"
         } else {
@@ -127,11 +139,73 @@ fn shape(
     (reference, envelope, q0)
 }
 
+/// A joint that moves less than this fraction of the arm's moving mass is a
+/// placeholder: where no gain holds it, it is locked rather than given
+/// armature.
+const PLACEHOLDER_FRACTION: f64 = 0.01;
+
+/// How many times the default scenario is re-chosen after adding armature
+/// or locking a joint no gain holds.
+const ADJUSTMENTS: usize = 4;
+
 impl ArmDefault {
     /// The default scenario for the arm in `urdf` (see the module docs).
     pub fn new(urdf: &str) -> Result<Self, PlantError> {
         let full = ArmModel::from_urdf_str(urdf)?;
-        let chosen = default_locks(&full);
+        let mut chosen = default_locks(&full);
+        let mut armature: Vec<(String, f64, String)> = Vec::new();
+        let mut attempt = 0;
+        loop {
+            let (d, model) = Self::attempt(urdf, &chosen, &armature)?;
+            let unheld = d.gains.unheld();
+            attempt += 1;
+            if unheld.is_empty() || attempt > ADJUSTMENTS {
+                return Ok(d);
+            }
+            // Lock placeholders, give the others armature; then choose again.
+            let controlled = model.dof();
+            let mut locked_now = 0;
+            for i in unheld {
+                let g = &d.gains.joints[i];
+                let ji = model.actuated[i];
+                let moved = model.subtree_mass(model.joints[ji].child);
+                let need = g.armature_needed.unwrap_or(0.0);
+                if moved < PLACEHOLDER_FRACTION * full.moving_mass() && locked_now + 1 < controlled
+                {
+                    locked_now += 1;
+                    chosen.push((
+                        g.name.clone(),
+                        lock_position(model.joints[ji].limits),
+                        format!(
+                            "a placeholder ({moved:.2e} kg moved, under {} % of the arm) that no gain holds at {} Hz against the barrier term (max M⁻¹_ii {:.3e}; it would need armature {need:.2e})",
+                            100.0 * PLACEHOLDER_FRACTION,
+                            d.scenario.rate_hz,
+                            g.minv_diag
+                        ),
+                    ));
+                } else if let Some(a) = armature.iter_mut().find(|(n, ..)| *n == g.name) {
+                    a.1 += need;
+                } else {
+                    armature.push((
+                        g.name.clone(),
+                        need,
+                        format!(
+                            "no gain holds it at {} Hz against the barrier term (max M⁻¹_ii {:.3e}, K_b Δt/K2 = {:.2} at the widest envelope its range allows); real motors add armature, URDFs omit it",
+                            d.scenario.rate_hz, g.minv_diag, g.barrier
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+
+    /// One choice of the default scenario with `chosen` locked and
+    /// `armature` added: the scenario and the model it runs.
+    fn attempt(
+        urdf: &str,
+        chosen: &[(String, f64, String)],
+        armature: &[(String, f64, String)],
+    ) -> Result<(Self, ArmModel), PlantError> {
         let lock: Locks = chosen.iter().map(|(n, p, _)| (n.clone(), *p)).collect();
         let model = ArmModel::from_urdf_str_locked(urdf, &lock)?;
         let offsets = crate::posture::choose(&model)?;
@@ -156,6 +230,19 @@ impl ArmDefault {
             ..Scenario::default()
         };
         s.plant.lock = lock;
+        let per_joint: Vec<f64> = model
+            .joint_names()
+            .iter()
+            .map(|name| {
+                armature
+                    .iter()
+                    .find(|(n, ..)| n == name)
+                    .map_or(0.0, |a| a.1)
+            })
+            .collect();
+        if per_joint.iter().any(|a| *a > 0.0) {
+            s.plant.armature = PerJoint::Each(per_joint.clone());
+        }
         let gains = choose_gains(&model, &s, &kc_cap(&model))?;
         let (_, envelope, q0) = shape(&model, &offsets, Some(&gains.envelope));
         s.envelope.joints = envelope;
@@ -163,12 +250,59 @@ impl ArmDefault {
         s.rate_hz = gains.rate_hz;
         s.controller.k1 = controller::Gain::Each(gains.joints.iter().map(|g| g.k1).collect());
         s.controller.k2 = controller::Gain::Each(gains.joints.iter().map(|g| g.k2).collect());
-        Ok(Self {
+        let warnings = warnings(&model, &offsets, &per_joint, &gains)?;
+        let d = Self {
             scenario: s,
-            locked: chosen.into_iter().map(|(n, _, why)| (n, why)).collect(),
+            locked: chosen
+                .iter()
+                .map(|(n, _, why)| (n.clone(), why.clone()))
+                .collect(),
+            armature: armature
+                .iter()
+                .map(|(n, a, why)| (n.clone(), *a, why.clone()))
+                .collect(),
             gains,
-        })
+            warnings,
+        };
+        Ok((d, model))
     }
+}
+
+/// What `testbed robot` should say about the default scenario beyond its
+/// numbers: gravity beyond a motor's effort at the posture the reference
+/// swings about, joints no gain holds, envelopes widened.
+fn warnings(
+    model: &ArmModel,
+    offsets: &[f64],
+    armature: &[f64],
+    gains: &GainChoice,
+) -> Result<Vec<String>, PlantError> {
+    let mut out = Vec::new();
+    let probe = Probe::at(model, offsets, armature)?;
+    for (i, &ji) in model.actuated.iter().enumerate() {
+        let j = &model.joints[ji];
+        let g = probe.gravity[i].abs();
+        if let Some(e) = j.effort
+            && g > e
+        {
+            out.push(format!(
+                "joint '{}': gravity alone loads it with {g:.1} N m at the default posture, beyond its effort limit {e} N m: it cannot hold the arm up and every step will saturate (check the URDF's masses and effort limits, or set [plant] effort_limit)",
+                j.name
+            ));
+        }
+    }
+    for j in &gains.joints {
+        if let Some(a) = j.armature_needed {
+            out.push(format!(
+                "joint '{}': no gain holds it at {} Hz against the barrier term even with the armature added (it needs {a:.2e} more); lock it in [plant.lock] or raise rate_hz",
+                j.name, gains.rate_hz
+            ));
+        }
+        if let Some(why) = &j.envelope_reason {
+            out.push(format!("joint '{}': envelope widened for {why}", j.name));
+        }
+    }
+    Ok(out)
 }
 
 impl Scenario {

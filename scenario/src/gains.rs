@@ -10,6 +10,17 @@
 //! at most 0.2/Δt so that the position loop stays well inside the velocity
 //! loop; where that is not enough the joint's envelope is widened, as far
 //! as its range allows. Only if some joint needs more is the rate raised.
+//!
+//! The barrier term γ Z1γ/(β D) of the law (SPEC §7) is a position gain of
+//! its own, K_b = γ²(k_c² + Z1γ²)/(β (k_c² − Z1γ²)²), which K1 and K2 do
+//! not scale. The sampled loop of a joint with velocity gain K2 and total
+//! position gain K1 K2 + K_b is stable while K1 Δt + K_b Δt/K2 < 2 (Jury's
+//! test on the double integrator with a zero-order hold; M⁻¹ cancels). On a
+//! feather-light joint K2 is tiny, so K_b alone can break it: the envelope
+//! is widened until K_b Δt/K2 ≤ 1 out to |Z1γ| = 0.8 k_c, and where its range
+//! does not allow that, the joint is reported (`armature`) for the default
+//! scenario to add armature or lock it. The shifting term a γ̇² … of α adds
+//! K2-scaled stiffness of order a (3/T_c)²/β, under 1e-2 of the budget.
 
 use plant_rapier::{ArmModel, PlantError};
 
@@ -28,6 +39,22 @@ const K1_MIN: f64 = 15.0;
 const MAX_RATE_HZ: f64 = 10_000.0;
 /// Postures probed along the reference.
 const POSTURES: usize = 12;
+/// How far into the envelope the loop must stay stable with the barrier
+/// term: |Z1γ| up to this fraction of k_c (the steady error aimed for is 0.4).
+const BARRIER_EDGE: f64 = 0.8;
+/// The barrier's share of the sampled loop's stability budget of 2
+/// (K1 Δt ≤ 0.2 takes another share).
+const BARRIER_BUDGET: f64 = 1.0;
+/// Armature added beyond the bare need, for the coupling and the postures
+/// between those probed.
+const ARMATURE_MARGIN: f64 = 1.25;
+
+/// (k_c² + x²)/(k_c² − x²)² · k_c² at x = [`BARRIER_EDGE`] k_c: the barrier's
+/// stiffness there is this over β k_c² (γ = 1).
+fn barrier_factor() -> f64 {
+    let f2 = BARRIER_EDGE * BARRIER_EDGE;
+    (1.0 + f2) / ((1.0 - f2) * (1.0 - f2))
+}
 
 /// One joint's gains and the numbers they come from.
 #[derive(Debug, Clone)]
@@ -46,6 +73,14 @@ pub struct JointGain {
     pub effort: Option<f64>,
     /// Why K1_i is what it is.
     pub k1_reason: String,
+    /// The barrier term's share of the sampled loop's stability budget,
+    /// K_b Δt/K2_i at |Z1γ| = 0.8 k_c of the chosen envelope (≤ 1 is held).
+    pub barrier: f64,
+    /// Why the envelope was widened, if it was.
+    pub envelope_reason: Option<String>,
+    /// Armature (kg m² or kg) the joint needs for the barrier term to be
+    /// held at this rate, when widening its envelope is not enough.
+    pub armature_needed: Option<f64>,
 }
 
 /// The gains of every joint, the rate, and the margins behind them.
@@ -65,6 +100,13 @@ pub struct GainChoice {
 }
 
 impl GainChoice {
+    /// Joints no gain holds at this rate (see [`JointGain::armature_needed`]).
+    pub fn unheld(&self) -> Vec<usize> {
+        (0..self.joints.len())
+            .filter(|&i| self.joints[i].armature_needed.is_some())
+            .collect()
+    }
+
     /// Joints whose K2_i is below the analysis's ½ (allowed, SPEC §7).
     pub fn below_half(&self) -> Vec<&str> {
         self.joints
@@ -165,6 +207,7 @@ pub fn choose_gains(
         .iter()
         .map(|e| e.min_value() / e.offset)
         .collect();
+    let beta = s.controller.beta;
     let mut rate = s.rate_hz;
     loop {
         let dt = 1.0 / rate;
@@ -173,9 +216,16 @@ pub fn choose_gains(
         let need: Vec<f64> = (0..n)
             .map(|i| m.load[i] / (ERROR_FRACTION * kc_low[i] * kc[i] * k2[i]))
             .collect();
+        // The envelope the barrier term needs: K_b Δt/K2 ≤ the budget.
+        let barrier_kc: Vec<f64> = (0..n)
+            .map(|i| (barrier_factor() * dt / (beta * k2[i] * BARRIER_BUDGET)).sqrt() / kc_low[i])
+            .collect();
         // Where K1 is capped, the envelope may widen up to its cap instead.
+        let load_kc: Vec<f64> = (0..n)
+            .map(|i| kc[i] * (need[i] / k1_max).max(1.0))
+            .collect();
         let envelope: Vec<f64> = (0..n)
-            .map(|i| (kc[i] * (need[i] / k1_max).max(1.0)).min(kc_cap[i].max(kc[i])))
+            .map(|i| load_kc[i].max(barrier_kc[i]).min(kc_cap[i].max(kc[i])))
             .collect();
         let short = (0..n)
             .map(|i| kc[i] * (need[i] / k1_max).max(1.0) / kc_cap[i].max(kc[i]))
@@ -189,10 +239,32 @@ pub fn choose_gains(
                     worst_joint(model, &need)
                 )
             });
+            let mut joints = joint_gains(model, &m, &k2, &need, k1_max);
+            for (i, j) in joints.iter_mut().enumerate() {
+                let low = kc_low[i] * envelope[i];
+                j.barrier = barrier_factor() * dt / (beta * low * low * k2[i]);
+                j.envelope_reason = (envelope[i] > kc[i] * (1.0 + 1e-9)).then(|| {
+                    if barrier_kc[i] > load_kc[i] {
+                        "the barrier term on a light joint (K_b Δt/K2 ≤ 1)".to_string()
+                    } else {
+                        format!("the load, with K1 capped at {k1_max:.0}")
+                    }
+                });
+                if j.barrier > BARRIER_BUDGET * (1.0 + 1e-9) {
+                    // M⁻¹_ii for which K2 = ρ_i/(Δt M⁻¹_ii) brings the
+                    // barrier's share to the budget; armature a gives
+                    // M⁻¹_ii/(1 + a M⁻¹_ii) (Sherman–Morrison).
+                    let minv = m.minv_diag[i];
+                    let rho = k2[i] * dt * minv;
+                    let target =
+                        BARRIER_BUDGET * beta * low * low * rho / (barrier_factor() * dt * dt);
+                    j.armature_needed = Some(round2(ARMATURE_MARGIN * (1.0 / target - 1.0 / minv)));
+                }
+            }
             return Ok(GainChoice {
                 rate_hz: rate,
                 rate_reason,
-                joints: joint_gains(model, &m, &k2, &need, k1_max),
+                joints,
                 stability_number: m
                     .probes
                     .iter()
@@ -225,8 +297,20 @@ fn joint_gains(
             load: m.load[i],
             effort: model.joints[model.actuated[i]].effort,
             k1_reason: k1_reason(need[i], k1_max),
+            barrier: 0.0,
+            envelope_reason: None,
+            armature_needed: None,
         })
         .collect()
+}
+
+/// `x` rounded up to two significant digits (a value users read and copy).
+fn round2(x: f64) -> f64 {
+    if !(x.is_finite() && x > 0.0) {
+        return x;
+    }
+    let scale = 10f64.powf(x.log10().floor() - 1.0);
+    (x / scale).ceil() * scale
 }
 
 fn worst_joint(model: &ArmModel, need: &[f64]) -> String {
@@ -245,5 +329,57 @@ fn k1_reason(need: f64, k1_max: f64) -> String {
         format!(
             "capped at 0.2/Δt = {k1_max:.0} (the load needs {need:.0}): the envelope is widened"
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Steps ẍ = M⁻¹ u, u = −K_d ẋ − K_p x held over each period (exact
+    /// for a constant u), and says whether it grew a thousandfold.
+    fn grows(kp: f64, kd: f64, minv: f64, dt: f64) -> bool {
+        let (mut x, mut v) = (1e-3, 0.0);
+        for _ in 0..5000 {
+            let a = minv * (-kd * v - kp * x);
+            x += v * dt + 0.5 * a * dt * dt;
+            v += a * dt;
+            if x.is_nan() || x.abs() >= 1.0 {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// The bound the barrier budget rests on: with K2 = 1/(Δt M⁻¹) the
+    /// sampled loop holds while (K1 K2 + K_b) Δt < 2 K2, whatever M⁻¹ (a
+    /// feather-light 1e6 as well as a shoulder's 1).
+    #[test]
+    fn the_sampled_loop_holds_below_twice_the_velocity_gain() {
+        let dt = 1e-3;
+        for minv in [1.0, 1e3, 1e6] {
+            let kd = 1.0 / (dt * minv);
+            for share in [0.2, 1.0, 1.9] {
+                assert!(
+                    !grows(share * kd / dt, kd, minv, dt),
+                    "M⁻¹ {minv}, share {share}"
+                );
+            }
+            for share in [2.1, 3.0] {
+                assert!(
+                    grows(share * kd / dt, kd, minv, dt),
+                    "M⁻¹ {minv}, share {share}"
+                );
+            }
+        }
+        // The barrier's stiffness grows fast near the edge: 12.6/(β k_c²)
+        // at 0.8 k_c, 1/(β k_c²) at the centre.
+        assert!((barrier_factor() - 1.64 / 0.1296).abs() < 1e-12);
+    }
+
+    #[test]
+    fn armature_amounts_round_up_to_two_digits() {
+        assert!((round2(4.2345e-6) - 4.3e-6).abs() < 1e-18);
+        assert_eq!(round2(0.0), 0.0);
     }
 }

@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 use trajectory::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError};
 
 pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
-pub use default_for_arm::ArmDefault;
+pub use default_for_arm::{ArmDefault, GRIPPER_LOCK};
 pub use gains::{GainChoice, JointGain};
 pub use plan::{Overrides, Plan, load, plan};
 pub use probe::Probe;
@@ -92,6 +92,24 @@ pub enum ScenarioError {
         file: String,
         /// The cause.
         cause: TrajectoryError,
+    },
+    /// The arm has more controlled joints than the wire carries.
+    #[error(
+        "{file}: robot {robot} has {dof} controlled joints; the wire carries at most {max}: lock {excess} of them in [plant.lock] (e.g. {example} = 0.0; the joints past the {max}th are {beyond})",
+        max = wire::MAX_DOF,
+        excess = dof - wire::MAX_DOF
+    )]
+    TooManyJoints {
+        /// The scenario.
+        file: String,
+        /// The robot's label.
+        robot: String,
+        /// Controlled joints after the scenario's locks.
+        dof: usize,
+        /// A joint the user could lock (the last one).
+        example: String,
+        /// The joints past [`wire::MAX_DOF`], in joint order.
+        beyond: String,
     },
     /// The plant settings or the robot are unusable.
     #[error("{file}: {cause}")]

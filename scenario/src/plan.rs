@@ -183,6 +183,22 @@ pub fn plan(
     robot: RobotSource,
 ) -> Result<Plan, ScenarioError> {
     let dof = robot.model.dof();
+    // Checked first: every later step (and every node) assumes it fits.
+    if dof > wire::MAX_DOF {
+        let names = robot.model.joint_names();
+        return Err(ScenarioError::TooManyJoints {
+            file: source,
+            robot: robot.label(),
+            dof,
+            example: names.last().cloned().unwrap_or_default(),
+            beyond: names
+                .iter()
+                .skip(wire::MAX_DOF)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", "),
+        });
+    }
     let mismatch = |key: &str, got: usize| ScenarioError::Invalid {
         file: source.clone(),
         key: key.to_string(),

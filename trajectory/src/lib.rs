@@ -91,6 +91,12 @@ pub enum TrajectoryError {
     /// No joints at all.
     #[error("reference.joints is empty: give one entry per joint")]
     Empty,
+    /// More joints than a sample carries.
+    #[error(
+        "reference.joints has {0} entries; a reference sample carries at most {max} joints (lock the others in [plant.lock])",
+        max = wire::MAX_DOF
+    )]
+    TooManyJoints(usize),
 }
 
 /// The desired joint trajectory, one sinusoid per joint.
@@ -250,6 +256,9 @@ impl ReferenceConfig {
     pub fn validate(&self) -> Result<(), TrajectoryError> {
         if self.joints.is_empty() {
             return Err(TrajectoryError::Empty);
+        }
+        if self.joints.len() > wire::MAX_DOF {
+            return Err(TrajectoryError::TooManyJoints(self.joints.len()));
         }
         for (i, s) in self.joints.iter().enumerate() {
             s.validate(&format!("reference.joints[{i}]"))?;

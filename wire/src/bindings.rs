@@ -260,7 +260,7 @@ mod tests {
         for t in crate::all_layouts() {
             assert!(py.contains(&format!("class {}(ctypes.Structure)", t.name)));
         }
-        assert!(py.contains("return \"testbed.JointState.v3\""));
+        assert!(py.contains("return \"testbed.JointState.v4\""));
         assert!(py.contains("\"joint_state\": (\"testbed/joint_state\", JointState, 1, 2, True)"));
         assert!(py.contains("FAULT_NO_REFERENCE = 5"));
         assert!(py.contains("RUN_END_LOST_NODE_BASE = 10"));

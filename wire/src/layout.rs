@@ -158,7 +158,7 @@ mod tests {
     #[test]
     fn type_names_are_the_ones_iceoryx2_sees() {
         let names: Vec<&str> = all_layouts().iter().map(|t| t.type_name).collect();
-        assert!(names.contains(&"testbed.JointState.v3"));
+        assert!(names.contains(&"testbed.JointState.v4"));
         assert!(names.contains(&"testbed.Control.v2"));
         // The derive and the layout read the same literal.
         #[allow(unsafe_code)]

@@ -2,9 +2,10 @@
 
 use iceoryx2::prelude::ZeroCopySend;
 
-/// The largest arm the wire carries. An arm with more actuated joints is
-/// refused before anything starts.
-pub const MAX_DOF: usize = 12;
+/// The largest arm the wire carries: dual arms and humanoid upper bodies.
+/// An arm with more controlled joints is refused before anything starts
+/// (`scenario::plan`, and each step machine's constructor).
+pub const MAX_DOF: usize = 32;
 
 /// Per-joint values; entries past `dof` are zero.
 pub type Joints = [f64; MAX_DOF];
@@ -41,7 +42,7 @@ pub const NONE_U64: u64 = u64::MAX;
 
 crate::data_message! {
     /// The plant's state at step `header.seq` (t_k = k Δt).
-    #[type_name("testbed.JointState.v3")]
+    #[type_name("testbed.JointState.v4")]
     pub struct JointState {
         /// seq = k, t_ns = t_k.
         header: Header,
@@ -81,7 +82,7 @@ crate::data_message! {
 
 crate::data_message! {
     /// The reference and envelope at `header.t_ns`.
-    #[type_name("testbed.Reference.v1")]
+    #[type_name("testbed.Reference.v2")]
     pub struct ReferenceSample {
         /// seq counts samples, t_ns is the time they describe.
         header: Header,
@@ -104,7 +105,7 @@ crate::data_message! {
 
 crate::data_message! {
     /// The controller's torque for the state with the same `header.seq`.
-    #[type_name("testbed.Command.v2")]
+    #[type_name("testbed.Command.v3")]
     pub struct Command {
         /// seq and t_ns of the state this answers; wall_ns when it was sent.
         header: Header,
@@ -133,7 +134,7 @@ crate::data_message! {
 
 crate::data_message! {
     /// Everything the controller computed at one step (SPEC §12).
-    #[type_name("testbed.ControllerDiagnostics.v2")]
+    #[type_name("testbed.ControllerDiagnostics.v3")]
     pub struct ControllerDiagnostics {
         /// seq and t_ns of the state acted on.
         header: Header,

@@ -32,6 +32,7 @@ pub fn describe(path: &Path) -> Result<String> {
         cause,
     })?;
     default_scenario(&mut out, &d);
+    warnings(&mut out, &d);
     Ok(out)
 }
 
@@ -112,6 +113,42 @@ fn links(out: &mut String, m: &ArmModel) {
     }
 }
 
+/// Everything the default scenario had to change or could not fix, together
+/// at the end where a user looks: each a line starting "warning:".
+fn warnings(out: &mut String, d: &ArmDefault) {
+    let mut lines: Vec<String> = Vec::new();
+    let controlled = d.gains.joints.len();
+    if controlled > wire::MAX_DOF {
+        // Described all the same: the joint list is what the user needs to
+        // choose which joints to lock.
+        lines.push(format!(
+            "{controlled} controlled joints; the wire carries at most {}: sim and run refuse this arm until {} joints are locked in [plant.lock]",
+            wire::MAX_DOF,
+            controlled - wire::MAX_DOF
+        ));
+    }
+    if let Some(why) = &d.gains.rate_reason {
+        lines.push(format!("rate raised to {} Hz: {why}", d.scenario.rate_hz));
+    }
+    for (name, why) in &d.locked {
+        if !why.starts_with(scenario::GRIPPER_LOCK) {
+            lines.push(format!("locked {name}: {why}"));
+        }
+    }
+    for (name, a, _) in &d.armature {
+        lines.push(format!(
+            "armature {a:.3e} added to {name}, which the URDF does not have"
+        ));
+    }
+    lines.extend(d.warnings.iter().cloned());
+    if !lines.is_empty() {
+        let _ = writeln!(out);
+    }
+    for l in lines {
+        let _ = writeln!(out, "warning: {l}");
+    }
+}
+
 fn default_scenario(out: &mut String, d: &ArmDefault) {
     let s = &d.scenario;
     let g = &d.gains;
@@ -128,6 +165,12 @@ fn default_scenario(out: &mut String, d: &ArmDefault) {
     for (name, why) in &d.locked {
         let at = s.plant.lock.get(name).copied().unwrap_or(0.0);
         let _ = writeln!(out, "  locked {name} at {at:.4}: {why}");
+    }
+    for (name, a, why) in &d.armature {
+        let _ = writeln!(
+            out,
+            "  armature {a:.3e} added to {name} ([plant] armature): {why}"
+        );
     }
     let _ = writeln!(
         out,

@@ -133,6 +133,16 @@ impl Plant {
         self.substeps
     }
 
+    /// Integrator steps the engine takes in a period of `dt` s: the
+    /// scenario's substeps, or more where stiff scenario friction needs
+    /// them (the articulated engine; URDF damping never does).
+    pub fn substeps_per_period(&self, dt: f64) -> u32 {
+        match &self.engine {
+            Engine::Articulated(a) => a.substeps_for(dt, self.substeps),
+            Engine::Rapier(_) => self.substeps,
+        }
+    }
+
     /// The engine that integrates the dynamics.
     pub fn engine_name(&self) -> EngineName {
         match self.engine {

@@ -2,8 +2,15 @@
 //! solved by projected Gauss–Seidel like Rapier's joint constraints: a
 //! friction impulse is bounded by the friction torque times the substep, a
 //! stop's only pushes back, and a stop is enforced once it is passed.
+//!
+//! With URDF damping integrated exactly, a friction impulse stands for a
+//! constant torque over the substep, so it moves each damped mode by what
+//! that torque would (φ1 of its velocity, φ2 of its displacement): an
+//! undamped impulse on a stiffly damped light joint would overshoot it by
+//! λh and creep a stuck arm. A stop acts at once (M⁻¹ as before).
 
 use super::Follow;
+use super::exponential::{Modes, Weights};
 use super::linalg::Cholesky;
 
 /// Which way a stop pushes.
@@ -25,8 +32,14 @@ pub(super) struct Impulses {
     lambda: Vec<f64>,
     /// M⁻¹ e_j for each controlled joint j, filled when needed.
     inverse: Vec<f64>,
+    /// A friction impulse's velocity change per unit on joint j: M⁻¹ e_j,
+    /// or its damped response.
+    friction_response: Vec<f64>,
     /// The velocity change from friction alone.
     friction_dv: Vec<f64>,
+    /// The friction impulse per controlled joint.
+    friction_impulse: Vec<f64>,
+    tmp: Vec<f64>,
     n: usize,
 }
 
@@ -42,7 +55,10 @@ impl Impulses {
             rows: Vec::with_capacity(rows),
             lambda: Vec::with_capacity(rows),
             inverse: vec![0.0; n * n],
+            friction_response: vec![0.0; n * n],
             friction_dv: vec![0.0; n],
+            friction_impulse: vec![0.0; n],
+            tmp: vec![0.0; n],
             n,
         }
     }
@@ -77,11 +93,13 @@ impl Impulses {
 
     /// Applies the impulses to q̇ (and friction's share of the substep to q),
     /// then puts every passed stop's coordinate back at the stop. `m` holds
-    /// the factored inertia at the end of the substep.
+    /// the factored inertia at the end of the substep; `damped`, the URDF
+    /// damping's modes over it, if the arm has any.
     pub(super) fn apply(
         &mut self,
         follow: &[Follow],
         m: &Cholesky,
+        damped: Option<&Modes>,
         q: &mut [f64],
         qd: &mut [f64],
         h: f64,
@@ -106,17 +124,31 @@ impl Impulses {
                 .enumerate()
                 .for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
             m.solve(col);
+            let response = &mut self.friction_response[j * n..(j + 1) * n];
+            match damped {
+                Some(modes) => {
+                    let mut e = std::mem::take(&mut self.friction_impulse);
+                    e.iter_mut()
+                        .enumerate()
+                        .for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
+                    modes.response(|w: &Weights| w.phi1, &e, &mut self.tmp, response);
+                    self.friction_impulse = e;
+                }
+                None => response.copy_from_slice(&self.inverse[j * n..(j + 1) * n]),
+            }
         }
         self.lambda.clear();
         self.lambda.resize(self.rows.len(), 0.0);
         self.friction_dv.iter_mut().for_each(|x| *x = 0.0);
+        self.friction_impulse.iter_mut().for_each(|x| *x = 0.0);
         for _ in 0..SWEEPS {
             for (r, row) in self.rows.iter().enumerate() {
-                let coord = match *row {
-                    Row::Friction { coord, .. } | Row::Stop { coord, .. } => coord,
+                let (coord, cols) = match *row {
+                    Row::Friction { coord, .. } => (coord, &self.friction_response),
+                    Row::Stop { coord, .. } => (coord, &self.inverse),
                 };
                 let f = follow[coord];
-                let col = &self.inverse[f.leader * n..(f.leader + 1) * n];
+                let col = &cols[f.leader * n..(f.leader + 1) * n];
                 let w = f.multiplier * f.multiplier * col[f.leader];
                 let rate = f.multiplier * qd[f.leader];
                 let old = self.lambda[r];
@@ -128,18 +160,40 @@ impl Impulses {
                 };
                 self.lambda[r] = new;
                 let push = f.multiplier * (new - old);
+                let friction = matches!(row, Row::Friction { .. });
+                if friction {
+                    self.friction_impulse[f.leader] += push;
+                }
                 for i in 0..n {
                     qd[i] += col[i] * push;
-                    if matches!(row, Row::Friction { .. }) {
+                    if friction {
                         self.friction_dv[i] += col[i] * push;
                     }
                 }
             }
         }
-        // Friction acted over the substep: half its velocity change, times h,
-        // is its effect on q (exact for a constant torque).
-        for (q, dv) in q.iter_mut().zip(&self.friction_dv) {
-            *q += 0.5 * h * dv;
+        // Friction acted over the substep as a constant torque: its effect
+        // on q is half its velocity change times h undamped (exact), and
+        // each damped mode's φ2 share of it otherwise.
+        match damped {
+            Some(modes) => {
+                let mut dq = std::mem::take(&mut self.friction_dv);
+                modes.response(
+                    |w: &Weights| w.phi2,
+                    &self.friction_impulse,
+                    &mut self.tmp,
+                    &mut dq,
+                );
+                for (q, dq) in q.iter_mut().zip(&dq) {
+                    *q += h * dq;
+                }
+                self.friction_dv = dq;
+            }
+            None => {
+                for (q, dv) in q.iter_mut().zip(&self.friction_dv) {
+                    *q += 0.5 * h * dv;
+                }
+            }
         }
         for (coord, _, limit) in stops {
             let f = follow[coord];

@@ -49,6 +49,12 @@ impl Cholesky {
 
     /// x = A⁻¹ b in place, after `factor`.
     pub(super) fn solve(&self, b: &mut [f64]) {
+        self.forward(b);
+        self.backward(b);
+    }
+
+    /// x = L⁻¹ b in place, after `factor`.
+    pub(super) fn forward(&self, b: &mut [f64]) {
         let (n, l) = (self.n, &self.a);
         for i in 0..n {
             let mut s = b[i];
@@ -57,6 +63,11 @@ impl Cholesky {
             }
             b[i] = s / l[i * n + i];
         }
+    }
+
+    /// x = L⁻ᵀ b in place, after `factor`.
+    pub(super) fn backward(&self, b: &mut [f64]) {
+        let (n, l) = (self.n, &self.a);
         for i in (0..n).rev() {
             let mut s = b[i];
             for k in i + 1..n {
@@ -64,6 +75,11 @@ impl Cholesky {
             }
             b[i] = s / l[i * n + i];
         }
+    }
+
+    /// L_ij (i ≥ j), after `factor`.
+    pub(super) fn lower(&self, i: usize, j: usize) -> f64 {
+        self.a[i * self.n + j]
     }
 }
 

@@ -1,5 +1,7 @@
 //! The arm's equations of motion in joint coordinates, integrated with RK4:
 //! M(q) q̈ + h(q, q̇) = τ, with URDF damping, dry friction and hard stops.
+//! URDF damping is integrated exactly (exponential time differencing,
+//! `exponential.rs`), so a damped light link takes one step per period.
 //!
 //! Rapier steps a multibody through its whole pipeline (islands, constraint
 //! assembly, a first-order integrator), which for an arm without colliders
@@ -11,6 +13,7 @@
 //! substep, as Rapier's velocity constraints do.
 
 mod constraints;
+mod exponential;
 mod linalg;
 mod spatial;
 mod tree;
@@ -20,6 +23,7 @@ use nalgebra::Vector3;
 use crate::PlantError;
 use arm_model::ArmModel;
 use constraints::Impulses;
+use exponential::Modes;
 use linalg::Cholesky;
 use spatial::Inertia;
 use tree::Tree;
@@ -43,6 +47,8 @@ pub(crate) trait Drive {
 /// An arm in joint coordinates.
 #[derive(Debug, Clone)]
 pub(crate) struct Articulated {
+    /// Controlled joint names, for errors.
+    names: Vec<String>,
     tree: Tree,
     follow: Vec<Follow>,
     gravity: Vector3<f64>,
@@ -50,11 +56,18 @@ pub(crate) struct Articulated {
     armature: Vec<f64>,
     /// Per full coordinate: URDF viscous damping.
     damping: Vec<f64>,
+    /// Per controlled joint: the URDF damping reduced onto it (Jᵀ D J is
+    /// diagonal: each full coordinate follows one controlled joint).
+    reduced_damping: Vec<f64>,
     impulses: Impulses,
     link_inertia: Vec<Inertia>,
-    /// An upper bound on the fastest decay rate damping gives the arm,
-    /// 1/s: RK4 is stable and accurate while a substep times it stays ≤ 1.
+    /// An upper bound on the fastest decay rate the scenario's friction
+    /// slope gives the arm, 1/s: it acts through the explicit stages, which
+    /// are stable and accurate while a substep times it stays ≤ 1. (URDF
+    /// damping is integrated exactly and needs no bound.)
     damping_rate: f64,
+    /// The exponential integrator's state, for an arm with URDF damping.
+    exponential: Option<Box<Exponential>>,
     q: Vec<f64>,
     qd: Vec<f64>,
     scratch: Scratch,
@@ -73,6 +86,36 @@ struct Scratch {
     qd0: Vec<f64>,
     k_q: [Vec<f64>; 4],
     k_qd: [Vec<f64>; 4],
+}
+
+/// ETDRK4's buffers: per joint, the start, the stages' velocities and (in
+/// the damping's modes) their velocities and forcings.
+#[derive(Debug, Clone)]
+struct Exponential {
+    modes: Modes,
+    q0: Vec<f64>,
+    v0: Vec<f64>,
+    qs: Vec<f64>,
+    g: Vec<f64>,
+    v: [Vec<f64>; 3],
+    y: [Vec<f64>; 4],
+    f: [Vec<f64>; 4],
+}
+
+impl Exponential {
+    fn new(n: usize) -> Self {
+        let v = || vec![0.0; n];
+        Self {
+            modes: Modes::new(n),
+            q0: v(),
+            v0: v(),
+            qs: v(),
+            g: v(),
+            v: std::array::from_fn(|_| v()),
+            y: std::array::from_fn(|_| v()),
+            f: std::array::from_fn(|_| v()),
+        }
+    }
 }
 
 /// What the engine needs from the model beyond its tree.
@@ -117,9 +160,21 @@ impl Articulated {
                 .collect()
         };
         let limits = moving.iter().map(|&ji| model.joints[ji].limits).collect();
+        let damping = of(|j| j.damping);
+        let mut reduced_damping = vec![0.0; n];
+        for (f, d) in follow.iter().zip(&damping) {
+            reduced_damping[f.leader] += f.multiplier * f.multiplier * d;
+        }
+        let exponential = reduced_damping
+            .iter()
+            .any(|d| *d > 0.0)
+            .then(|| Box::new(Exponential::new(n)));
         let mut arm = Self {
+            names: model.joint_names(),
             impulses: Impulses::new(of(|j| j.friction), limits, n),
-            damping: of(|j| j.damping),
+            damping,
+            reduced_damping,
+            exponential,
             link_inertia: model.links.iter().map(tree::link_inertia).collect(),
             tree,
             follow,
@@ -170,22 +225,97 @@ impl Articulated {
         true
     }
 
-    /// Advances by `dt` in `substeps` RK4 steps with the torque `drive`.
+    /// The substeps a period of `dt` takes when the scenario asks for
+    /// `substeps`: more only where stiff scenario friction needs them.
+    pub(crate) fn substeps_for(&self, dt: f64, substeps: u32) -> u32 {
+        // The friction slope acts through the explicit stages.
+        substeps.max((dt * self.damping_rate).ceil().min(1e6) as u32)
+    }
+
+    /// Advances by `dt` in `substeps` steps (RK4, or ETDRK4 with URDF
+    /// damping) with the torque `drive`.
     pub(crate) fn step(
         &mut self,
         drive: &dyn Drive,
         dt: f64,
         substeps: u32,
     ) -> Result<(), PlantError> {
-        // Stiff damping (a light link on a damped joint) needs more substeps
-        // than the scenario asked for: RK4 is explicit.
-        let substeps = substeps.max((dt * self.damping_rate).ceil().min(1e6) as u32);
+        let substeps = self.substeps_for(dt, substeps);
         let h = dt / f64::from(substeps);
         for _ in 0..substeps {
-            self.rk4(drive, h);
+            match self.exponential.take() {
+                Some(mut x) => {
+                    self.etdrk4(&mut x, drive, h);
+                    self.exponential = Some(x);
+                }
+                None => self.rk4(drive, h),
+            }
             self.constrain(h);
         }
         Ok(())
+    }
+
+    /// One ETDRK4 step of `h` (Cox & Matthews' scheme; see
+    /// `exponential.rs`): positions as in RK4, velocities in the damping's
+    /// modes at the start of the step, each decaying exactly.
+    fn etdrk4(&mut self, x: &mut Exponential, drive: &dyn Drive, h: f64) {
+        let n = self.q.len();
+        x.q0.copy_from_slice(&self.q);
+        x.v0.copy_from_slice(&self.qd);
+        if self.factor_mass(&x.q0, &x.v0).is_err() {
+            // Blown up (see `acceleration`): report the non-finite state.
+            self.q.iter_mut().for_each(|v| *v = f64::NAN);
+            self.qd.iter_mut().for_each(|v| *v = f64::NAN);
+            return;
+        }
+        x.modes.update(&self.scratch.chol, &self.reduced_damping, h);
+        self.accelerate_factored(drive, &x.v0, &mut x.g);
+        x.modes.to_modes(&x.v0, &mut x.y[0]);
+        forcing(x, 0);
+        // Stages a, b, c: position, then the velocity in modes.
+        for stage in 1..4 {
+            for i in 0..n {
+                let v = if stage == 1 {
+                    x.v0[i]
+                } else {
+                    x.v[stage - 2][i]
+                };
+                x.qs[i] = x.q0[i] + if stage == 3 { h * v } else { 0.5 * h * v };
+            }
+            for m in 0..n {
+                let w = x.modes.weights[m];
+                x.y[stage][m] = match stage {
+                    1 => w.e2 * x.y[0][m] + w.half * x.f[0][m],
+                    2 => w.e2 * x.y[0][m] + w.half * x.f[1][m],
+                    _ => w.e2 * x.y[1][m] + w.half * (2.0 * x.f[2][m] - x.f[0][m]),
+                };
+            }
+            let (ys, vs) = (&x.y[stage], &mut x.v[stage - 1]);
+            x.modes.to_joints(ys, vs);
+            let (qs, vs) = (
+                std::mem::take(&mut x.qs),
+                std::mem::take(&mut x.v[stage - 1]),
+            );
+            self.acceleration(drive, &qs, &vs, &mut x.g);
+            (x.qs, x.v[stage - 1]) = (qs, vs);
+            forcing(x, stage);
+        }
+        // The step's end: velocity and displacement, per mode.
+        let (mut y1, mut dy) = (std::mem::take(&mut x.qs), std::mem::take(&mut x.g));
+        for m in 0..n {
+            let (w, f) = (x.modes.weights[m], &x.f);
+            y1[m] = w.e * x.y[0][m]
+                + w.f1 * f[0][m]
+                + 2.0 * w.f2 * (f[1][m] + f[2][m])
+                + w.f3 * f[3][m];
+            dy[m] = w.p0 * x.y[0][m] + w.p1 * f[0][m] + w.p2 * (f[1][m] + f[2][m]) + w.p3 * f[3][m];
+        }
+        x.modes.to_joints(&y1, &mut self.qd);
+        x.modes.to_joints(&dy, &mut self.q);
+        for (q, q0) in self.q.iter_mut().zip(&x.q0) {
+            *q += q0;
+        }
+        (x.qs, x.g) = (y1, dy);
     }
 
     fn rk4(&mut self, drive: &dyn Drive, h: f64) {
@@ -226,6 +356,11 @@ impl Articulated {
             qdd.iter_mut().for_each(|x| *x = f64::NAN);
             return;
         }
+        self.accelerate_factored(drive, qd, qdd);
+    }
+
+    /// [`Self::acceleration`] at the state `factor_mass` was last called at.
+    fn accelerate_factored(&mut self, drive: &dyn Drive, qd: &[f64], qdd: &mut [f64]) {
         let s = &mut self.scratch;
         drive.torque(qd, &mut s.tau);
         for (k, f) in self.follow.iter().enumerate() {
@@ -257,16 +392,18 @@ impl Articulated {
         for (i, a) in self.armature.iter().enumerate() {
             m[i * n + i] += a;
         }
+        let names = &self.names;
         s.chol.factor().map_err(|row| {
+            let joint = names.get(row).map_or("?", String::as_str);
             PlantError::Engine(format!(
-                "the joint-space inertia is singular at joint {row} (q = {q:?})"
+                "the joint-space inertia is singular at joint '{joint}' (q = {q:?}): nothing it moves has inertia about its axis that the joints before it do not already account for; give the links it moves inertia, add [plant] armature for it, or lock it in [plant.lock]"
             ))
         })
     }
 
-    /// trace(M⁻¹ D) at the factored posture, D the URDF damping (mapped to
-    /// the controlled joints) plus `extra`: an upper bound on the largest
-    /// eigenvalue of M⁻¹ D, since D is positive semi-definite.
+    /// trace(M⁻¹ E) at the factored posture, E the scenario's friction
+    /// slope `extra` per joint: an upper bound on the largest eigenvalue of
+    /// M⁻¹ E, since E is positive semi-definite.
     fn rate_of(&self, extra: &[f64]) -> f64 {
         let n = self.armature.len();
         let mut inverse_diagonal = vec![0.0; n];
@@ -278,13 +415,7 @@ impl Articulated {
             self.scratch.chol.solve(&mut e);
             *d = e[j];
         }
-        let urdf: f64 = self
-            .follow
-            .iter()
-            .zip(&self.damping)
-            .map(|(f, d)| d * f.multiplier * f.multiplier * inverse_diagonal[f.leader])
-            .sum();
-        urdf + extra
+        extra
             .iter()
             .zip(&inverse_diagonal)
             .map(|(d, m)| d * m)
@@ -300,8 +431,20 @@ impl Articulated {
         let (mut q, mut qd) = (std::mem::take(&mut self.q), std::mem::take(&mut self.qd));
         if self.factor_mass(&q, &qd).is_ok() {
             let chol = &self.scratch.chol;
-            self.impulses.apply(&self.follow, chol, &mut q, &mut qd, h);
+            let modes = self.exponential.as_deref().map(|x| &x.modes);
+            self.impulses
+                .apply(&self.follow, chol, modes, &mut q, &mut qd, h);
         }
         (self.q, self.qd) = (q, qd);
+    }
+}
+
+/// The modal forcing of stage `stage`: W⁻¹ q̈ + Λ y, i.e. everything but
+/// the damping's linear part at M₀ (q̈ is in `x.g`).
+fn forcing(x: &mut Exponential, stage: usize) {
+    let f = &mut x.f[stage];
+    x.modes.to_modes(&x.g, f);
+    for (m, f) in f.iter_mut().enumerate() {
+        *f += x.modes.rate(m) * x.y[stage][m];
     }
 }
