@@ -31,6 +31,7 @@ mod inertia;
 mod parse;
 mod prefixes;
 mod tree;
+mod xml_depth;
 
 use std::collections::BTreeMap;
 
@@ -228,6 +229,14 @@ impl ArmModel {
     /// Parses and checks a URDF document with the joints in `locks` held
     /// at the given positions.
     pub fn from_urdf_str_locked(text: &str, locks: &Locks) -> Result<Self, ModelError> {
+        let deepest = xml_depth::depth(text, xml_depth::MAX_XML_DEPTH);
+        if deepest > xml_depth::MAX_XML_DEPTH {
+            return Err(ModelError::Parse(format!(
+                "elements are nested more than {} deep: not a URDF (a robot's elements \
+                 nest a few levels)",
+                xml_depth::MAX_XML_DEPTH
+            )));
+        }
         let (text, undeclared) = prefixes::declare_undeclared(text);
         let robot =
             urdf_rs::read_from_string(&text).map_err(|e| ModelError::Parse(e.to_string()))?;

@@ -324,3 +324,24 @@ fn runs_shorter_than_tc_are_not_judged() {
     let r: serde_json::Value = serde_json::from_slice(&json).unwrap();
     assert!(r["cells"][0]["success_rate"].is_null(), "{r}");
 }
+
+/// Row 15: a URDF of 50 000 nested elements (350 KB) is refused by name, not
+/// a stack overflow.
+#[test]
+fn a_deeply_nested_urdf_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = dir.path().join("deep.urdf");
+    let text = format!(
+        "<robot name=\"deep\">{}{}</robot>",
+        "<link name=\"a\">".repeat(50_000),
+        "</link>".repeat(50_000)
+    );
+    std::fs::write(&urdf, text).unwrap();
+    for args in [&["robot"][..], &["sim", "--robot"][..]] {
+        let err = crate::util::fails(testbed().args(args).arg(&urdf));
+        assert!(
+            err.contains("deep.urdf") && err.contains("nested more than 100 deep"),
+            "{err}"
+        );
+    }
+}
