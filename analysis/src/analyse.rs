@@ -72,7 +72,8 @@ pub struct Series {
 }
 
 impl Series {
-    fn new(n: usize) -> Self {
+    /// Empty series for `n` joints.
+    pub fn new(n: usize) -> Self {
         let v = || vec![Vec::new(); n];
         Self {
             q: v(),
@@ -87,7 +88,8 @@ impl Series {
         }
     }
 
-    fn add(&mut self, r: &crate::record::StepRecord<'_>) {
+    /// Adds one row.
+    pub fn add(&mut self, r: &crate::record::StepRecord<'_>) {
         self.t.push(r.t);
         for i in 0..self.q.len() {
             self.q[i].push(r.q[i]);

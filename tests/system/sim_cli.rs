@@ -251,3 +251,27 @@ fn the_docs_generated_numbers_are_current() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// #29: `sim --plots DIR` writes the paper's figures (no log needed), and a
+/// mistyped scenario name lists the shipped ones.
+#[test]
+fn sim_writes_figures_and_a_wrong_scenario_name_lists_the_shipped_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let plots = dir.path().join("figs");
+    let out = crate::util::ok(
+        crate::util::testbed()
+            .args(["sim", "--duration", "2.5", "--plots"])
+            .arg(&plots),
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("wrote 5 figures"));
+    for f in ["fig3_errors.png", "fig3_errors.svg", "fig1_positions.png"] {
+        assert!(plots.join(f).metadata().unwrap().len() > 1000, "{f}");
+    }
+    let err = crate::util::fails(crate::util::testbed().args(["sim", "--scenario", "paper_typo"]));
+    assert!(
+        err.contains("paper_typo")
+            && err.contains("payload_pickup")
+            && err.contains("testbed scenarios"),
+        "{err}"
+    );
+}

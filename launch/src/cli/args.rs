@@ -36,6 +36,10 @@ pub(crate) struct ScenarioArgs {
 pub(crate) struct SimArgs {
     #[command(flatten)]
     pub(crate) common: ScenarioArgs,
+    /// Write the paper's figures (PNG and SVG: positions, velocities, error
+    /// against the envelope, weights and torques) into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) plots: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]

@@ -187,6 +187,18 @@ pub(crate) fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario:
         law: common.law,
     };
     let path = common.scenario.as_deref().map(resolve_scenario);
+    if let Some(p) = &path
+        && !p.exists()
+        && p.components().count() == 1
+    {
+        let names: Vec<&str> = scenario::SHIPPED.iter().map(|s| s.name).collect();
+        anyhow::bail!(
+            "--scenario {}: no such file, and not a shipped scenario; the shipped ones are {} \
+             (`testbed scenarios` describes them)",
+            p.display(),
+            names.join(", ")
+        );
+    }
     Ok(scenario::load(path.as_deref(), &overrides)?)
 }
 

@@ -14,6 +14,7 @@ use super::{load, print_report};
 use analysis::report::Report;
 
 pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
+    let plots = args.plots;
     let args = args.common;
     let plan = load(&args, None)?;
     let mut csv = match &args.csv {
@@ -32,10 +33,16 @@ pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
         plan.dt(),
         plan.scenario.controller.tc,
     );
+    let mut series = plots
+        .as_ref()
+        .map(|_| analysis::Series::new(plan.robot.model.dof()));
     let start = Instant::now();
     let mut costs = in_process::StepCosts::default();
     let result = in_process::run_measured(&plan, Some(&mut costs), |r| {
         summary.add(r);
+        if let Some(s) = series.as_mut() {
+            s.add(r);
+        }
         match csv.as_mut() {
             Some(w) => csv_out::write_row(w, r),
             None => Ok(()),
@@ -48,6 +55,11 @@ pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     result.with_context(|| format!("running {}", plan.source))?;
+    if let (Some(dir), Some(s)) = (&plots, &series) {
+        let written = analysis::plots::write_all(dir, s, &plan)
+            .with_context(|| format!("writing figures to {}", dir.display()))?;
+        eprintln!("testbed: wrote {written} figures to {}", dir.display());
+    }
     let report = Report::from_sim(&plan, summary.finish(), wall, costs.controller_us.finish());
     print_report(&report, args.json)?;
     Ok(ExitCode::SUCCESS)
