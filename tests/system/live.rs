@@ -23,8 +23,14 @@ fn free_port() -> u16 {
         .port()
 }
 
-/// One WebSocket connection as Foxglove opens it.
-fn handshake(port: u16) -> Result<WebSocket<TcpStream>, String> {
+/// The subprotocol Foxglove's app offers.
+const SDK: &str = "foxglove.sdk.v1";
+/// The name in the ws-protocol specification (npm `@foxglove/ws-protocol`).
+const LEGACY: &str = "foxglove.websocket.v1";
+
+/// One WebSocket connection as Foxglove opens it, offering `protocol`;
+/// the server must answer with that name.
+fn handshake(port: u16, protocol: &str) -> Result<WebSocket<TcpStream>, String> {
     let stream = TcpStream::connect(("127.0.0.1", port)).map_err(|e| e.to_string())?;
     stream
         .set_read_timeout(Some(Duration::from_secs(30)))
@@ -33,10 +39,18 @@ fn handshake(port: u16) -> Result<WebSocket<TcpStream>, String> {
         .into_client_request()
         .unwrap();
     req.headers_mut()
-        .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
-    tungstenite::client::client(req, stream)
-        .map(|(ws, _)| ws)
-        .map_err(|e| e.to_string())
+        .insert("Sec-WebSocket-Protocol", protocol.parse().unwrap());
+    let (ws, answer) = tungstenite::client::client(req, stream).map_err(|e| match e {
+        tungstenite::HandshakeError::Failure(tungstenite::Error::Http(r)) => format!(
+            "{}: {}",
+            r.status(),
+            String::from_utf8_lossy(r.body().as_deref().unwrap_or_default())
+        ),
+        e => e.to_string(),
+    })?;
+    let chosen = answer.headers().get("Sec-WebSocket-Protocol");
+    assert_eq!(chosen.and_then(|v| v.to_str().ok()), Some(protocol));
+    Ok(ws)
 }
 
 /// A channel as the server advertised it.
@@ -57,7 +71,7 @@ struct Viewer {
 impl Viewer {
     /// Connects as soon as the logger listens (watchdog: 60 s, or the
     /// launcher ending first).
-    fn connect(port: u16, launcher: &mut Child) -> Viewer {
+    fn connect(port: u16, launcher: &mut Child, protocol: &str) -> Viewer {
         // Retried until the logger's server answers: the launcher checks the
         // port by listening on it a moment first, and a connection that
         // lands then is reset.
@@ -71,7 +85,7 @@ impl Viewer {
                 start.elapsed() < Duration::from_secs(60),
                 "nobody listens on {port}"
             );
-            if let Ok(ws) = handshake(port) {
+            if let Ok(ws) = handshake(port, protocol) {
                 break ws;
             }
             std::thread::sleep(Duration::from_millis(2));
@@ -196,7 +210,7 @@ fn a_lockstep_run_streams_live_what_its_log_keeps() {
     let dir = tempfile::tempdir().unwrap();
     let port = free_port();
     let mut run = live_run(port, "lockstep", &["--duration", "60"], dir.path());
-    let mut viewer = Viewer::connect(port, &mut run);
+    let mut viewer = Viewer::connect(port, &mut run, SDK);
     viewer.subscribe(&["/joint_state", "/arm/transforms"]);
     let got = viewer.read_to_end();
     let (status, out, err) = ended(&mut run, 300);
@@ -253,6 +267,35 @@ fn a_lockstep_run_streams_live_what_its_log_keeps() {
     assert!(handed >= got.len() as u64, "{handed} < {}", got.len());
 }
 
+/// Both subprotocol names are served, a viewer past `--live-clients` is
+/// refused with the reason, and the log counts both.
+#[test]
+fn both_subprotocols_are_served_and_a_viewer_past_the_limit_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let port = free_port();
+    let extra = ["--duration", "60", "--live-clients", "2"];
+    let mut run = live_run(port, "lockstep", &extra, dir.path());
+    let mut legacy = Viewer::connect(port, &mut run, LEGACY);
+    let mut sdk = Viewer::connect(port, &mut run, SDK);
+    let refused = handshake(port, SDK).expect_err("a third viewer was let in");
+    assert!(refused.contains("503"), "{refused}");
+    assert!(refused.contains("at most 2 clients"), "{refused}");
+    legacy.subscribe(&["/joint_state"]);
+    sdk.subscribe(&["/joint_state"]);
+    let got_legacy = legacy.read_to_end();
+    let got_sdk = sdk.read_to_end();
+    let (status, out, err) = ended(&mut run, 300);
+    assert!(status.success(), "{err}");
+    assert!(got_legacy.len() >= 10, "{}", got_legacy.len());
+    assert!(!got_sdk.is_empty());
+    let report = parse_json_str(&out);
+    let log = Path::new(report["log"].as_str().unwrap());
+    let stats = logger::read_log(log, None).unwrap().stats.unwrap();
+    assert_eq!(stats["live.clients"], "2", "{stats:?}");
+    assert_eq!(stats["live.refused_clients"], "1", "{stats:?}");
+    assert_eq!(stats["live.max_clients"], "2", "{stats:?}");
+}
+
 fn parse_json_str(out: &str) -> Value {
     serde_json::from_str(out).unwrap_or_else(|e| panic!("{e}: {out}"))
 }
@@ -296,7 +339,7 @@ fn a_realtime_run_with_a_viewer_that_never_reads_keeps_its_deadlines() {
     let port = free_port();
     let extra = ["--duration", "3", "--live-rate", "1000"];
     let mut run = live_run(port, "realtime", &extra, dir.path());
-    let mut viewer = Viewer::connect(port, &mut run);
+    let mut viewer = Viewer::connect(port, &mut run, SDK);
     viewer.subscribe(&[]);
     let nodes = wait_for_nodes(run.id());
     let logger = nodes.iter().find(|n| n.0 == "logger").unwrap().1;

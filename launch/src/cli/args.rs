@@ -87,6 +87,10 @@ pub(crate) struct RunArgs {
     /// every one).
     #[arg(long, value_name = "HZ", requires = "live", default_value_t = logger::live::DEFAULT_RATE_HZ, value_parser = parse_live_rate)]
     pub(crate) live_rate: f64,
+    /// Most live viewers at once (1 to 64); the next one is refused with
+    /// HTTP 503 and a reason. Each costs the logger a bounded queue.
+    #[arg(long, value_name = "N", requires = "live", default_value_t = logger::live::DEFAULT_MAX_CLIENTS, value_parser = parse_live_clients)]
+    pub(crate) live_clients: usize,
 }
 
 /// `ADDR:PORT` of `--live`, a host name (localhost) resolved.
@@ -96,6 +100,14 @@ fn parse_live_addr(s: &str) -> Result<std::net::SocketAddr, String> {
         .map_err(|e| format!("{s:?} is not ADDR:PORT ({e})"))?
         .next()
         .ok_or_else(|| format!("{s:?} names no address"))
+}
+
+fn parse_live_clients(s: &str) -> Result<usize, String> {
+    let max = logger::live::MAX_CLIENTS_LIMIT;
+    match s.parse::<usize>() {
+        Ok(n) if (1..=max).contains(&n) => Ok(n),
+        _ => Err(format!("{s:?} is not a number of clients from 1 to {max}")),
+    }
 }
 
 fn parse_live_rate(s: &str) -> Result<f64, String> {

@@ -32,6 +32,7 @@ pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
         live: args.live.map(|addr| logger::live::LiveConfig {
             addr,
             rate_hz: args.live_rate,
+            max_clients: args.live_clients,
         }),
     };
     let outcome = match run::run(opts) {

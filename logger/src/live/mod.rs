@@ -13,12 +13,18 @@ use serde::{Deserialize, Serialize};
 use crate::ChannelSpec;
 
 #[cfg(feature = "live")]
+mod front;
+#[cfg(feature = "live")]
 mod server;
 
 /// The port Foxglove's own examples use, and its app's default.
 pub const DEFAULT_PORT: u16 = 8765;
 /// Most samples per topic and second of sim time sent live.
 pub const DEFAULT_RATE_HZ: f64 = 50.0;
+/// Most viewers connected at once: each costs the logger a queue.
+pub const DEFAULT_MAX_CLIENTS: usize = 8;
+/// The most `--live-clients` may ask for.
+pub const MAX_CLIENTS_LIMIT: usize = 64;
 
 /// What the launcher hands the logger for a live run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -29,6 +35,13 @@ pub struct LiveConfig {
     /// Most samples per topic and second of sim time sent live (the log
     /// keeps every one).
     pub rate_hz: f64,
+    /// Most clients connected at once; the next is refused (HTTP 503).
+    #[serde(default = "default_max_clients")]
+    pub max_clients: usize,
+}
+
+fn default_max_clients() -> usize {
+    DEFAULT_MAX_CLIENTS
 }
 
 /// Why the live view could not start.
@@ -53,6 +66,9 @@ pub enum LiveError {
     /// This build has no live view (the logger crate without `live`).
     #[error("this build has no live view (the logger crate's `live` feature is off)")]
     NotBuilt,
+    /// The client limit is out of range.
+    #[error("live max_clients must be 1 to {MAX_CLIENTS_LIMIT}, got {0}")]
+    Clients(usize),
     /// The rate is not a positive number.
     #[error("live rate_hz must be a positive number, got {0}")]
     Rate(f64),
@@ -77,6 +93,9 @@ pub fn start(
 ) -> Result<Box<dyn LiveView>, LiveError> {
     if !(config.rate_hz.is_finite() && config.rate_hz > 0.0) {
         return Err(LiveError::Rate(config.rate_hz));
+    }
+    if !(1..=MAX_CLIENTS_LIMIT).contains(&config.max_clients) {
+        return Err(LiveError::Clients(config.max_clients));
     }
     #[cfg(feature = "live")]
     return Ok(Box::new(server::Live::start(config, channels)?));

@@ -15,6 +15,7 @@
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::sync::{Arc, Mutex};
 
+use super::front::Front;
 use super::{LiveConfig, LiveError, LiveView};
 use crate::ChannelSpec;
 use foxglove::websocket::{Capability, ChannelView, Client, ClientId, ServerListener};
@@ -92,6 +93,8 @@ pub(super) struct Live {
     /// Holds the channels and the server's sinks: both go with it.
     _context: Arc<Context>,
     server: Option<WebSocketServerHandle>,
+    /// The relay on the user's address (client limit, subprotocol names).
+    front: Option<Front>,
     topics: Vec<LiveTopic>,
     period_ns: u64,
     book: Arc<ClientBook>,
@@ -110,7 +113,8 @@ impl Live {
         let server = ctx
             .websocket_server()
             .name(format!("testbed {}", env!("CARGO_PKG_VERSION")))
-            .bind(addr.ip().to_string(), addr.port())
+            // Loopback only: clients come through the front relay.
+            .bind("127.0.0.1", 0)
             .capabilities([Capability::Time])
             .message_backlog_size(BACKLOG)
             .listener(book.clone())
@@ -123,11 +127,18 @@ impl Live {
             .iter()
             .map(|spec| open(&ctx, spec))
             .collect::<Result<Vec<_>, _>>()?;
+        let inner = std::net::SocketAddr::from(([127, 0, 0, 1], server.port()));
+        let front =
+            Front::start(addr, inner, config.max_clients).map_err(|e| LiveError::Listen {
+                addr,
+                cause: e.to_string(),
+            })?;
         // Port 0 asks the system for one: record the one it gave.
-        let bound = std::net::SocketAddr::new(addr.ip(), server.port());
+        let bound = front.address();
         Ok(Self {
             _context: ctx,
             server: Some(server),
+            front: Some(front),
             topics,
             period_ns: (1e9 / config.rate_hz) as u64,
             book,
@@ -144,6 +155,15 @@ impl Live {
         let mut out = BTreeMap::new();
         out.insert("live.address".into(), self.config.addr.to_string());
         out.insert("live.rate_hz".into(), format!("{:?}", self.config.rate_hz));
+        out.insert(
+            "live.max_clients".into(),
+            self.config.max_clients.to_string(),
+        );
+        if let Some(front) = &self.front {
+            let (refused, accepted) = front.counts();
+            out.insert("live.connections".into(), accepted.to_string());
+            out.insert("live.refused_clients".into(), refused.to_string());
+        }
         for t in &self.topics {
             let name = t.name.trim_start_matches('/');
             out.insert(format!("live.{name}.sent"), t.sent.to_string());
@@ -209,6 +229,9 @@ impl LiveView for Live {
                 let _ = done.send(());
             });
             let _ = stopped.recv_timeout(STOP_WAIT);
+        }
+        if let Some(front) = self.front.take() {
+            front.stop();
         }
         out
     }
