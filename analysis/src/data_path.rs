@@ -8,12 +8,11 @@
 use serde::Serialize;
 use wire::{Command, JointState, NONE_U64, is_stale};
 
-use crate::timing::Percentiles;
+use crate::timing::{Percentiles, Quantiles};
 
 /// What the log says about one state.
 #[derive(Debug, Clone, Copy, Default)]
 struct StateStamp {
-    seen: bool,
     wall_ns: u64,
     command_seq: u64,
     applied_wall_ns: u64,
@@ -22,11 +21,10 @@ struct StateStamp {
 /// What the log says about one command.
 #[derive(Debug, Clone, Copy, Default)]
 struct CommandStamp {
-    seen: bool,
-    t_ns: u64,
     wall_ns: u64,
     started_wall_ns: u64,
-    reference_t_ns: u64,
+    /// Its age was counted (when the plant first took it).
+    taken: bool,
 }
 
 /// Counts recomputed from the log's stamps.
@@ -54,20 +52,74 @@ pub struct DataPathSummary {
     /// Of the stale references that had a sample: how much older it was
     /// than the one due, µs of sim time.
     pub reference_lag_us: Percentiles,
-    /// Steps with a timing fault (a miss or a stale reference), in order.
+    /// Steps with a timing fault (a miss or a stale reference), in order:
+    /// the first [`MAX_FAULT_STEPS`] of them.
     #[serde(skip)]
     pub fault_steps: Vec<u64>,
+    /// More faults than [`MAX_FAULT_STEPS`] came up (the list is their start).
+    #[serde(skip)]
+    pub fault_steps_cut: bool,
 }
 
-/// Collects the stamps while a log is read.
+/// Fault steps kept by number (8 MB); the counts go on past it.
+pub const MAX_FAULT_STEPS: usize = 1 << 20;
+
+/// Steps of stamps kept: a state is judged once one 2048 steps newer came,
+/// so a log's topics may interleave that far out of order. Memory stays
+/// the same whatever the run's length.
+const WINDOW: u64 = 4096;
+
+/// The last [`WINDOW`] stamps of one topic, by seq.
+#[derive(Debug, Clone)]
+struct Ring<T> {
+    slots: Vec<Option<(u64, T)>>,
+}
+
+impl<T: Copy> Ring<T> {
+    fn new() -> Self {
+        Self {
+            slots: vec![None; WINDOW as usize],
+        }
+    }
+
+    fn slot(&mut self, seq: u64) -> &mut Option<(u64, T)> {
+        &mut self.slots[(seq % WINDOW) as usize]
+    }
+
+    fn get(&mut self, seq: u64) -> Option<&mut T> {
+        match self.slot(seq) {
+            Some((s, t)) if *s == seq => Some(t),
+            _ => None,
+        }
+    }
+
+    #[cfg(test)]
+    fn is_empty(&self) -> bool {
+        self.slots.iter().all(Option::is_none)
+    }
+}
+
+/// Collects the stamps while a log is read, judging each step as soon as
+/// its partners are in.
 #[derive(Debug, Clone)]
 pub struct DataPath {
     reference_period_ns: u64,
     /// Seqs past this are not the run's (a damaged or hostile log).
     last_seq: u64,
-    states: Vec<StateStamp>,
-    commands: Vec<CommandStamp>,
+    states: Ring<StateStamp>,
+    commands: Ring<CommandStamp>,
+    /// States before this seq are judged.
+    next_state: u64,
+    /// The command the plant took last, among the states judged.
+    last_taken: u64,
     live_stale: u64,
+    misses: u64,
+    stale: u64,
+    state_age: Quantiles,
+    command_age: Quantiles,
+    lag: Quantiles,
+    faults: Vec<u64>,
+    faults_cut: bool,
 }
 
 impl DataPath {
@@ -76,101 +128,137 @@ impl DataPath {
         Self {
             reference_period_ns,
             last_seq: steps,
-            states: Vec::new(),
-            commands: Vec::new(),
+            states: Ring::new(),
+            commands: Ring::new(),
+            next_state: 0,
+            last_taken: NONE_U64,
             live_stale: 0,
+            misses: 0,
+            stale: 0,
+            state_age: Quantiles::default(),
+            command_age: Quantiles::default(),
+            lag: Quantiles::default(),
+            faults: Vec::new(),
+            faults_cut: false,
         }
     }
 
-    /// Adds a state.
+    /// Adds a state. One older than the states already judged (a copy, or
+    /// a log shuffled by more than half the window) is left out.
     pub fn add_state(&mut self, s: &JointState) {
-        if let Some(slot) = slot(&mut self.states, s.header.seq, self.last_seq) {
-            *slot = StateStamp {
-                seen: true,
+        let seq = s.header.seq;
+        if seq > self.last_seq || seq < self.next_state {
+            return;
+        }
+        // Judged first, so that the new stamp takes no unjudged one's slot.
+        let judge_to = (seq + 1).saturating_sub(WINDOW / 2);
+        if judge_to > self.next_state + WINDOW {
+            // A jump past the window (a gap in the log): all kept are judged.
+            self.judge_until(self.next_state + WINDOW);
+            self.next_state = judge_to;
+        }
+        self.judge_until(judge_to);
+        *self.states.slot(seq) = Some((
+            seq,
+            StateStamp {
                 wall_ns: s.header.wall_ns,
                 command_seq: s.command_seq,
                 applied_wall_ns: s.applied_wall_ns,
-            };
+            },
+        ));
+    }
+
+    /// Judges the states before seq `end`.
+    fn judge_until(&mut self, end: u64) {
+        while self.next_state < end {
+            self.judge_state(self.next_state);
+            self.next_state += 1;
         }
     }
 
-    /// Adds a command.
+    /// Adds a command; whether its reference was stale is judged at once.
     pub fn add_command(&mut self, c: &Command) {
         self.live_stale = self.live_stale.max(c.stale_references);
-        if let Some(slot) = slot(&mut self.commands, c.header.seq, self.last_seq) {
-            *slot = CommandStamp {
-                seen: true,
-                t_ns: c.header.t_ns,
+        let seq = c.header.seq;
+        if seq > self.last_seq {
+            return;
+        }
+        // A copy of one in the window is the same command: judged once.
+        if self.commands.get(seq).is_some() {
+            return;
+        }
+        *self.commands.slot(seq) = Some((
+            seq,
+            CommandStamp {
                 wall_ns: c.header.wall_ns,
                 started_wall_ns: c.started_wall_ns,
-                reference_t_ns: c.reference_t_ns,
-            };
+                taken: false,
+            },
+        ));
+        let used = (c.reference_t_ns != NONE_U64).then(|| reference_at(c.reference_t_ns));
+        if is_stale(used.as_ref(), c.header.t_ns, self.reference_period_ns) {
+            self.stale += 1;
+            self.fault(seq);
+            if let Some(r) = used {
+                let period = self.reference_period_ns.max(1);
+                let due = c.header.t_ns / period * period;
+                self.lag.add(due.saturating_sub(r.header.t_ns) as f64 / 1e3);
+            }
         }
     }
 
-    /// The figures, from every stamp collected.
-    pub fn finish(&self) -> DataPathSummary {
-        let mut faults = std::collections::BTreeSet::new();
-        let (mut misses, mut stale) = (0, 0);
-        let (mut state_age, mut command_age, mut lag) = (Vec::new(), Vec::new(), Vec::new());
-        let mut last_taken = NONE_U64;
-        for (k, s) in self.states.iter().enumerate().filter(|(_, s)| s.seen) {
-            let k = k as u64;
-            if k >= 1 && s.command_seq != k - 1 {
-                misses += 1;
-                faults.insert(k - 1);
-            }
-            // Each command's age once: when the plant took it.
-            if s.command_seq != last_taken
-                && let Some(c) = self.command(s.command_seq)
-            {
-                command_age.push(micros(s.applied_wall_ns, c.wall_ns));
-                last_taken = s.command_seq;
-            }
+    /// State `k` against its command (state age) and the command it took
+    /// (a miss, and that command's age the first time it was taken).
+    fn judge_state(&mut self, k: u64) {
+        let Some(s) = self.states.get(k).copied() else {
+            return;
+        };
+        *self.states.slot(k) = None;
+        if k >= 1 && s.command_seq != k - 1 {
+            self.misses += 1;
+            self.fault(k - 1);
         }
-        for (k, c) in self.commands.iter().enumerate().filter(|(_, c)| c.seen) {
-            let used = (c.reference_t_ns != NONE_U64).then(|| reference_at(c.reference_t_ns));
-            if is_stale(used.as_ref(), c.t_ns, self.reference_period_ns) {
-                stale += 1;
-                faults.insert(k as u64);
-                if let Some(r) = used {
-                    let due =
-                        c.t_ns / self.reference_period_ns.max(1) * self.reference_period_ns.max(1);
-                    lag.push(due.saturating_sub(r.header.t_ns) as f64 / 1e3);
-                }
-            }
-            if let Some(s) = self.states.get(k).filter(|s| s.seen) {
-                state_age.push(micros(c.started_wall_ns, s.wall_ns));
-            }
+        if s.command_seq != self.last_taken
+            && let Some(c) = self.commands.get(s.command_seq)
+            && !c.taken
+        {
+            c.taken = true;
+            let age = micros(s.applied_wall_ns, c.wall_ns);
+            self.command_age.add(age);
+            self.last_taken = s.command_seq;
         }
+        if let Some(c) = self.commands.get(k) {
+            let age = micros(c.started_wall_ns, s.wall_ns);
+            self.state_age.add(age);
+        }
+    }
+
+    fn fault(&mut self, step: u64) {
+        if self.faults.len() < MAX_FAULT_STEPS {
+            self.faults.push(step);
+        } else {
+            self.faults_cut = true;
+        }
+    }
+
+    /// The figures, once every stamp is in.
+    pub fn finish(mut self) -> DataPathSummary {
+        self.judge_until(self.next_state + WINDOW);
+        self.faults.sort_unstable();
+        self.faults.dedup();
         DataPathSummary {
             recount: Recount {
-                deadline_misses: misses,
-                stale_references: stale,
+                deadline_misses: self.misses,
+                stale_references: self.stale,
             },
             stale_references: self.live_stale,
-            state_age_us: Percentiles::of(state_age),
-            command_age_us: Percentiles::of(command_age),
-            reference_lag_us: Percentiles::of(lag),
-            fault_steps: faults.into_iter().collect(),
+            state_age_us: self.state_age.finish(),
+            command_age_us: self.command_age.finish(),
+            reference_lag_us: self.lag.finish(),
+            fault_steps: self.faults,
+            fault_steps_cut: self.faults_cut,
         }
     }
-
-    fn command(&self, seq: u64) -> Option<&CommandStamp> {
-        usize::try_from(seq)
-            .ok()
-            .and_then(|i| self.commands.get(i))
-            .filter(|c| c.seen)
-    }
-}
-
-/// The slot for `seq`, grown on demand; None past the run's last step.
-fn slot<T: Default + Clone>(v: &mut Vec<T>, seq: u64, last: u64) -> Option<&mut T> {
-    let i = usize::try_from(seq).ok().filter(|_| seq <= last)?;
-    if v.len() <= i {
-        v.resize(i + 1, T::default());
-    }
-    v.get_mut(i)
 }
 
 /// `later − earlier` in µs (negative if the clocks disagree).
@@ -248,12 +336,48 @@ mod tests {
         assert!((s.command_age_us.max - 0.7).abs() < 1e-9);
     }
 
+    /// A run far longer than the window, with a miss every 1000 steps, is
+    /// counted exactly in the window's memory.
+    #[test]
+    fn a_long_run_is_recounted_in_bounded_memory() {
+        let n = 50_000;
+        let mut d = DataPath::new(n, 1000);
+        for k in 0..n {
+            let taken = if k % 1000 == 999 {
+                k.saturating_sub(2)
+            } else {
+                k.wrapping_sub(1)
+            };
+            d.add_state(&state(k, if k == 0 { NONE_U64 } else { taken }));
+            d.add_command(&command(k, k * 1000, 0));
+        }
+        let s = d.finish();
+        assert_eq!(s.recount.deadline_misses, 50);
+        assert_eq!(s.state_age_us.count, n);
+        assert_eq!(s.fault_steps.len(), 50);
+        // States 1.. take a command each; the 50 late ones take again the
+        // one before, counted once.
+        assert_eq!(s.command_age_us.count, n - 1 - 50);
+    }
+
+    /// A hostile seq far ahead neither stalls the reader nor loses the
+    /// stamps already in.
+    #[test]
+    fn a_jump_far_ahead_judges_what_was_kept() {
+        let mut d = DataPath::new(u64::MAX / 2, 1000);
+        d.add_state(&state(0, NONE_U64));
+        d.add_state(&state(1, NONE_U64));
+        d.add_state(&state(1 << 40, 0));
+        assert_eq!(d.next_state, (1 << 40) + 1 - WINDOW / 2);
+        assert_eq!(d.finish().recount.deadline_misses, 2);
+    }
+
     #[test]
     fn a_seq_past_the_run_is_ignored() {
         let mut d = DataPath::new(2, 1000);
         d.add_state(&state(u64::MAX - 1, 0));
         d.add_command(&command(1 << 40, 0, 0));
-        assert_eq!(d.finish().recount.deadline_misses, 0);
         assert!(d.states.is_empty() && d.commands.is_empty());
+        assert_eq!(d.finish().recount.deadline_misses, 0);
     }
 }

@@ -376,7 +376,9 @@ pub fn judge(t: &mut TimingSummary, facts: &RunFacts<'_>) {
     t.timing_faults_before_non_finite = facts.first_non_finite_s.and_then(|first| {
         let d = t.data_path.as_ref()?;
         let step = (first * 1e9 / facts.period_ns.max(1) as f64).round() as u64;
-        Some(d.fault_steps.iter().take_while(|k| **k <= step).count() as u64)
+        let before = d.fault_steps.iter().take_while(|k| **k <= step).count();
+        // Past the steps kept by number the count is not known.
+        (!d.fault_steps_cut || before < d.fault_steps.len()).then_some(before as u64)
     });
     t.reasons = invalid.into_iter().chain(degraded).collect();
 }
