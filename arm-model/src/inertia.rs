@@ -82,6 +82,9 @@ pub(super) fn merge_mass(parent: &mut LinkInfo, child: &LinkInfo, t: &Isometry3<
 /// largest moment) and are still simulated as given, with a note.
 const TRIANGLE_SLACK: f64 = 0.25;
 
+/// Principal moments below this (kg m²) are zero to rounding.
+const POINT_MASS_MOMENT: f64 = 1e-12;
+
 /// A physical inertia tensor is positive semi-definite (a point mass or a
 /// thin rod has zero moments) and its principal moments obey the triangle
 /// inequality. Rounding in published files is allowed for: a tensor that
@@ -96,6 +99,18 @@ pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Option<String>, 
     };
     let mut ev: Vec<f64> = tensor(i).symmetric_eigenvalues().iter().copied().collect();
     ev.sort_by(f64::total_cmp);
+    // Moments this small (a 1 g body 30 µm across) are rounding, not a
+    // shape: such a link is a point mass, whatever the signs.
+    if ev.iter().all(|e| e.abs() <= POINT_MASS_MOMENT) {
+        let zero = ev.iter().any(|e| *e != 0.0);
+        return Ok(zero.then(|| {
+            format!(
+                "link '{link}': principal moments {:.3e}, {:.3e}, {:.3e} are zero to rounding: \
+                 taken as a point mass",
+                ev[0], ev[1], ev[2]
+            )
+        }));
+    }
     let scale = ev[2].abs().max(f64::MIN_POSITIVE);
     if ev[0] < -1e-9 * scale {
         return bad(format!(

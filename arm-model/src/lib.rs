@@ -27,6 +27,7 @@
 
 pub mod dynamics;
 mod error;
+mod file_refs;
 mod inertia;
 mod parse;
 mod prefixes;
@@ -238,9 +239,19 @@ impl ArmModel {
             )));
         }
         let (text, undeclared) = prefixes::declare_undeclared(text);
+        let (text, unnamed_files) = file_refs::fill_missing(&text);
         let robot =
             urdf_rs::read_from_string(&text).map_err(|e| ModelError::Parse(e.to_string()))?;
         let mut model = tree::build(&robot, locks)?;
+        for (element, n) in unnamed_files.iter().rev() {
+            model.notes.insert(
+                0,
+                format!(
+                    "{n} <{element}> element(s) without a filename: read as naming no file \
+                     (they do not change the dynamics)"
+                ),
+            );
+        }
         if !undeclared.is_empty() {
             model.notes.insert(
                 0,

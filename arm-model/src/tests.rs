@@ -386,3 +386,39 @@ fn a_placeholder_link_with_malformed_inertia_is_massless() {
         "{e}"
     );
 }
+
+/// iCub's head: 1.34 kg with moments ±2.4e-35 (zero but for rounding) is a
+/// point mass, noted; no refusal for a sign in the 35th decimal.
+#[test]
+fn a_tensor_zero_to_rounding_is_a_point_mass() {
+    let tiny = r#"ixx="0" ixy="0" ixz="2.40741e-35" iyy="0" iyz="0" izz="0""#;
+    let jb = J1.replace("j1", "neck").replace("\"a\"", "\"head\"");
+    let jb = jb.replace("<parent link=\"base\"/>", "<parent link=\"a\"/>");
+    let text = arm(&format!("{J1}{jb}"), &link("head", "1.33687", tiny));
+    let m = ArmModel::from_urdf_str(&text).unwrap();
+    assert!(m.ignored.is_empty(), "{:?}", m.ignored);
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.contains("link 'head'") && n.contains("point mass")),
+        "{:?}",
+        m.notes
+    );
+}
+
+/// A bare `<texture />` (romeo, icub) reads as naming no file, noted.
+#[test]
+fn a_texture_without_a_filename_is_read() {
+    let text = arm(J1, "").replace(
+        "</robot>",
+        "<material name=\"grey\"><texture /></material></robot>",
+    );
+    let m = ArmModel::from_urdf_str(&text).unwrap();
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.contains("<texture>") && n.contains("without a filename")),
+        "{:?}",
+        m.notes
+    );
+}

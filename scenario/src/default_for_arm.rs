@@ -159,7 +159,15 @@ impl ArmDefault {
             let (d, model) = Self::attempt(urdf, &chosen, &armature)?;
             let unheld = d.gains.unheld();
             attempt += 1;
-            if unheld.is_empty() || attempt > ADJUSTMENTS {
+            if attempt > ADJUSTMENTS {
+                return Ok(d);
+            }
+            let overloaded = overloaded(&d);
+            if !overloaded.is_empty() && overloaded.len() < model.dof() {
+                chosen.extend(overloaded);
+                continue;
+            }
+            if unheld.is_empty() {
                 return Ok(d);
             }
             // Lock placeholders, give the others armature; then choose again.
@@ -266,6 +274,32 @@ impl ArmDefault {
         };
         Ok((d, model))
     }
+}
+
+/// Joints that gravity alone loads beyond their effort limit somewhere
+/// along the default reference (a humanoid's 30 N m waist under a 30 kg
+/// chest, a mobile base's suspension): no controller holds them, so they
+/// are locked where the reference would hold them, and the rest of the arm
+/// is controlled. Locks to add, with the reason.
+fn overloaded(d: &ArmDefault) -> Vec<(String, f64, String)> {
+    d.gains
+        .joints
+        .iter()
+        .zip(&d.scenario.reference.joints)
+        .filter_map(|(g, r)| {
+            let e = g.effort?;
+            (g.gravity > e).then(|| {
+                (
+                    g.name.clone(),
+                    r.offset,
+                    format!(
+                        "gravity alone loads it with up to {:.1} N m along the reference, beyond its effort limit {e} N m: no controller holds it",
+                        g.gravity
+                    ),
+                )
+            })
+        })
+        .collect()
 }
 
 /// What `testbed robot` should say about the default scenario beyond its

@@ -69,6 +69,8 @@ pub struct JointGain {
     pub minv_diag: f64,
     /// τ*_i: the largest torque the reference needs, N m.
     pub load: f64,
+    /// The largest gravity torque |G_i| along the reference, N m.
+    pub gravity: f64,
     /// Its effort limit, if any.
     pub effort: Option<f64>,
     /// Why K1_i is what it is.
@@ -134,6 +136,7 @@ struct Measured {
     probes: Vec<Probe>,
     minv_diag: Vec<f64>,
     load: Vec<f64>,
+    gravity: Vec<f64>,
 }
 
 /// Probes the arm at the reference's postures; the load τ*_i of each joint.
@@ -169,10 +172,19 @@ fn measure(model: &ArmModel, s: &Scenario) -> Result<Measured, PlantError> {
             worst + urdf
         })
         .collect();
+    let gravity = (0..n)
+        .map(|i| {
+            probes
+                .iter()
+                .map(|p| p.gravity[i].abs())
+                .fold(0.0, f64::max)
+        })
+        .collect();
     Ok(Measured {
         probes,
         minv_diag,
         load,
+        gravity,
     })
 }
 
@@ -295,6 +307,7 @@ fn joint_gains(
             k2: k2[i],
             minv_diag: m.minv_diag[i],
             load: m.load[i],
+            gravity: m.gravity[i],
             effort: model.joints[model.actuated[i]].effort,
             k1_reason: k1_reason(need[i], k1_max),
             barrier: 0.0,

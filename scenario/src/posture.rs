@@ -8,8 +8,12 @@ use crate::probe::Probe;
 
 /// Load over effort at which the middle of the range is good enough.
 const COMFORTABLE: f64 = 0.3;
-/// Offsets tried, as fractions of the half range from the middle.
-const FRACTIONS: [f64; 5] = [0.0, -0.3, 0.3, -0.6, 0.6];
+/// Offsets tried, as fractions of the half range from the middle: at most
+/// 0.6, since the swing about it takes up to 0.3 more (and the limits
+/// must stay out of the reference's way).
+const FRACTIONS: [f64; 9] = [0.0, -0.15, 0.15, -0.3, 0.3, -0.45, 0.45, -0.6, 0.6];
+/// Passes of coordinate descent over the joints at most.
+const PASSES: usize = 4;
 /// Offsets tried for a joint without limits, rad.
 const UNLIMITED: [f64; 4] = [
     0.0,
@@ -22,9 +26,9 @@ const UNLIMITED: [f64; 4] = [
 /// 1 kHz hold inside the widest envelope: (ρ/Δt)(K1 Δt/Δt)(0.4 · 0.8 · 0.6 rad).
 const HELD_ACCELERATION: f64 = 1000.0 * 200.0 * 0.32 * 0.6;
 
-/// How hard gravity at `q` is on the arm: the largest of |G_i| / effort_i
-/// and |G_i| M⁻¹_ii / [`HELD_ACCELERATION`] over the joints.
-fn effort_ratio(model: &ArmModel, q: &[f64]) -> Result<f64, PlantError> {
+/// How hard gravity at `q` is on each joint: |G_i| / effort_i or
+/// |G_i| M⁻¹_ii / [`HELD_ACCELERATION`], whichever is larger.
+fn joint_ratios(model: &ArmModel, q: &[f64]) -> Result<Vec<f64>, PlantError> {
     let p = Probe::at(model, q, &vec![0.0; model.dof()])?;
     Ok(model
         .actuated
@@ -35,7 +39,24 @@ fn effort_ratio(model: &ArmModel, q: &[f64]) -> Result<f64, PlantError> {
             let motor = model.joints[ji].effort.map_or(0.0, |e| g / e);
             motor.max(g * p.minv[(i, i)] / HELD_ACCELERATION)
         })
-        .fold(0.0, f64::max))
+        .collect())
+}
+
+/// The posture's cost: the worst joint first, then how much the others ask
+/// beyond comfortable. A move that unloads a joint other than the worst
+/// counts too: the worst one's load often comes from the links beyond it.
+fn cost(ratios: &[f64]) -> (f64, f64) {
+    let worst = ratios.iter().copied().fold(0.0, f64::max);
+    let rest = ratios
+        .iter()
+        .map(|r| (r - COMFORTABLE).max(0.0).powi(2))
+        .sum();
+    (worst, rest)
+}
+
+/// Whether cost `a` beats `b` by more than rounding.
+fn better(a: (f64, f64), b: (f64, f64)) -> bool {
+    a.0 < b.0 - 1e-9 || (a.0 <= b.0 + 1e-12 && a.1 < b.1 - 1e-9)
 }
 
 fn candidates(limits: Option<(f64, f64)>) -> Vec<f64> {
@@ -56,12 +77,14 @@ pub(crate) fn choose(model: &ArmModel) -> Result<Vec<f64>, PlantError> {
         .map(|&ji| candidates(model.joints[ji].limits))
         .collect();
     let mut q: Vec<f64> = options.iter().map(|o| o[0]).collect();
-    let mut best = effort_ratio(model, &q)?;
-    if best <= COMFORTABLE {
+    let mut best = cost(&joint_ratios(model, &q)?);
+    if best.0 <= COMFORTABLE {
         return Ok(q);
     }
-    // Coordinate descent, twice over the joints from the root outwards.
-    for _ in 0..2 {
+    // Coordinate descent over the joints from the root outwards, until a
+    // pass changes nothing.
+    for _ in 0..PASSES {
+        let mut moved = false;
         for i in 0..q.len() {
             for &x in &options[i] {
                 if x == q[i] {
@@ -69,12 +92,16 @@ pub(crate) fn choose(model: &ArmModel) -> Result<Vec<f64>, PlantError> {
                 }
                 let mut trial = q.clone();
                 trial[i] = x;
-                let r = effort_ratio(model, &trial)?;
-                if r < best - 1e-9 {
-                    best = r;
+                let c = cost(&joint_ratios(model, &trial)?);
+                if better(c, best) {
+                    best = c;
                     q = trial;
+                    moved = true;
                 }
             }
+        }
+        if !moved || best.0 <= COMFORTABLE {
+            break;
         }
     }
     Ok(q)

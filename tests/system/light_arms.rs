@@ -91,9 +91,11 @@ fn a_light_joint_that_moves_real_mass_gets_armature_and_runs_clean() {
 }
 
 /// A shoulder whose gravity load at every posture its limits allow is six
-/// times its effort limit: `robot` says so, naming the joint and both numbers.
+/// times its effort limit: no controller holds it, so the default scenario
+/// locks it (`robot` says so, naming the joint and both numbers) and the
+/// elbow runs clean.
 #[test]
-fn gravity_beyond_an_effort_limit_is_a_warning() {
+fn gravity_beyond_an_effort_limit_locks_the_joint_and_says_so() {
     let dir = tempfile::tempdir().unwrap();
     let urdf = write(
         dir.path(),
@@ -102,10 +104,12 @@ fn gravity_beyond_an_effort_limit_is_a_warning() {
     );
     let text = robot_text(&urdf);
     assert!(
-        text.contains("warning: joint 'shoulder': gravity alone loads it with")
+        text.contains("warning: locked shoulder: gravity alone loads it with")
             && text.contains("beyond its effort limit 1 N m"),
         "{text}"
     );
+    let s = runs_clean(&urdf);
+    assert_eq!(s["dof"], 1, "{s}");
 }
 
 /// Drake's dialect: the base welded to a `world` the file never defines,
