@@ -12,7 +12,7 @@
 //! and why, with any gravity load beyond an effort limit.
 
 use plant_rapier::{ArmModel, JointKind, Locks, PerJoint, PlantError};
-use trajectory::{EnvelopeConfig, ReferenceConfig, Sinusoid};
+use trajectory::{EnvelopeConfig, ReferenceConfig, Signal, Sinusoid};
 
 use crate::gains::{GainChoice, choose_gains};
 use crate::probe::Probe;
@@ -99,7 +99,7 @@ fn shape(
     model: &ArmModel,
     offsets: &[f64],
     kc: Option<&[f64]>,
-) -> (Vec<Sinusoid>, Vec<Sinusoid>, Vec<f64>) {
+) -> (Vec<Signal>, Vec<Signal>, Vec<f64>) {
     let (mut reference, mut envelope, mut q0) = (Vec::new(), Vec::new(), Vec::new());
     for (i, &ji) in model.actuated.iter().enumerate() {
         let j = &model.joints[ji];
@@ -132,8 +132,8 @@ fn shape(
             let pad = 0.02 * (hi - lo);
             q = q.clamp(lo + pad, hi - pad);
         }
-        reference.push(r);
-        envelope.push(e);
+        reference.push(r.into());
+        envelope.push(e.into());
         q0.push(q);
     }
     (reference, envelope, q0)
@@ -224,12 +224,17 @@ impl ArmDefault {
             duration_s: 10.0,
             reference: ReferenceConfig {
                 joints: reference,
+                waypoints: Vec::new(),
+                file: None,
+                samples: None,
                 rate_hz: None,
                 horizon_s: trajectory::DEFAULT_HORIZON_S,
             },
             envelope: EnvelopeConfig {
                 joints: envelope,
                 from_limits: false,
+                file: None,
+                samples: None,
             },
             initial: Initial {
                 q: q0,

@@ -151,10 +151,7 @@ fn measure(model: &ArmModel, s: &Scenario) -> Result<Measured, PlantError> {
         .map(|i| probes.iter().map(|p| p.minv[(i, i)]).fold(0.0, f64::max))
         .collect();
     let r = &s.reference.joints;
-    let qdd_max: Vec<f64> = r
-        .iter()
-        .map(|r| r.amplitude() * r.omega * r.omega)
-        .collect();
+    let qdd_max: Vec<f64> = r.iter().map(trajectory::Signal::accel_bound).collect();
     let load: Vec<f64> = (0..n)
         .map(|i| {
             let j = &model.joints[model.actuated[i]];
@@ -163,7 +160,7 @@ fn measure(model: &ArmModel, s: &Scenario) -> Result<Measured, PlantError> {
                 .iter()
                 .map(|p| p.gravity[i].abs() + inertial(p))
                 .fold(0.0, f64::max);
-            let qd_max = r[i].amplitude() * r[i].omega;
+            let qd_max = r[i].speed_bound();
             let urdf = if s.plant.urdf_dynamics {
                 j.friction + j.damping * qd_max
             } else {

@@ -25,7 +25,12 @@ pub mod sweep_file;
 use controller::{ControllerError, ControllerParams};
 use plant_rapier::{PlantConfig, PlantError};
 use serde::{Deserialize, Serialize};
+use std::path::Path;
+
 use trajectory::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError};
+
+/// Largest trajectory CSV read (10⁶ rows of a few joints).
+pub const TRAJECTORY_FILE_BYTES: u64 = 128 << 20;
 
 pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
 pub use default_for_arm::{ArmDefault, GRIPPER_LOCK};
@@ -187,12 +192,44 @@ impl Default for Scenario {
 impl Scenario {
     /// Parses TOML; `file` names the source in errors.
     pub fn from_toml_str(text: &str, file: &str) -> Result<Self, ScenarioError> {
-        let s: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Toml {
+        let mut s: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Toml {
             file: file.to_string(),
             message: e.to_string().trim_end().to_string(),
         })?;
+        // Trajectory files are named relative to the scenario file.
+        let base = Path::new(file).parent().unwrap_or(Path::new(""));
+        s.read_trajectory_files(base, file)?;
         s.validate(file)?;
         Ok(s)
+    }
+
+    /// Reads `reference.file` and `envelope.file` (relative to `base`) into
+    /// their `samples`, unless they hold samples already.
+    pub fn read_trajectory_files(&mut self, base: &Path, file: &str) -> Result<(), ScenarioError> {
+        let slots = [
+            (&self.reference.file, &mut self.reference.samples),
+            (&self.envelope.file, &mut self.envelope.samples),
+        ];
+        for (name, samples) in slots {
+            let (Some(name), None) = (name, &samples) else {
+                continue;
+            };
+            let path = base.join(name);
+            let text = wire::read_text_file(&path, TRAJECTORY_FILE_BYTES).map_err(|cause| {
+                ScenarioError::Io {
+                    file: format!("{file}: {}", path.display()),
+                    cause,
+                }
+            })?;
+            let read = trajectory::Samples::from_csv(&text, &path.display().to_string()).map_err(
+                |cause| ScenarioError::Trajectory {
+                    file: file.to_string(),
+                    cause,
+                },
+            )?;
+            *samples = Some(read);
+        }
+        Ok(())
     }
 
     /// Checks the values that do not depend on the robot.

@@ -147,6 +147,16 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
             source,
         ),
     };
+    // A log must replay without the trajectory files: the scenario it
+    // keeps carries their samples.
+    let toml_text = if scenario.reference.samples.is_some() || scenario.envelope.samples.is_some() {
+        toml::to_string(&scenario).map_err(|e| ScenarioError::Toml {
+            file: source.clone(),
+            message: format!("cannot write the scenario with its trajectory samples: {e}"),
+        })?
+    } else {
+        toml_text
+    };
     if let Some(d) = overrides.duration_s {
         scenario.duration_s = d;
         scenario.validate(&format!("{source} with --duration {d}"))?;
@@ -212,8 +222,8 @@ pub fn plan(
     for (key, len) in [
         ("initial.q", scenario.initial.q.len()),
         ("initial.qd", scenario.initial.qd.len()),
-        ("reference.joints", scenario.reference.joints.len()),
-        ("envelope.joints", scenario.envelope.joints.len()),
+        ("reference.joints", scenario.reference.dof()),
+        ("envelope.joints", scenario.envelope.dof()),
     ] {
         if len != dof && !(key == "envelope.joints" && scenario.envelope.from_limits) {
             return Err(mismatch(key, len));

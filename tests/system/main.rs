@@ -20,4 +20,5 @@ mod scenarios;
 mod sim_cli;
 mod slurm;
 mod sweep;
+mod trajectories;
 mod util;

@@ -20,10 +20,18 @@
 
 mod machine;
 pub mod node;
+mod samples;
+mod signal;
 mod sinusoid;
+mod waypoints;
 
 pub use machine::TrajectoryMachine;
+pub use samples::{MAX_ROWS, Samples};
+pub use signal::{Ramp, Signal, Sine, Step};
 pub use sinusoid::Sinusoid;
+pub use waypoints::Waypoint;
+
+use samples::Spline;
 
 use serde::{Deserialize, Serialize};
 
@@ -91,6 +99,28 @@ pub enum TrajectoryError {
     /// No joints at all.
     #[error("reference.joints is empty: give one entry per joint")]
     Empty,
+    /// A value that is finite but not allowed.
+    #[error("{field}: {reason}")]
+    Invalid {
+        /// The scenario key.
+        field: String,
+        /// What is wrong and what to give.
+        reason: String,
+    },
+    /// A trajectory file's cell.
+    #[error("{file}: row {row}, column {column} ('{name}'): {reason}")]
+    Csv {
+        /// The file.
+        file: String,
+        /// Its row, from 1 (the header is row 1).
+        row: usize,
+        /// Its column, from 1.
+        column: usize,
+        /// The column's name in the header.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// More joints than a sample carries.
     #[error(
         "reference.joints has {0} entries; a reference sample carries at most {max} joints (lock the others in [plant.lock])",
@@ -105,7 +135,18 @@ pub enum TrajectoryError {
 pub struct ReferenceConfig {
     /// q_d,i(t) per joint (rad or m; default: the paper's two).
     #[serde(default = "paper_reference_joints")]
-    pub joints: Vec<Sinusoid>,
+    pub joints: Vec<Signal>,
+    /// Or: minimum-jerk moves through these postures (instead of `joints`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub waypoints: Vec<Waypoint>,
+    /// Or: a CSV file of `t` and one column per joint, relative to the
+    /// scenario file (instead of `joints`); the scenario loader reads it
+    /// into `samples`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// The samples of `file`, as read (or given inline).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<Samples>,
     /// Rate at which the trajectory publishes samples, Hz (default: unset,
     /// the control rate). The controller uses the newest sample not later
     /// than the state, so a slower reference is held between samples.
@@ -143,14 +184,19 @@ impl ReferenceConfig {
                     sin: 1.0,
                     cos: 0.0,
                     omega: 2.0,
-                },
+                }
+                .into(),
                 Sinusoid {
                     offset: 0.0,
                     sin: 0.0,
                     cos: 1.0,
                     omega: 1.0,
-                },
+                }
+                .into(),
             ],
+            waypoints: Vec::new(),
+            file: None,
+            samples: None,
             rate_hz: None,
             horizon_s: DEFAULT_HORIZON_S,
         }
@@ -158,11 +204,11 @@ impl ReferenceConfig {
 }
 
 /// A table that leaves `joints` out takes the paper's (every key is optional).
-fn paper_reference_joints() -> Vec<Sinusoid> {
+fn paper_reference_joints() -> Vec<Signal> {
     ReferenceConfig::paper().joints
 }
 
-fn paper_envelope_joints() -> Vec<Sinusoid> {
+fn paper_envelope_joints() -> Vec<Signal> {
     EnvelopeConfig::paper().joints
 }
 
@@ -173,7 +219,14 @@ pub struct EnvelopeConfig {
     /// k_c,i(t) per joint (rad or m; default: the paper's two); must stay
     /// positive. Ignored with `from_limits`.
     #[serde(default = "paper_envelope_joints")]
-    pub joints: Vec<Sinusoid>,
+    pub joints: Vec<Signal>,
+    /// Or: a CSV file of `t` and one k_c column per joint, relative to the
+    /// scenario file (instead of `joints`); read into `samples`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// The samples of `file`, as read (or given inline).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<Samples>,
     /// Take the envelope from the robot's joint limits, as in the paper's
     /// Section III: k_c,i(t) = min(upper_i − q_d,i(t), q_d,i(t) − lower_i)
     /// (default: false).
@@ -186,19 +239,23 @@ impl EnvelopeConfig {
     pub fn paper() -> Self {
         Self {
             from_limits: false,
+            file: None,
+            samples: None,
             joints: vec![
                 Sinusoid {
                     offset: 0.5,
                     sin: 0.1,
                     cos: 0.0,
                     omega: 0.5,
-                },
+                }
+                .into(),
                 Sinusoid {
                     offset: 0.45,
                     sin: 0.0,
                     cos: 0.1,
                     omega: 0.5,
-                },
+                }
+                .into(),
             ],
         }
     }
@@ -235,11 +292,56 @@ impl ReferenceSample {
     }
 }
 
+/// Where q_d comes from.
+#[derive(Debug, Clone)]
+enum Desired {
+    /// One signal per joint.
+    Signals(Vec<Signal>),
+    /// Minimum-jerk moves through postures.
+    Waypoints(Vec<Waypoint>),
+    /// A spline through a file's samples.
+    Samples(Spline),
+}
+
+impl Desired {
+    fn dof(&self) -> usize {
+        match self {
+            Self::Signals(s) => s.len(),
+            Self::Waypoints(w) => w[0].q.len(),
+            Self::Samples(s) => s.columns(),
+        }
+    }
+
+    fn eval(&self, i: usize, t: f64) -> [f64; 3] {
+        match self {
+            Self::Signals(s) => s[i].eval(t),
+            Self::Waypoints(w) => waypoints::eval(w, i, t),
+            Self::Samples(s) => s.eval(i, t),
+        }
+    }
+
+    /// The smallest and largest value joint `i` takes (bounds for signals).
+    fn range(&self, i: usize) -> (f64, f64) {
+        match self {
+            Self::Signals(s) => (s[i].min_value(), s[i].max_value()),
+            Self::Waypoints(w) => w
+                .iter()
+                .map(|p| p.q[i])
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
+                }),
+            Self::Samples(s) => s.range(i),
+        }
+    }
+}
+
 /// Where k_c comes from.
 #[derive(Debug, Clone)]
 enum Envelope {
-    /// One sinusoid per joint.
-    Sinusoids(Vec<Sinusoid>),
+    /// One signal per joint.
+    Signals(Vec<Signal>),
+    /// A spline through a file's samples.
+    Samples(Spline),
     /// The distance from q_d to the nearer joint limit.
     Limits(Vec<(f64, f64)>),
 }
@@ -247,41 +349,99 @@ enum Envelope {
 /// A validated reference and envelope.
 #[derive(Debug, Clone)]
 pub struct Reference {
-    q_d: Vec<Sinusoid>,
+    q_d: Desired,
     kc: Envelope,
 }
 
-impl ReferenceConfig {
-    /// Checks that every number is finite.
-    pub fn validate(&self) -> Result<(), TrajectoryError> {
-        if self.joints.is_empty() {
-            return Err(TrajectoryError::Empty);
+/// The samples of a `file`, which the scenario loader must have read.
+fn loaded<'a>(
+    file: &Option<String>,
+    samples: &'a Option<Samples>,
+    field: &str,
+) -> Result<Option<&'a Samples>, TrajectoryError> {
+    match (file, samples) {
+        (_, Some(s)) => {
+            s.validate(&format!("{field}.samples"))?;
+            Ok(Some(s))
         }
-        if self.joints.len() > wire::MAX_DOF {
-            return Err(TrajectoryError::TooManyJoints(self.joints.len()));
-        }
-        for (i, s) in self.joints.iter().enumerate() {
-            s.validate(&format!("reference.joints[{i}]"))?;
-        }
-        Ok(())
+        (Some(f), None) => Err(TrajectoryError::Invalid {
+            field: format!("{field}.file"),
+            reason: format!("{f:?} was not read (the scenario loader reads it)"),
+        }),
+        (None, None) => Ok(None),
     }
 }
 
-impl Reference {
-    /// Validates both configs (finite, same length, envelope > 0 everywhere).
-    /// Without `from_limits` only; see [`Reference::with_limits`].
-    pub fn new(
-        reference: &ReferenceConfig,
-        envelope: &EnvelopeConfig,
-    ) -> Result<Self, TrajectoryError> {
-        reference.validate()?;
-        if reference.joints.len() != envelope.joints.len() {
-            return Err(TrajectoryError::DofMismatch {
-                reference: reference.joints.len(),
-                envelope: envelope.joints.len(),
+impl ReferenceConfig {
+    /// Checks that every number is finite and that one source is given.
+    pub fn validate(&self) -> Result<(), TrajectoryError> {
+        self.desired().map(|_| ())
+    }
+
+    /// Joints the reference drives.
+    pub fn dof(&self) -> usize {
+        self.desired().map_or(self.joints.len(), |d| d.dof())
+    }
+
+    fn desired(&self) -> Result<Desired, TrajectoryError> {
+        let samples = loaded(&self.file, &self.samples, "reference")?;
+        let sources = usize::from(!self.waypoints.is_empty()) + usize::from(samples.is_some());
+        if sources > 1 || (sources == 1 && self.joints != paper_reference_joints()) {
+            return Err(TrajectoryError::Invalid {
+                field: "reference".into(),
+                reason: "give one of `joints`, `waypoints` or `file`, not several".into(),
             });
         }
-        for (i, s) in envelope.joints.iter().enumerate() {
+        let desired = if !self.waypoints.is_empty() {
+            waypoints::validate(&self.waypoints)?;
+            Desired::Waypoints(self.waypoints.clone())
+        } else if let Some(s) = samples {
+            Desired::Samples(Spline::new(s))
+        } else {
+            for (i, s) in self.joints.iter().enumerate() {
+                s.validate(&format!("reference.joints[{i}]"))?;
+            }
+            Desired::Signals(self.joints.clone())
+        };
+        match desired.dof() {
+            0 => Err(TrajectoryError::Empty),
+            n if n > wire::MAX_DOF => Err(TrajectoryError::TooManyJoints(n)),
+            _ => Ok(desired),
+        }
+    }
+}
+
+impl EnvelopeConfig {
+    /// Joints the envelope covers (0 with `from_limits`: it covers all).
+    pub fn dof(&self) -> usize {
+        match &self.samples {
+            Some(s) => s.values.len(),
+            None => self.joints.len(),
+        }
+    }
+
+    /// The envelope, checked positive.
+    fn envelope(&self) -> Result<Envelope, TrajectoryError> {
+        if let Some(s) = loaded(&self.file, &self.samples, "envelope")? {
+            if self.joints != paper_envelope_joints() {
+                return Err(TrajectoryError::Invalid {
+                    field: "envelope".into(),
+                    reason: "give `joints` or `file`, not both".into(),
+                });
+            }
+            let spline = Spline::new(s);
+            for (c, name) in s.columns.iter().enumerate() {
+                let (min, _) = spline.range(c);
+                if min.is_nan() || min <= 0.0 {
+                    return Err(TrajectoryError::Invalid {
+                        field: format!("envelope.file ({}, column '{name}')", s.source),
+                        reason: format!("the envelope must stay positive, but reaches {min}"),
+                    });
+                }
+            }
+            return Ok(Envelope::Samples(spline));
+        }
+        for (i, s) in self.joints.iter().enumerate() {
             let field = format!("envelope.joints[{i}]");
             s.validate(&field)?;
             let min = s.min_value();
@@ -294,9 +454,27 @@ impl Reference {
                 });
             }
         }
+        Ok(Envelope::Signals(self.joints.clone()))
+    }
+}
+
+impl Reference {
+    /// Validates both configs (finite, same length, envelope > 0 everywhere).
+    /// Without `from_limits` only; see [`Reference::with_limits`].
+    pub fn new(
+        reference: &ReferenceConfig,
+        envelope: &EnvelopeConfig,
+    ) -> Result<Self, TrajectoryError> {
+        let q_d = reference.desired()?;
+        if q_d.dof() != envelope.dof() {
+            return Err(TrajectoryError::DofMismatch {
+                reference: q_d.dof(),
+                envelope: envelope.dof(),
+            });
+        }
         Ok(Self {
-            q_d: reference.joints.clone(),
-            kc: Envelope::Sinusoids(envelope.joints.clone()),
+            q_d,
+            kc: envelope.envelope()?,
         })
     }
 
@@ -311,7 +489,7 @@ impl Reference {
         if !envelope.from_limits {
             return Self::new(reference, envelope);
         }
-        reference.validate()?;
+        let q_d = reference.desired()?;
         let mut bounds = Vec::with_capacity(limits.len());
         for (i, (lim, name)) in limits.iter().zip(names).enumerate() {
             let Some((lo, hi)) = *lim else {
@@ -319,8 +497,8 @@ impl Reference {
                     joint: name.clone(),
                 });
             };
-            if let Some(s) = reference.joints.get(i) {
-                let (min, max) = (s.min_value(), s.max_value());
+            if i < q_d.dof() {
+                let (min, max) = q_d.range(i);
                 if !(min > lo && max < hi) {
                     return Err(TrajectoryError::OutsideLimits {
                         field: format!("reference.joints[{i}]"),
@@ -334,37 +512,50 @@ impl Reference {
             }
             bounds.push((lo, hi));
         }
-        if reference.joints.len() != bounds.len() {
+        if q_d.dof() != bounds.len() {
             return Err(TrajectoryError::DofMismatch {
-                reference: reference.joints.len(),
+                reference: q_d.dof(),
                 envelope: bounds.len(),
             });
         }
         Ok(Self {
-            q_d: reference.joints.clone(),
+            q_d,
             kc: Envelope::Limits(bounds),
         })
     }
 
     /// Number of joints.
     pub fn dof(&self) -> usize {
-        self.q_d.len()
+        self.q_d.dof()
+    }
+
+    /// The smallest and largest q_d of joint `i` (bounds for signals; the
+    /// spline checked between its samples).
+    pub fn range(&self, i: usize) -> (f64, f64) {
+        self.q_d.range(i)
     }
 
     /// Fills `out` with the reference at sim time `t` (s). `out` must have
     /// been made by `ReferenceSample::new(self.dof())`.
     pub fn sample_into(&self, t: f64, out: &mut ReferenceSample) {
         out.t = t;
-        for (i, s) in self.q_d.iter().enumerate() {
-            let [v, d1, d2] = s.eval(t);
+        for i in 0..self.dof() {
+            let [v, d1, d2] = self.q_d.eval(i, t);
             out.q_d[i] = v;
             out.qd_d[i] = d1;
             out.qdd_d[i] = d2;
         }
         match &self.kc {
-            Envelope::Sinusoids(kc) => {
+            Envelope::Signals(kc) => {
                 for (i, s) in kc.iter().enumerate() {
                     let [v, d1, _] = s.eval(t);
+                    out.kc[i] = v;
+                    out.kc_dot[i] = d1;
+                }
+            }
+            Envelope::Samples(spline) => {
+                for i in 0..spline.columns() {
+                    let [v, d1, _] = spline.eval(i, t);
                     out.kc[i] = v;
                     out.kc_dot[i] = d1;
                 }
@@ -444,6 +635,8 @@ mod tests {
         let env = EnvelopeConfig {
             joints: vec![],
             from_limits: true,
+            file: None,
+            samples: None,
         };
         let names = ["a".to_string(), "b".to_string()];
         let r = Reference::with_limits(

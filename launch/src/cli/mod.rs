@@ -54,6 +54,10 @@ enum Command {
         /// The URDF file.
         #[arg(value_name = "URDF")]
         path: PathBuf,
+        /// Also write the default scenario to FILE as TOML, to edit and run
+        /// with `testbed sim FILE` (its `robot` key names the URDF).
+        #[arg(long, value_name = "FILE")]
+        write_scenario: Option<PathBuf>,
     },
     /// Measure speed and timing on this machine: in process, lockstep, real
     /// time, and the machine's own timer floor.
@@ -167,8 +171,17 @@ pub fn run() -> Result<ExitCode> {
             write_stdout(&scenarios::scenario_list())?;
             Ok(ExitCode::SUCCESS)
         }
-        Command::Robot { path } => {
+        Command::Robot {
+            path,
+            write_scenario,
+        } => {
+            if let Some(out) = &write_scenario {
+                robot::write_scenario(&path, out)?;
+            }
             write_stdout(&robot::describe(&path)?)?;
+            if let Some(out) = &write_scenario {
+                eprintln!("testbed: default scenario written to {}", out.display());
+            }
             Ok(ExitCode::SUCCESS)
         }
         Command::Node { name, args } => {

@@ -4,7 +4,7 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use plant_rapier::{ArmModel, Locks};
 use scenario::{ArmDefault, RobotSource};
 
@@ -34,6 +34,28 @@ pub fn describe(path: &Path) -> Result<String> {
     default_scenario(&mut out, &d);
     warnings(&mut out, &d);
     Ok(out)
+}
+
+/// Writes the default scenario for the arm at `path` to `out` as TOML,
+/// naming the URDF by its absolute path so the file runs from anywhere.
+pub fn write_scenario(path: &Path, out: &Path) -> Result<()> {
+    let robot = RobotSource::from_file(path, &Locks::new())?;
+    let mut s = scenario::Scenario::for_arm(&robot.urdf).map_err(|cause| {
+        scenario::ScenarioError::Plant {
+            file: robot.label(),
+            cause,
+        }
+    })?;
+    let abs = std::path::absolute(path).with_context(|| format!("resolving {}", path.display()))?;
+    s.robot = Some(abs.display().to_string());
+    let text = toml::to_string(&s).context("writing the default scenario as TOML")?;
+    let header = format!(
+        "# The default scenario testbed chose for {}\n# (testbed robot {} --write-scenario). Edit it, then: testbed sim --scenario {}\n\n",
+        robot.label(),
+        path.display(),
+        out.display()
+    );
+    std::fs::write(out, header + &text).with_context(|| format!("writing {}", out.display()))
 }
 
 /// The Foxglove layout (pretty JSON) for the arm at `path`, or the paper's.
