@@ -185,9 +185,10 @@ impl ArmDefault {
                         g.name.clone(),
                         lock_position(model.joints[ji].limits),
                         format!(
-                            "a placeholder ({moved:.2e} kg moved, under {} % of the arm) that no gain holds at {} Hz against the barrier term (max M⁻¹_ii {:.3e}; it would need armature {need:.2e})",
+                            "a placeholder ({moved:.2e} kg moved, under {} % of the arm) that no gain holds at {} Hz {} (max M⁻¹_ii {:.3e}; it would need armature {need:.2e})",
                             100.0 * PLACEHOLDER_FRACTION,
                             d.scenario.rate_hz,
+                            armature_purpose(g),
                             g.minv_diag
                         ),
                     ));
@@ -198,8 +199,10 @@ impl ArmDefault {
                         g.name.clone(),
                         need,
                         format!(
-                            "no gain holds it at {} Hz against the barrier term (max M⁻¹_ii {:.3e}, K_b Δt/K2 = {:.2} at the widest envelope its range allows); real motors add armature, URDFs omit it",
-                            d.scenario.rate_hz, g.minv_diag, g.barrier
+                            "no gain holds it at {} Hz {} (max M⁻¹_ii {:.3e}); real motors add armature, URDFs omit it",
+                            d.scenario.rate_hz,
+                            armature_purpose(g),
+                            g.minv_diag
                         ),
                     ));
                 }
@@ -281,6 +284,20 @@ impl ArmDefault {
     }
 }
 
+/// What a joint's armature is for, as `robot` says it.
+fn armature_purpose(g: &crate::JointGain) -> String {
+    match g.armature_for {
+        Some(crate::ArmatureFor::Barrier) | None => format!(
+            "against the barrier term (K_b Δt/K2 = {:.2} at the widest envelope its range allows)",
+            g.barrier
+        ),
+        Some(crate::ArmatureFor::Load) => format!(
+            "within its envelope against its load of {:.3} N m (K1 at most 0.2/Δt)",
+            g.load
+        ),
+    }
+}
+
 /// Joints that gravity alone loads beyond their effort limit somewhere
 /// along the default reference (a humanoid's 30 N m waist under a 30 kg
 /// chest, a mobile base's suspension): no controller holds them, so they
@@ -333,8 +350,10 @@ fn warnings(
     for j in &gains.joints {
         if let Some(a) = j.armature_needed {
             out.push(format!(
-                "joint '{}': no gain holds it at {} Hz against the barrier term even with the armature added (it needs {a:.2e} more); lock it in [plant.lock] or raise rate_hz",
-                j.name, gains.rate_hz
+                "joint '{}': no gain holds it at {} Hz {} even with the armature added (it needs {a:.2e} more); lock it in [plant.lock] or raise rate_hz",
+                j.name,
+                gains.rate_hz,
+                armature_purpose(j)
             ));
         }
         if let Some(why) = &j.envelope_reason {

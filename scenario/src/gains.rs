@@ -9,7 +9,8 @@
 //! 40 % of the envelope needs K1_i ≥ τ*_i / (0.4 k_c,i K2_i). K1_i is kept
 //! at most 0.2/Δt so that the position loop stays well inside the velocity
 //! loop; where that is not enough the joint's envelope is widened, as far
-//! as its range allows. Only if some joint needs more is the rate raised.
+//! as its range allows. Where that is not enough either, the joint is
+//! reported (`armature`): armature raises M_ii, hence K2, at the same rate.
 //!
 //! The barrier term γ Z1γ/(β D) of the law (SPEC §7) is a position gain of
 //! its own, K_b = γ²(k_c² + Z1γ²)/(β (k_c² − Z1γ²)²), which K1 and K2 do
@@ -35,8 +36,6 @@ const ERROR_FRACTION: f64 = 0.4;
 const K1_DT_MAX: f64 = 0.2;
 /// The paper's gain: the smallest K1_i chosen.
 const K1_MIN: f64 = 15.0;
-/// Fastest rate the default scenario will use.
-const MAX_RATE_HZ: f64 = 10_000.0;
 /// Postures probed along the reference.
 const POSTURES: usize = 12;
 /// How far into the envelope the loop must stay stable with the barrier
@@ -83,6 +82,17 @@ pub struct JointGain {
     /// Armature (kg m² or kg) the joint needs for the barrier term to be
     /// held at this rate, when widening its envelope is not enough.
     pub armature_needed: Option<f64>,
+    /// What the armature is for.
+    pub armature_for: Option<ArmatureFor>,
+}
+
+/// Why a joint needs armature at the scenario's rate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ArmatureFor {
+    /// The barrier term's stiffness breaks the sampled loop of a light joint.
+    Barrier,
+    /// No K1 ≤ 0.2/Δt holds the load within 40 % of the widest envelope.
+    Load,
 }
 
 /// The gains of every joint, the rate, and the margins behind them.
@@ -90,8 +100,6 @@ pub struct JointGain {
 pub struct GainChoice {
     /// Control rate, Hz.
     pub rate_hz: f64,
-    /// Why the rate is not the scenario's 1 kHz, if it is not.
-    pub rate_reason: Option<String>,
     /// Per joint.
     pub joints: Vec<JointGain>,
     /// The largest Δt·λ_max(K2^½ M⁻¹ K2^½) over the postures (< 2 is stable).
@@ -217,77 +225,67 @@ pub fn choose_gains(
         .map(|e| e.min_value() / e.offset)
         .collect();
     let beta = s.controller.beta;
-    let mut rate = s.rate_hz;
-    loop {
-        let dt = 1.0 / rate;
-        let k2 = k2_at(&m, dt);
-        let k1_max = K1_DT_MAX / dt;
-        let need: Vec<f64> = (0..n)
-            .map(|i| m.load[i] / (ERROR_FRACTION * kc_low[i] * kc[i] * k2[i]))
-            .collect();
-        // The envelope the barrier term needs: K_b Δt/K2 ≤ the budget.
-        let barrier_kc: Vec<f64> = (0..n)
-            .map(|i| (barrier_factor() * dt / (beta * k2[i] * BARRIER_BUDGET)).sqrt() / kc_low[i])
-            .collect();
-        // Where K1 is capped, the envelope may widen up to its cap instead.
-        let load_kc: Vec<f64> = (0..n)
-            .map(|i| kc[i] * (need[i] / k1_max).max(1.0))
-            .collect();
-        let envelope: Vec<f64> = (0..n)
-            .map(|i| load_kc[i].max(barrier_kc[i]).min(kc_cap[i].max(kc[i])))
-            .collect();
-        let short = (0..n)
-            .map(|i| kc[i] * (need[i] / k1_max).max(1.0) / kc_cap[i].max(kc[i]))
-            .fold(0.0, f64::max);
-        if short <= 1.0 || rate >= MAX_RATE_HZ {
-            let rate_reason = (rate != s.rate_hz).then(|| {
-                format!(
-                    "at {} Hz no K1_i ≤ {:.0} holds joint {}'s load within 40 % of the widest envelope its range allows; K1 K2 grows with the rate squared",
-                    s.rate_hz,
-                    K1_DT_MAX * s.rate_hz,
-                    worst_joint(model, &need)
-                )
-            });
-            let mut joints = joint_gains(model, &m, &k2, &need, k1_max);
-            for (i, j) in joints.iter_mut().enumerate() {
-                let low = kc_low[i] * envelope[i];
-                j.barrier = barrier_factor() * dt / (beta * low * low * k2[i]);
-                j.envelope_reason = (envelope[i] > kc[i] * (1.0 + 1e-9)).then(|| {
-                    if barrier_kc[i] > load_kc[i] {
-                        "the barrier term on a light joint (K_b Δt/K2 ≤ 1)".to_string()
-                    } else {
-                        format!("the load, with K1 capped at {k1_max:.0}")
-                    }
-                });
-                if j.barrier > BARRIER_BUDGET * (1.0 + 1e-9) {
-                    // M⁻¹_ii for which K2 = ρ_i/(Δt M⁻¹_ii) brings the
-                    // barrier's share to the budget; armature a gives
-                    // M⁻¹_ii/(1 + a M⁻¹_ii) (Sherman–Morrison).
-                    let minv = m.minv_diag[i];
-                    let rho = k2[i] * dt * minv;
-                    let target =
-                        BARRIER_BUDGET * beta * low * low * rho / (barrier_factor() * dt * dt);
-                    j.armature_needed = Some(round2(ARMATURE_MARGIN * (1.0 / target - 1.0 / minv)));
-                }
+    let rate = s.rate_hz;
+    let dt = 1.0 / rate;
+    let k2 = k2_at(&m, dt);
+    let k1_max = K1_DT_MAX / dt;
+    let need: Vec<f64> = (0..n)
+        .map(|i| m.load[i] / (ERROR_FRACTION * kc_low[i] * kc[i] * k2[i]))
+        .collect();
+    // The envelope the barrier term needs: K_b Δt/K2 ≤ the budget.
+    let barrier_kc: Vec<f64> = (0..n)
+        .map(|i| (barrier_factor() * dt / (beta * k2[i] * BARRIER_BUDGET)).sqrt() / kc_low[i])
+        .collect();
+    // Where K1 is capped, the envelope may widen up to its cap instead.
+    let load_kc: Vec<f64> = (0..n)
+        .map(|i| kc[i] * (need[i] / k1_max).max(1.0))
+        .collect();
+    let cap: Vec<f64> = (0..n).map(|i| kc_cap[i].max(kc[i])).collect();
+    let envelope: Vec<f64> = (0..n)
+        .map(|i| load_kc[i].max(barrier_kc[i]).min(cap[i]))
+        .collect();
+    let mut joints = joint_gains(model, &m, &k2, &need, k1_max);
+    for (i, j) in joints.iter_mut().enumerate() {
+        let low = kc_low[i] * envelope[i];
+        j.barrier = barrier_factor() * dt / (beta * low * low * k2[i]);
+        j.envelope_reason = (envelope[i] > kc[i] * (1.0 + 1e-9)).then(|| {
+            if barrier_kc[i] > load_kc[i] {
+                "the barrier term on a light joint (K_b Δt/K2 ≤ 1)".to_string()
+            } else {
+                format!("the load, with K1 capped at {k1_max:.0}")
             }
-            return Ok(GainChoice {
-                rate_hz: rate,
-                rate_reason,
-                joints,
-                stability_number: m
-                    .probes
-                    .iter()
-                    .map(|p| p.stability_number(&k2, dt))
-                    .fold(0.0, f64::max),
-                envelope,
-            });
+        });
+        // M⁻¹_ii with armature a is M⁻¹_ii/(1 + a M⁻¹_ii) (Sherman–Morrison),
+        // and K2 = ρ_i/(Δt M⁻¹_ii) grows with it.
+        let minv = m.minv_diag[i];
+        let rho = k2[i] * dt * minv;
+        if j.barrier > BARRIER_BUDGET * (1.0 + 1e-9) {
+            let target = BARRIER_BUDGET * beta * low * low * rho / (barrier_factor() * dt * dt);
+            j.armature_needed = Some(round2(ARMATURE_MARGIN * (1.0 / target - 1.0 / minv)));
+            j.armature_for = Some(ArmatureFor::Barrier);
+        } else if load_kc[i] > cap[i] * (1.0 + 1e-9) {
+            // K1_max K2 must hold the load within 40 % of the widest
+            // envelope: K2 ≥ load/c. The armature adds a q̈_d,i to the load.
+            let c = ERROR_FRACTION * kc_low[i] * cap[i] * k1_max;
+            let qdd = s.reference.joints.get(i).map_or(0.0, trajectory::Signal::accel_bound);
+            let per_armature = rho / dt - qdd / c;
+            let a = (m.load[i] / c - rho / (dt * minv)) / per_armature;
+            if per_armature > 0.0 && a > 0.0 {
+                j.armature_needed = Some(round2(ARMATURE_MARGIN * a));
+                j.armature_for = Some(ArmatureFor::Load);
+            }
         }
-        // K1_max K2 grows with rate²: the rate that closes the gap, in
-        // multiples of 100 Hz so the period stays a round number of ns.
-        rate = ((rate * short.sqrt() / 100.0).ceil() * 100.0)
-            .min(MAX_RATE_HZ)
-            .max(rate + 100.0);
     }
+    Ok(GainChoice {
+        rate_hz: rate,
+        joints,
+        stability_number: m
+            .probes
+            .iter()
+            .map(|p| p.stability_number(&k2, dt))
+            .fold(0.0, f64::max),
+        envelope,
+    })
 }
 
 fn joint_gains(
@@ -310,6 +308,7 @@ fn joint_gains(
             barrier: 0.0,
             envelope_reason: None,
             armature_needed: None,
+            armature_for: None,
         })
         .collect()
 }
@@ -321,13 +320,6 @@ fn round2(x: f64) -> f64 {
     }
     let scale = 10f64.powf(x.log10().floor() - 1.0);
     (x / scale).ceil() * scale
-}
-
-fn worst_joint(model: &ArmModel, need: &[f64]) -> String {
-    let i = (0..need.len())
-        .max_by(|&a, &b| need[a].total_cmp(&need[b]))
-        .unwrap_or(0);
-    format!("'{}'", model.joints[model.actuated[i]].name)
 }
 
 fn k1_reason(need: f64, k1_max: f64) -> String {

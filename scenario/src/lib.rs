@@ -34,7 +34,7 @@ pub const TRAJECTORY_FILE_BYTES: u64 = 128 << 20;
 
 pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
 pub use default_for_arm::{ArmDefault, GRIPPER_LOCK};
-pub use gains::{GainChoice, JointGain};
+pub use gains::{ArmatureFor, GainChoice, JointGain};
 pub use plan::{Overrides, Plan, load, plan};
 pub use probe::Probe;
 pub use robot::RobotSource;

@@ -149,9 +149,6 @@ fn warnings(out: &mut String, d: &ArmDefault) {
             controlled - wire::MAX_DOF
         ));
     }
-    if let Some(why) = &d.gains.rate_reason {
-        lines.push(format!("rate raised to {} Hz: {why}", d.scenario.rate_hz));
-    }
     for (name, why) in &d.locked {
         if !why.starts_with(scenario::GRIPPER_LOCK) {
             lines.push(format!("locked {name}: {why}"));
@@ -181,9 +178,6 @@ fn default_scenario(out: &mut String, d: &ArmDefault) {
         s.rate_hz,
         g.joints.len()
     );
-    if let Some(why) = &g.rate_reason {
-        let _ = writeln!(out, "  rate raised from 1000 Hz: {why}");
-    }
     for (name, why) in &d.locked {
         let at = s.plant.lock.get(name).copied().unwrap_or(0.0);
         let _ = writeln!(out, "  locked {name} at {at:.4}: {why}");
