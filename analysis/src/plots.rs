@@ -1,4 +1,5 @@
-//! The paper's five figures and a timing figure, as PNG and SVG.
+//! The paper's five figures, the error as a fraction of its envelope after
+//! T_c, and a timing figure, as PNG and SVG.
 //!
 //! Text is drawn with an embedded DejaVu Sans (see `assets/`), so figures do
 //! not depend on the fonts of the machine.
@@ -88,7 +89,8 @@ fn draw_panels<DB: DrawingBackend>(
     root.fill(&WHITE).map_err(err)?;
     let root = root.titled(title, (FAMILY, 22)).map_err(err)?;
     let areas = root.split_evenly((panels.len(), 1));
-    let t_end = t.last().copied().unwrap_or(1.0).max(1e-9);
+    let t0 = t.first().copied().unwrap_or(0.0);
+    let t_end = t.last().copied().unwrap_or(1.0).max(t0 + 1e-9);
     for (area, panel) in areas.iter().zip(panels) {
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for l in &panel.lines {
@@ -106,7 +108,7 @@ fn draw_panels<DB: DrawingBackend>(
             .margin(8)
             .x_label_area_size(32)
             .y_label_area_size(60)
-            .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))
+            .build_cartesian_2d(t0..t_end, (lo - pad)..(hi + pad))
             .map_err(err)?;
         chart
             .configure_mesh()
@@ -210,12 +212,16 @@ fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
     velocities(dir, s, &names, tc)?;
     errors(dir, s, &names, tc)?;
     weights_and_torques(dir, s, &names, tc)?;
+    let mut written = 5;
+    if error_over_envelope(dir, s, &names, tc)? {
+        written += 1;
+    }
     // An in-process run has no cross-process timing to draw.
     if s.jitter_us.is_empty() && s.round_trip_us.is_empty() {
-        return Ok(5);
+        return Ok(written);
     }
     timing_figure(dir, s)?;
-    Ok(6)
+    Ok(written + 1)
 }
 
 /// One line of a panel in the `i`-th colour.
@@ -335,6 +341,49 @@ fn errors(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), Strin
         Some(tc),
     )?;
     Ok(())
+}
+
+/// |Z1|/k_c after T_c, per joint, against the constraint's 1: how close
+/// the error comes to its envelope, on a scale where a 0.03 rad error is
+/// not a flat line beside a 0.5 rad bound. None before T_c to draw: false.
+fn error_over_envelope(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<bool, String> {
+    let from = s.t.partition_point(|t| *t < tc);
+    if s.t.len().saturating_sub(from) < 2 {
+        return Ok(false);
+    }
+    let t = &s.t[from..];
+    let ratio: Vec<Vec<f64>> = (0..names.len())
+        .map(|i| {
+            (from..s.t.len())
+                .map(|k| s.z1[i][k].abs() / s.kc[i][k])
+                .collect()
+        })
+        .collect();
+    let one = vec![1.0; t.len()];
+    let panels: Vec<Panel<'_>> = (0..names.len())
+        .map(|i| Panel {
+            title: format!("{}: |Z1| / k_c after T_c", names[i]),
+            y_label: "|Z1| / k_c",
+            lines: vec![
+                line("|Z1| / k_c".into(), &ratio[i], 0, false),
+                Line {
+                    label: "constraint (1)".into(),
+                    y: &one,
+                    color: RED,
+                    dashed: true,
+                },
+            ],
+        })
+        .collect();
+    save(
+        dir,
+        "fig7_error_over_envelope",
+        "Tracking error as a fraction of the envelope, after T_c",
+        t,
+        &panels,
+        None,
+    )?;
+    Ok(true)
 }
 
 /// Figs. 4 and 5: the actor's weight norms and the torques.

@@ -263,6 +263,7 @@ pub(crate) fn load(robot: Option<&Path>, opts: &BenchOptions) -> Result<Plan, Be
             rate_hz: None,
             robot: robot.map(Path::to_path_buf),
             law: opts.law,
+            set: Vec::new(),
         },
     )?)
 }
@@ -279,6 +280,7 @@ pub(crate) fn stack(
         csv: None,
         external: Vec::new(),
         runs_dir: opts.runs_dir.clone(),
+        name: None,
         progress: false,
         realtime_setup: opts.realtime_setup,
         verbose: false,

@@ -267,7 +267,11 @@ pub fn choose_gains(
             // K1_max K2 must hold the load within 40 % of the widest
             // envelope: K2 ≥ load/c. The armature adds a q̈_d,i to the load.
             let c = ERROR_FRACTION * kc_low[i] * cap[i] * k1_max;
-            let qdd = s.reference.joints.get(i).map_or(0.0, trajectory::Signal::accel_bound);
+            let qdd = s
+                .reference
+                .joints
+                .get(i)
+                .map_or(0.0, trajectory::Signal::accel_bound);
             let per_armature = rho / dt - qdd / c;
             let a = (m.load[i] / c - rho / (dt * minv)) / per_armature;
             if per_armature > 0.0 && a > 0.0 {

@@ -35,7 +35,7 @@ pub const TRAJECTORY_FILE_BYTES: u64 = 128 << 20;
 pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
 pub use default_for_arm::{ArmDefault, GRIPPER_LOCK};
 pub use gains::{ArmatureFor, GainChoice, JointGain};
-pub use plan::{Overrides, Plan, load, plan};
+pub use plan::{Overrides, Plan, load, parse_set, plan};
 pub use probe::Probe;
 pub use robot::RobotSource;
 pub use wire::ns_to_s;

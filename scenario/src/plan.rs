@@ -103,6 +103,45 @@ pub struct Overrides {
     /// kept, keys the law does not take go back to their defaults
     /// ([`controller::ControllerParams::for_law`]), as in `compare`.
     pub law: Option<controller::LawName>,
+    /// `--set key.path=value`, applied in order to the scenario's TOML
+    /// before it is read (so checked like the file).
+    pub set: Vec<(String, toml::Value)>,
+}
+
+/// Reads `key.path=value` (the value in TOML; a bare word is a string).
+pub fn parse_set(arg: &str) -> Result<(String, toml::Value), String> {
+    let Some((key, raw)) = arg.split_once('=') else {
+        return Err(format!("{arg:?} is not KEY=VALUE (e.g. controller.k1=20)"));
+    };
+    let key = key.trim().to_string();
+    crate::sweep_file::checks::check_key_shape(&key)?;
+    let raw = raw.trim();
+    let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(raw.to_string()));
+    Ok((key, value))
+}
+
+/// `text` with every `set` applied; `source` says so, for messages.
+fn apply_set(
+    text: &str,
+    source: &str,
+    set: &[(String, toml::Value)],
+) -> Result<(String, String), ScenarioError> {
+    let err = |message: String| ScenarioError::Toml {
+        file: source.to_string(),
+        message,
+    };
+    let mut root: toml::Table = toml::from_str(text).map_err(|e| err(e.to_string()))?;
+    let mut said = Vec::new();
+    for (key, value) in set {
+        crate::sweep_file::set_key(&mut root, key, value.clone())
+            .map_err(|e| err(format!("--set {key}: {e}")))?;
+        said.push(format!("--set {key}={value}"));
+    }
+    let text = toml::to_string(&root).map_err(|e| err(e.to_string()))?;
+    Ok((text, format!("{source} with {}", said.join(" "))))
 }
 
 /// Loads a scenario file (or the built-in paper scenario when `path` is
@@ -129,7 +168,7 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
         Some(path) => Some(RobotSource::from_file(path, &Locks::new())?),
         None => None,
     };
-    let (mut scenario, toml_text, source) = match (&arm, path) {
+    let (scenario, toml_text, source) = match (&arm, path) {
         (Some(arm), None) => {
             let s = Scenario::for_arm(&arm.urdf).map_err(|cause| ScenarioError::Plant {
                 file: arm.label(),
@@ -146,6 +185,19 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
             toml_text,
             source,
         ),
+    };
+    let (mut scenario, toml_text, source) = if overrides.set.is_empty() {
+        (scenario, toml_text, source)
+    } else {
+        let (text, said) = apply_set(&toml_text, &source, &overrides.set)?;
+        // Relative paths in the file stay relative to it.
+        let mut s: Scenario = toml::from_str(&text).map_err(|e| ScenarioError::Toml {
+            file: said.clone(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        s.read_trajectory_files(base.as_deref().unwrap_or(Path::new("")), &said)?;
+        s.validate(&said)?;
+        (s, text, said)
     };
     // A log must replay without the trajectory files: the scenario it
     // keeps carries their samples.

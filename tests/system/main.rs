@@ -22,3 +22,4 @@ mod slurm;
 mod sweep;
 mod trajectories;
 mod util;
+mod workflow;

@@ -263,8 +263,13 @@ fn sim_writes_figures_and_a_wrong_scenario_name_lists_the_shipped_ones() {
             .args(["sim", "--duration", "2.5", "--plots"])
             .arg(&plots),
     );
-    assert!(String::from_utf8_lossy(&out.stderr).contains("wrote 5 figures"));
-    for f in ["fig3_errors.png", "fig3_errors.svg", "fig1_positions.png"] {
+    assert!(String::from_utf8_lossy(&out.stderr).contains("wrote 6 figures"));
+    for f in [
+        "fig3_errors.png",
+        "fig3_errors.svg",
+        "fig1_positions.png",
+        "fig7_error_over_envelope.png",
+    ] {
         assert!(plots.join(f).metadata().unwrap().len() > 1000, "{f}");
     }
     let err = crate::util::fails(crate::util::testbed().args(["sim", "--scenario", "paper_typo"]));

@@ -30,6 +30,11 @@ pub(crate) struct ScenarioArgs {
     /// Write one row per control step to this CSV file.
     #[arg(long, value_name = "FILE")]
     pub(crate) csv: Option<PathBuf>,
+    /// Set one scenario key (repeatable), checked like the file:
+    /// `--set plant.engine=rapier --set controller.k1=20`. The value is
+    /// TOML (`[1.0, 2.0]`, `true`); a bare word is a string.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = scenario::parse_set)]
+    pub(crate) set: Vec<(String, toml::Value)>,
 }
 
 #[derive(Debug, Args)]
@@ -58,6 +63,10 @@ pub(crate) struct RunArgs {
     /// Folder for run folders.
     #[arg(long, value_name = "DIR", default_value = "runs")]
     pub(crate) runs_dir: PathBuf,
+    /// Name the run's folder (RUNS_DIR/NAME; default: <epoch seconds>-<pid>);
+    /// refused if it exists.
+    #[arg(long, value_name = "NAME", value_parser = parse_run_name)]
+    pub(crate) name: Option<String>,
     /// Leave the nodes where the OS puts them: no CPU pinning, and in real
     /// time no SCHED_FIFO and no locked memory.
     #[arg(long)]
@@ -100,6 +109,23 @@ fn parse_live_addr(s: &str) -> Result<std::net::SocketAddr, String> {
         .map_err(|e| format!("{s:?} is not ADDR:PORT ({e})"))?
         .next()
         .ok_or_else(|| format!("{s:?} names no address"))
+}
+
+/// A run folder's name: one path component of printable characters.
+fn parse_run_name(s: &str) -> Result<String, String> {
+    let ok = !s.is_empty()
+        && s.len() <= 100
+        && s != "."
+        && s != ".."
+        && !s.contains('/')
+        && !s.chars().any(char::is_control);
+    if ok {
+        Ok(s.to_string())
+    } else {
+        Err(format!(
+            "{s:?} is not a folder name (1 to 100 printable characters, no '/', not . or ..)"
+        ))
+    }
 }
 
 fn parse_live_clients(s: &str) -> Result<usize, String> {
@@ -213,6 +239,10 @@ pub(crate) struct CompareArgs {
     /// Run for this many seconds instead of the scenario's duration_s.
     #[arg(long, value_name = "S")]
     pub(crate) duration: Option<f64>,
+    /// Set one scenario key (repeatable), checked like the file, e.g.
+    /// `--set controller.tc=3`.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = scenario::parse_set)]
+    pub(crate) set: Vec<(String, toml::Value)>,
     /// The laws, comma-separated [default: every law but pd-gravity].
     #[arg(long, value_name = "LAW,…", value_delimiter = ',', value_parser = law_parser())]
     pub(crate) laws: Vec<controller::LawName>,

@@ -44,6 +44,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
         law: None,
         json: args.json,
         csv: None,
+        set: args.set.clone(),
     };
     let plan = super::load(&common, None)?;
     let laws = if args.laws.is_empty() {

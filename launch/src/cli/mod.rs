@@ -198,6 +198,7 @@ pub(crate) fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario:
         rate_hz: rate,
         robot: common.robot.clone(),
         law: common.law,
+        set: common.set.clone(),
     };
     let path = common.scenario.as_deref().map(resolve_scenario);
     if let Some(p) = &path

@@ -20,6 +20,7 @@ pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
         csv: args.common.csv.clone(),
         external: args.external.iter().map(|n| n.kind()).collect(),
         runs_dir: args.runs_dir.clone(),
+        name: args.name.clone(),
         progress: std::io::stderr().is_terminal(),
         realtime_setup: !args.no_realtime_setup,
         verbose,

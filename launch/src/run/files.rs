@@ -21,6 +21,36 @@ pub(super) struct RunFiles {
     pub(super) configs: Vec<(NodeKind, PathBuf)>,
 }
 
+/// Makes the run's folder under `runs_dir`: `name`, or a fresh id (with a
+/// suffix when a run of this process made one the same second). A folder
+/// is never reused: an earlier run's files stay as they are.
+fn new_folder(runs_dir: &Path, name: Option<&str>) -> Result<PathBuf, RunError> {
+    let fail = |p: &Path, e: std::io::Error| RunError::Output(p.display().to_string(), e);
+    let id = run_id();
+    let tries: Vec<String> = match name {
+        Some(n) => vec![n.to_string()],
+        None => std::iter::once(id.clone())
+            .chain((2..100).map(|k| format!("{id}-{k}")))
+            .collect(),
+    };
+    for t in &tries {
+        let dir = std::path::absolute(runs_dir.join(t)).map_err(|e| fail(runs_dir, e))?;
+        match std::fs::create_dir(&dir) {
+            Ok(()) => return Ok(dir),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && name.is_none() => {}
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                let why = "a run folder of that name exists: choose another --name, or remove it";
+                return Err(fail(&dir, std::io::Error::new(e.kind(), why)));
+            }
+            Err(e) => return Err(fail(&dir, e)),
+        }
+    }
+    Err(fail(
+        runs_dir,
+        std::io::Error::other("no free run folder name: 99 runs this second"),
+    ))
+}
+
 impl RunFiles {
     pub(super) fn write(opts: &RunOptions) -> Result<Self, RunError> {
         let plan = &opts.plan;
@@ -28,9 +58,8 @@ impl RunFiles {
             let p = p.display().to_string();
             move |e| RunError::Output(p.clone(), e)
         };
-        let run_dir =
-            std::path::absolute(opts.runs_dir.join(run_id())).map_err(out(&opts.runs_dir))?;
-        std::fs::create_dir_all(&run_dir).map_err(out(&run_dir))?;
+        std::fs::create_dir_all(&opts.runs_dir).map_err(out(&opts.runs_dir))?;
+        let run_dir = new_folder(&opts.runs_dir, opts.name.as_deref())?;
         let scenario_file = run_dir.join("scenario.toml");
         let toml = plan.effective_toml().map_err(|e| {
             RunError::Output(

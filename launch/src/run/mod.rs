@@ -68,6 +68,9 @@ pub struct RunOptions {
     pub external: Vec<NodeKind>,
     /// Folder under which the run's folder is made.
     pub runs_dir: PathBuf,
+    /// The run folder's name (default: `<epoch seconds>-<pid>`); a folder
+    /// of that name must not exist yet.
+    pub name: Option<String>,
     /// Show a progress bar (real time, on a terminal).
     pub progress: bool,
     /// Pin the nodes to CPUs and, in real time, run the loop under

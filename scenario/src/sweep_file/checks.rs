@@ -7,7 +7,7 @@ use super::{MAX_KEY_PARTS, MAX_RUNS, SweepFile, SweepFileError, set_key};
 use crate::{Plan, Scenario};
 
 /// A dotted scenario key of at most [`MAX_KEY_PARTS`] non-empty parts.
-pub(super) fn check_key_shape(key: &str) -> Result<(), String> {
+pub(crate) fn check_key_shape(key: &str) -> Result<(), String> {
     let parts = key.split('.').take(MAX_KEY_PARTS + 1).collect::<Vec<_>>();
     if parts.len() > MAX_KEY_PARTS {
         let shown: String = key.chars().take(40).collect();

@@ -11,7 +11,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-mod checks;
+pub(crate) mod checks;
 use checks::{check_distinct, check_key, check_key_shape, count_runs};
 
 /// Files a sweep reads (sweep files, manifests, results) larger than this
@@ -221,7 +221,7 @@ impl Axis {
 }
 
 /// Sets the dotted `key` in a scenario's TOML tree, creating tables.
-fn set_key(root: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
+pub(crate) fn set_key(root: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
     check_key_shape(key)?;
     let parts: Vec<&str> = key.split('.').collect();
     let mut table = root;
