@@ -37,6 +37,10 @@ pub struct Report {
     /// the scenario's law parameters as its configuration.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controller_cmd: Option<String>,
+    /// The law that command declared itself to be, and its own parameters
+    /// (`key=value` pairs): the law that actually ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controller_law: Option<ExternalLaw>,
     /// Controller compute time per step, µs (in process: timed around each
     /// step; a logged run: as the controller node measured it).
     pub compute_us: Percentiles,
@@ -145,6 +149,7 @@ impl Report {
             warning: None,
             run_end: None,
             controller_cmd: None,
+            controller_law: None,
         }
     }
 
@@ -179,9 +184,24 @@ impl Report {
             warning,
             run_end: a.contents.run_end().map(String::from),
             controller_cmd: Some(meta("controller_cmd")).filter(|c| !c.is_empty()),
+            controller_law: Some(meta("controller_name"))
+                .filter(|c| !c.is_empty())
+                .map(|name| ExternalLaw {
+                    name,
+                    parameters: meta("controller_params"),
+                }),
             summary: a.summary,
         }
     }
+}
+
+/// An external controller's own law, as it declared it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ExternalLaw {
+    /// Its name.
+    pub name: String,
+    /// Its parameters, `key=value` pairs.
+    pub parameters: String,
 }
 
 fn opt(v: Option<f64>, prec: usize) -> String {
@@ -231,8 +251,24 @@ fn heading(out: &mut String, r: &Report) {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let _ = writeln!(out, "law {}", r.law.label());
-    if let Some(cmd) = &r.controller_cmd {
+    match (&r.controller_law, &r.controller_cmd) {
+        (Some(l), Some(cmd)) => {
+            let _ = writeln!(
+                out,
+                "law {} (external: `{cmd}`; its parameters: {}; its gains are the scenario's)",
+                l.name,
+                if l.parameters.is_empty() {
+                    "none"
+                } else {
+                    &l.parameters
+                },
+            );
+        }
+        _ => {
+            let _ = writeln!(out, "law {}", r.law.label());
+        }
+    }
+    if let (None, Some(cmd)) = (&r.controller_law, &r.controller_cmd) {
         let _ = writeln!(
             out,
             "controller: `{cmd}` (the user's command computed the torques; the law's \

@@ -31,6 +31,11 @@ pub struct ControllerNodeConfig {
     /// The arm's model, for `pd-gravity` and `ctc` (None for the others).
     #[serde(default)]
     pub model: Option<NodeModel>,
+    /// An external controller's own parameters (its declared defaults with
+    /// the scenario's `[external]` table over them); the testbed's own
+    /// controller takes none.
+    #[serde(default, skip_serializing_if = "serde_json::Map::is_empty")]
+    pub own_params: serde_json::Map<String, serde_json::Value>,
 }
 
 /// The URDF a model-based law evaluates, with the run's locked joints.

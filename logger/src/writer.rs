@@ -64,6 +64,13 @@ pub struct RunMetadata {
     /// --controller-cmd`); empty for the testbed's own controller.
     #[serde(default)]
     pub controller_cmd: String,
+    /// The law that command declared (`CMD --describe`); empty when it
+    /// declared none or the testbed's own controller ran.
+    #[serde(default)]
+    pub controller_name: String,
+    /// Its own parameters as `key=value` pairs.
+    #[serde(default)]
+    pub controller_params: String,
 }
 
 /// The log format this logger writes, recorded as `log_format` in the

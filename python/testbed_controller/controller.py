@@ -30,6 +30,9 @@ class RunInfo:
     #: Period of the reference samples, ns (0: the control period): which
     #: sample is due at a state's time.
     reference_period_ns: int = 0
+    #: This controller's own parameters: its declared `params` with the
+    #: scenario's `[external]` table over them (checked by the launcher).
+    own: dict = field(default_factory=dict)
 
     @property
     def dt(self) -> float:
@@ -73,7 +76,25 @@ class Reference:
 
 
 class Controller:
-    """A control law. Implement `step`; the others are optional."""
+    """A control law. Implement `step`; the others are optional.
+
+    Declare what the law is, and the launcher names it in the log and the
+    summary, and takes its parameters from the scenario's `[external]`
+    table (checked against these, by name and kind):
+
+        class PID(Controller):
+            name = "pid"
+            params = {"ki": 2.0}      # defaults; run.own["ki"] in setup()
+    """
+
+    #: The law's name (1 to 40 of a-z, 0-9, '-', '_'); "" declares nothing.
+    name: str = ""
+    #: Its own parameters and their defaults (numbers, booleans, strings, lists).
+    params: dict = {}
+
+    def describe(self) -> dict:
+        """What `--describe` prints: the law's name and parameters."""
+        return {"name": self.name, "params": dict(self.params)}
 
     def setup(self, run: RunInfo) -> None:
         """Called once before the first step."""

@@ -140,6 +140,7 @@ def read_run_info(path: str, mode: str) -> RunInfo:
             mode=mode,
             params=dict(cfg["params"]),
             reference_period_ns=int(cfg.get("reference_period_ns", 0)),
+            own=dict(cfg.get("own_params", {})),
         )
     except (OSError, ValueError, KeyError, TypeError) as e:
         raise SystemExit(f"controller: cannot read the config {path}: {e!r}") from e
@@ -288,6 +289,14 @@ def die_with_parent(parent_pid: Optional[int]) -> None:
 
 
 def main(controller: Controller, argv: Optional[Sequence[str]] = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv == ["--describe"]:
+        # The launcher asks before the run; a controller that declares no
+        # name says so by failing, and runs unnamed.
+        if not controller.name:
+            return 1
+        print(json.dumps(controller.describe()))
+        return 0
     args = parse_args(argv)
     die_with_parent(args.parent_pid)
     for refused in apply_placement(args.cpus, args.fifo, args.lock_memory):

@@ -170,6 +170,11 @@ pub struct Scenario {
     pub controller: ControllerParams,
     /// Plant integration settings and effects.
     pub plant: PlantConfig,
+    /// Parameters of an external controller (`run --controller-cmd`), by
+    /// the names it declares (`CMD --describe`); checked against that
+    /// declaration before the run, passed to it as `own_params`.
+    #[serde(skip_serializing_if = "toml::Table::is_empty")]
+    pub external: toml::Table,
 }
 
 impl Default for Scenario {
@@ -185,6 +190,7 @@ impl Default for Scenario {
             envelope: EnvelopeConfig::paper(),
             controller: ControllerParams::default(),
             plant: PlantConfig::default(),
+            external: toml::Table::new(),
         }
     }
 }

@@ -62,6 +62,7 @@ impl Plan {
                     urdf: self.robot.urdf.clone(),
                     lock: self.scenario.plant.lock.clone(),
                 }),
+            own_params: serde_json::Map::new(),
         }
     }
 

@@ -304,3 +304,60 @@ fn a_controller_command_that_cannot_start_is_refused_before_any_node() {
     let err = fails(testbed().args(["run", "--controller-cmd", "'unclosed"]));
     assert!(err.contains("cannot be split into words"), "{err}");
 }
+
+/// #29: a Python controller as a law of its own. The PID example declares
+/// its name and a parameter `ki`; the scenario's `[external]` table sets
+/// it (checked: unknown keys and wrong kinds are refused before the run);
+/// the log and the summary name `pid` with its `ki`; what it printed is in
+/// the run folder.
+#[test]
+fn a_python_pid_declares_its_law_and_takes_its_own_parameter() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = |body: &str| {
+        let p = dir.path().join(format!("s{}.toml", body.len()));
+        std::fs::write(&p, format!("duration_s = 3.0\n[external]\n{body}\n")).unwrap();
+        p
+    };
+    let run = |s: &Path, name: &str| {
+        let mut c = testbed();
+        c.args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--json",
+            "--controller-cmd",
+            &example("pid.py"),
+        ])
+        .arg("--scenario")
+        .arg(s)
+        .args(["--name", name, "--runs-dir"])
+        .arg(dir.path().join("runs"));
+        c
+    };
+    let s = json(&ok(&mut run(&scenario("ki = 5"), "pid")));
+    assert_eq!(s["controller_law"]["name"], "pid", "{s}");
+    assert_eq!(s["controller_law"]["parameters"], "ki=5", "{s}");
+    let printed =
+        std::fs::read_to_string(dir.path().join("runs/pid/nodes/controller.log")).unwrap();
+    assert!(printed.contains("pid: ki = 5.0"), "{printed}");
+    // The log says it too: replay names the law that ran.
+    let log = s["log"].as_str().unwrap();
+    let r = json(&ok(testbed().args(["replay", "--json", log])));
+    assert_eq!(r["controller_law"], s["controller_law"]);
+    // A larger integral gain changes the run.
+    let s2 = json(&ok(&mut run(&scenario("ki = 50.0"), "pid2")));
+    assert_ne!(s2["metrics"], s["metrics"]);
+    let err = fails(&mut run(&scenario("kx = 5"), "bad1"));
+    assert!(
+        err.contains("[external] kx: 'pid' declares no such parameter (it has: ki)"),
+        "{err}"
+    );
+    let err = fails(&mut run(&scenario("ki = \"a\""), "bad2"));
+    assert!(err.contains("declares it like 2.0"), "{err}");
+    let err = fails(
+        testbed()
+            .args(["sim", "--scenario"])
+            .arg(scenario("ki = 1")),
+    );
+    assert!(err.contains("is for an external controller"), "{err}");
+}

@@ -47,6 +47,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
         set: args.set.clone(),
     };
     let plan = super::load(&common, None)?;
+    super::no_external(&plan, "compare")?;
     let laws = if args.laws.is_empty() {
         compare::DEFAULT_LAWS.to_vec()
     } else {

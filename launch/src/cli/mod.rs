@@ -216,6 +216,19 @@ pub(crate) fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario:
     Ok(scenario::load(path.as_deref(), &overrides)?)
 }
 
+/// Refuses a scenario with an `[external]` table where no external
+/// controller runs (`sim`, `compare`): its values would be ignored.
+pub(crate) fn no_external(plan: &scenario::Plan, command: &str) -> Result<()> {
+    if let Some(key) = plan.scenario.external.keys().next() {
+        anyhow::bail!(
+            "{}: [external] {key} is for an external controller (`testbed run --controller-cmd`); \
+             `testbed {command}` runs the testbed's own laws",
+            plan.source
+        );
+    }
+    Ok(())
+}
+
 /// A scenario argument that is not a file but names a shipped scenario
 /// becomes that scenario's file.
 fn resolve_scenario(arg: &std::path::Path) -> PathBuf {

@@ -17,6 +17,7 @@ pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
     let plots = args.plots;
     let args = args.common;
     let plan = load(&args, None)?;
+    super::no_external(&plan, "sim")?;
     let mut csv = match &args.csv {
         Some(path) => {
             let file = File::create(path)

@@ -58,6 +58,8 @@ pub fn trajectory(plan: &Plan) -> TrajectoryNodeConfig {
 pub struct LoggerOptions<'a> {
     /// The user's command that replaces the controller node (recorded).
     pub controller_cmd: Option<&'a str>,
+    /// What that command declared itself to be (its law and parameters).
+    pub declared: Option<&'a crate::run::external::Declared>,
     /// Serve the run live.
     pub live: Option<&'a LiveConfig>,
     /// The log's chunk compression.
@@ -75,6 +77,10 @@ pub fn logger(
 ) -> LoggerNodeConfig {
     let mut metadata = metadata(plan, mode, out, toml);
     metadata.controller_cmd = opts.controller_cmd.unwrap_or_default().to_string();
+    if let Some(d) = opts.declared {
+        metadata.controller_name = d.name.clone();
+        metadata.controller_params = d.params_text();
+    }
     LoggerNodeConfig {
         out: out.to_path_buf(),
         metadata,
@@ -122,6 +128,8 @@ pub fn metadata(plan: &Plan, mode: Mode, out: &Path, toml: &str) -> RunMetadata 
         urdf_dynamics: plan.scenario.plant.urdf_dynamics,
         start_time_unix_ns: 0,
         controller_cmd: String::new(),
+        controller_name: String::new(),
+        controller_params: String::new(),
     }
 }
 
@@ -170,7 +178,13 @@ pub fn write_all(
         let path = dir.join(format!("{}.json", kind.name()));
         match kind {
             NodeKind::Plant => write_config(&path, &plant(plan))?,
-            NodeKind::Controller => write_config(&path, &controller(plan))?,
+            NodeKind::Controller => {
+                let mut c = controller(plan);
+                if let Some(d) = logger_opts.declared {
+                    c.own_params = d.params.clone();
+                }
+                write_config(&path, &c)?
+            }
             NodeKind::Trajectory => write_config(&path, &trajectory(plan))?,
             NodeKind::Logger => write_config(&path, &logger(plan, mode, log, toml, logger_opts))?,
         }

@@ -30,6 +30,20 @@ pub enum RunError {
         /// The cause.
         cause: std::io::Error,
     },
+    /// The scenario asks for something this run cannot give.
+    #[error("{reason}")]
+    Scenario {
+        /// What, and what to do.
+        reason: String,
+    },
+    /// An external controller's declaration, or the scenario's values for it.
+    #[error("the controller command `{command}`: {reason}")]
+    External {
+        /// The command.
+        command: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// A node died or exited before the run was over.
     #[error("the {node} node {how}{}", if .stderr.is_empty() { String::new() } else { format!("; its last words:\n{}", .stderr) })]
     NodeFailed {

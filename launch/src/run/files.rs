@@ -52,7 +52,10 @@ fn new_folder(runs_dir: &Path, name: Option<&str>) -> Result<PathBuf, RunError> 
 }
 
 impl RunFiles {
-    pub(super) fn write(opts: &RunOptions) -> Result<Self, RunError> {
+    pub(super) fn write(
+        opts: &RunOptions,
+        declared: Option<&super::external::Declared>,
+    ) -> Result<Self, RunError> {
         let plan = &opts.plan;
         let out = |p: &Path| {
             let p = p.display().to_string();
@@ -84,6 +87,7 @@ impl RunFiles {
             &toml,
             LoggerOptions {
                 controller_cmd: command.as_deref(),
+                declared,
                 live: opts.live.as_ref(),
                 compression: opts.log_compression,
             },

@@ -2,6 +2,7 @@
 //! processes, starts them together, watches them, and stops them in order.
 
 mod error;
+pub mod external;
 mod files;
 mod nodes;
 pub mod spawn;
@@ -142,7 +143,11 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
 
 fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
     check_up_front(opts)?;
-    let files = RunFiles::write(opts)?;
+    let declared = match &opts.controller_cmd {
+        Some(command) => external::declared(command, &opts.plan.scenario.external)?,
+        None => None,
+    };
+    let files = RunFiles::write(opts, declared.as_ref())?;
     let prefix = RunPrefix::unique();
     // Domains that killed launchers left behind.
     for stale in RunPrefix::stale_domains(&prefix) {
@@ -234,6 +239,15 @@ fn check_up_front(opts: &RunOptions) -> Result<(), RunError> {
         std::net::TcpListener::bind(live.addr)
             .map_err(|cause| RunError::LivePort(live.addr, cause))?;
     }
+    if opts.controller_cmd.is_none()
+        && let Some(key) = opts.plan.scenario.external.keys().next()
+    {
+        return Err(RunError::Scenario {
+            reason: format!(
+                "the scenario sets [external] {key}, which only an external controller (--controller-cmd) takes"
+            ),
+        });
+    }
     if let Some(command) = &opts.controller_cmd {
         spawn::check_program(command).map_err(|cause| RunError::Spawn {
             node: NodeKind::Controller.name(),
@@ -284,9 +298,13 @@ fn spawn_nodes(
             );
             continue;
         }
+        // Beside its config: nodes/<node>.log.
+        let output = config.with_extension("log");
         let child = match (&opts.controller_cmd, kind) {
-            (Some(command), NodeKind::Controller) => spawn::spawn_command(command, kind, &args),
-            _ => spawn::spawn(&exe, kind, &args),
+            (Some(command), NodeKind::Controller) => {
+                spawn::spawn_command(command, kind, &args, &output)
+            }
+            _ => spawn::spawn(&exe, kind, &args, &output),
         }
         .map_err(|cause| RunError::Spawn {
             node: kind.name(),

@@ -1,9 +1,11 @@
 //! Node processes: spawning, watching, stopping.
 //!
 //! Children get their own process group (a Ctrl-C in the terminal reaches
-//! only the launcher, which then stops them in order) and their stderr is
-//! forwarded line by line with the node's name, keeping the last lines for
-//! the error message if the node dies. Whatever path the launcher leaves by,
+//! only the launcher, which then stops them in order). Their stderr is
+//! forwarded line by line with the node's name; stdout and stderr both go
+//! to the node's file in the run folder (`nodes/<node>.log`, bounded), and
+//! the last lines of either are kept for the error message if the node
+//! dies. Whatever path the launcher leaves by,
 //! [`Children`]'s `Drop` kills and reaps what is still running.
 
 use std::collections::VecDeque;
@@ -26,6 +28,33 @@ const MAX_LINE_BYTES: usize = 64 * 1024;
 /// How long the launcher waits for a node's stderr to close after the node
 /// exited.
 const FORWARDER_WAIT: Duration = Duration::from_secs(1);
+/// Most bytes of a node's output kept in its file (a node that prints
+/// without end must not fill the disk).
+const MAX_OUTPUT_BYTES: u64 = 16 << 20;
+
+/// A node's output file, shared by its two streams' forwarders.
+struct OutputFile {
+    file: Option<std::fs::File>,
+    written: u64,
+}
+
+impl OutputFile {
+    fn write_line(&mut self, line: &str) {
+        use std::io::Write;
+        let Some(f) = self.file.as_mut() else { return };
+        let len = line.len() as u64 + 1;
+        if self.written + len > MAX_OUTPUT_BYTES {
+            let _ = writeln!(f, "[testbed: output cut here at {MAX_OUTPUT_BYTES} bytes]");
+            self.file = None;
+            return;
+        }
+        self.written += len;
+        // A full disk costs the copy, never the run.
+        if writeln!(f, "{line}").is_err() {
+            self.file = None;
+        }
+    }
+}
 
 /// One running node process.
 pub struct Child {
@@ -33,7 +62,7 @@ pub struct Child {
     pub kind: NodeKind,
     process: std::process::Child,
     tail: Arc<Mutex<VecDeque<String>>>,
-    forwarder: Option<JoinHandle<()>>,
+    forwarders: Vec<JoinHandle<()>>,
     exited: Option<ExitStatus>,
 }
 
@@ -43,7 +72,7 @@ impl Child {
         self.process.id()
     }
 
-    /// The last lines the node wrote to stderr.
+    /// The last lines the node wrote (stdout and stderr).
     pub fn stderr_tail(&self) -> String {
         // Let the forwarder finish reading what the process wrote before it exited.
         let lines = self
@@ -72,8 +101,8 @@ impl Child {
     /// forwarder is left to finish alone.
     fn join_forwarder(&mut self) {
         self.signal_group(Signal::SIGKILL);
-        if let Some(h) = self.forwarder.take() {
-            let start = Instant::now();
+        let start = Instant::now();
+        for h in std::mem::take(&mut self.forwarders) {
             while !h.is_finished() && start.elapsed() < FORWARDER_WAIT {
                 std::thread::sleep(Duration::from_millis(5));
             }
@@ -84,11 +113,12 @@ impl Child {
     }
 }
 
-/// Spawns `testbed node <kind> <args…>` from the running executable.
-pub fn spawn(exe: &Path, kind: NodeKind, args: &[String]) -> std::io::Result<Child> {
+/// Spawns `testbed node <kind> <args…>` from the running executable; its
+/// output goes to `output` too.
+pub fn spawn(exe: &Path, kind: NodeKind, args: &[String], output: &Path) -> std::io::Result<Child> {
     let mut argv = vec!["node".to_string(), kind.name().to_string()];
     argv.extend_from_slice(args);
-    spawn_program(exe.as_os_str(), &argv, kind)
+    spawn_program(exe.as_os_str(), &argv, kind, output)
 }
 
 /// Spawns a user's command as node `kind` (`--controller-cmd`): its own
@@ -97,6 +127,7 @@ pub fn spawn_command(
     command: &[String],
     kind: NodeKind,
     args: &[String],
+    output: &Path,
 ) -> std::io::Result<Child> {
     let Some((program, words)) = command.split_first() else {
         return Err(std::io::Error::new(
@@ -106,7 +137,7 @@ pub fn spawn_command(
     };
     let mut argv = words.to_vec();
     argv.extend_from_slice(args);
-    spawn_program(program.as_ref(), &argv, kind)
+    spawn_program(program.as_ref(), &argv, kind, output)
 }
 
 /// Whether `command`'s program can be run: an executable file at its path
@@ -138,37 +169,63 @@ fn spawn_program(
     program: &std::ffi::OsStr,
     argv: &[String],
     kind: NodeKind,
+    output: &Path,
 ) -> std::io::Result<Child> {
+    let file = std::fs::File::create(output)?;
     let mut process = std::process::Command::new(program)
         .args(argv)
         .stdin(Stdio::null())
-        .stdout(Stdio::null())
+        .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .process_group(0)
         .spawn()?;
     let tail = Arc::new(Mutex::new(VecDeque::with_capacity(TAIL_LINES)));
-    let forwarder = process.stderr.take().map(|stderr| {
-        let tail = Arc::clone(&tail);
-        let name = kind.name();
-        std::thread::spawn(move || {
-            let mut reader = BufReader::new(stderr);
-            while let Some(line) = read_line_bounded(&mut reader) {
-                eprintln!("[{name}] {line}");
-                if let Ok(mut t) = tail.lock() {
-                    if t.len() == TAIL_LINES {
-                        t.pop_front();
-                    }
-                    t.push_back(line);
-                }
-            }
-        })
-    });
+    let file = Arc::new(Mutex::new(OutputFile {
+        file: Some(file),
+        written: 0,
+    }));
+    let name = kind.name();
+    let mut forwarders = Vec::new();
+    if let Some(stderr) = process.stderr.take() {
+        forwarders.push(forward(stderr, Some(name), &tail, &file));
+    }
+    if let Some(stdout) = process.stdout.take() {
+        forwarders.push(forward(stdout, None, &tail, &file));
+    }
     Ok(Child {
         kind,
         process,
         tail,
-        forwarder,
+        forwarders,
         exited: None,
+    })
+}
+
+/// Passes a node's stream on, line by line: to its file, to the tail, and
+/// (stderr, with the node's `name`) to the launcher's stderr.
+fn forward(
+    stream: impl std::io::Read + Send + 'static,
+    name: Option<&'static str>,
+    tail: &Arc<Mutex<VecDeque<String>>>,
+    file: &Arc<Mutex<OutputFile>>,
+) -> JoinHandle<()> {
+    let (tail, file) = (Arc::clone(tail), Arc::clone(file));
+    std::thread::spawn(move || {
+        let mut reader = BufReader::new(stream);
+        while let Some(line) = read_line_bounded(&mut reader) {
+            if let Some(name) = name {
+                eprintln!("[{name}] {line}");
+            }
+            if let Ok(mut f) = file.lock() {
+                f.write_line(&line);
+            }
+            if let Ok(mut t) = tail.lock() {
+                if t.len() == TAIL_LINES {
+                    t.pop_front();
+                }
+                t.push_back(line);
+            }
+        }
     })
 }
 

@@ -1,0 +1,229 @@
+//! An external controller (`run --controller-cmd CMD`) as a law of its own:
+//! before the run the launcher asks it what it is (`CMD --describe` prints
+//! `{"name": …, "params": {key: default, …}}`), checks the scenario's
+//! `[external]` table against those parameters, and hands it the merged
+//! values (`own_params` in its config). The log and the summary then name
+//! the law that ran, not the scenario's.
+
+use std::io::Read;
+use std::os::unix::process::CommandExt;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::{Map, Value};
+
+use super::RunError;
+
+/// How long a command may take to describe itself (Python with numpy
+/// starts in about a second).
+const DESCRIBE_WAIT: Duration = Duration::from_secs(30);
+/// Most bytes of a description read.
+const MAX_DESCRIPTION: u64 = 64 * 1024;
+
+/// What an external controller says it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Declared {
+    /// Its law's name.
+    pub name: String,
+    /// Its own parameters: the declared defaults with the scenario's
+    /// `[external]` values over them.
+    pub params: Map<String, Value>,
+}
+
+impl Declared {
+    /// The parameters as `key=value` pairs, for the log.
+    pub fn params_text(&self) -> String {
+        self.params
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+}
+
+fn refused(command: &[String], reason: String) -> RunError {
+    RunError::External {
+        command: shell_words::join(command),
+        reason,
+    }
+}
+
+/// The declaration of `command` with `table`'s values checked and merged;
+/// None for a command that does not describe itself (it then takes no
+/// `[external]` table).
+pub fn declared(command: &[String], table: &toml::Table) -> Result<Option<Declared>, RunError> {
+    let Some(text) = describe(command)? else {
+        if let Some(key) = table.keys().next() {
+            return Err(refused(
+                command,
+                format!(
+                    "the scenario sets [external] {key}, but the command declares no parameters \
+                     (`--describe` did not answer; see docs/python.md)"
+                ),
+            ));
+        }
+        return Ok(None);
+    };
+    let mut d = parse(&text).map_err(|reason| refused(command, reason))?;
+    for (key, value) in table {
+        let Some(default) = d.params.get(key) else {
+            let known: Vec<&str> = d.params.keys().map(String::as_str).collect();
+            return Err(refused(
+                command,
+                format!(
+                    "[external] {key}: '{}' declares no such parameter (it has: {})",
+                    d.name,
+                    if known.is_empty() {
+                        "none".to_string()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            ));
+        };
+        let given = serde_json::to_value(value).map_err(|e| refused(command, e.to_string()))?;
+        if !same_kind(default, &given) {
+            return Err(refused(
+                command,
+                format!(
+                    "[external] {key} = {given}: '{}' declares it like {default}",
+                    d.name
+                ),
+            ));
+        }
+        d.params.insert(key.clone(), given);
+    }
+    Ok(Some(d))
+}
+
+/// Numbers match numbers (an integer where a float is declared too).
+fn same_kind(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Number(_), Value::Number(_))
+        | (Value::Bool(_), Value::Bool(_))
+        | (Value::String(_), Value::String(_)) => true,
+        (Value::Array(x), Value::Array(y)) => x
+            .first()
+            .zip(y.first())
+            .is_none_or(|(p, q)| same_kind(p, q)),
+        _ => false,
+    }
+}
+
+/// Reads a description: a name of lowercase letters, digits, `-` and `_`,
+/// and parameters that are numbers, booleans, strings or lists.
+fn parse(text: &str) -> Result<Declared, String> {
+    let v: Value = serde_json::from_str(text.trim())
+        .map_err(|e| format!("`--describe` printed no JSON object: {e}"))?;
+    let name = v["name"].as_str().unwrap_or_default().to_string();
+    let ok_name = !name.is_empty()
+        && name.len() <= 40
+        && name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_');
+    if !ok_name {
+        return Err(format!(
+            "`--describe` gave the name {:?}: 1 to 40 of a-z, 0-9, '-', '_'",
+            v["name"]
+        ));
+    }
+    let params = match &v["params"] {
+        Value::Null => Map::new(),
+        Value::Object(m) => m.clone(),
+        other => {
+            return Err(format!(
+                "`--describe` gave params {other}: an object is needed"
+            ));
+        }
+    };
+    if let Some((k, _)) = params.iter().find(|(_, p)| p.is_null() || p.is_object()) {
+        return Err(format!(
+            "`--describe` parameter {k}: a number, boolean, string or list"
+        ));
+    }
+    Ok(Declared { name, params })
+}
+
+/// `CMD --describe`'s standard output, None if it exits non-zero.
+fn describe(command: &[String]) -> Result<Option<String>, RunError> {
+    let Some((program, words)) = command.split_first() else {
+        return Ok(None);
+    };
+    let mut child = Command::new(program)
+        .args(words)
+        .arg("--describe")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .process_group(0)
+        .spawn()
+        .map_err(|e| refused(command, format!("cannot start it: {e}")))?;
+    // Whatever it started goes with it (a helper would hold the pipe open).
+    let group = nix::unistd::Pid::from_raw(child.id() as i32);
+    let end_group = || {
+        let _ = nix::sys::signal::killpg(group, nix::sys::signal::Signal::SIGKILL);
+    };
+    let mut out = String::new();
+    let stdout = child.stdout.take();
+    let reader = std::thread::spawn(move || {
+        let mut text = Vec::new();
+        if let Some(s) = stdout {
+            let _ = s.take(MAX_DESCRIPTION).read_to_end(&mut text);
+        }
+        String::from_utf8_lossy(&text).into_owned()
+    });
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child
+            .try_wait()
+            .map_err(|e| refused(command, e.to_string()))?
+        {
+            break status;
+        }
+        if start.elapsed() > DESCRIBE_WAIT {
+            end_group();
+            let _ = child.wait();
+            return Err(refused(
+                command,
+                format!(
+                    "`--describe` did not answer in {} s",
+                    DESCRIBE_WAIT.as_secs()
+                ),
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    end_group();
+    // The pipe closes with the group; a reader still blocked is left behind.
+    let waited = Instant::now();
+    while !reader.is_finished() && waited.elapsed() < Duration::from_secs(1) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    if reader.is_finished()
+        && let Ok(text) = reader.join()
+    {
+        out = text;
+    }
+    Ok(status.success().then_some(out))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn descriptions_are_checked() {
+        let d = parse(r#"{"name": "pid", "params": {"ki": 0.5, "mode": "x"}}"#).unwrap();
+        assert_eq!(d.name, "pid");
+        assert_eq!(d.params_text(), "ki=0.5,mode=\"x\"");
+        assert!(
+            parse(r#"{"name": "Bad Name"}"#)
+                .unwrap_err()
+                .contains("1 to 40")
+        );
+        assert!(parse("nope").unwrap_err().contains("no JSON"));
+        assert!(parse(r#"{"name": "a", "params": {"k": null}}"#).is_err());
+        assert!(same_kind(&Value::from(1), &Value::from(0.5)));
+        assert!(!same_kind(&Value::from(true), &Value::from(0.5)));
+    }
+}
