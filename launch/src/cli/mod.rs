@@ -38,11 +38,19 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Run the closed loop in one process, as fast as the machine allows.
+    ///
+    /// Prints the run's summary on standard output (a table, or one JSON
+    /// object with --json); writes nothing else unless asked: --csv FILE
+    /// (one row per step), --plots DIR (figures). No log: use `run --mode
+    /// lockstep` for one (the same bits).
     Sim(SimArgs),
     /// Run the stack as separate processes over iceoryx2 shared memory.
     ///
-    /// Writes the run's folder (scenario, node configs, run.mcap) under
-    /// --runs-dir and prints the summary with a timing verdict. Exit
+    /// Writes the run's folder under --runs-dir (runs/<id>/ or runs/NAME/
+    /// with --name: scenario.toml, run.mcap, the Foxglove layout, each
+    /// node's config and output in nodes/) and prints the summary with a
+    /// timing verdict on standard output; node messages go to standard
+    /// error. Exit
     /// status: 0 ran, verdict clean; 1 could not run; 2 bad command line;
     /// 3 ran, verdict degraded (missed commands, stale references, late
     /// wake-ups); 4 ran, verdict invalid (rows or a node lost, the run
@@ -50,28 +58,45 @@ enum Command {
     Run(RunArgs),
     /// Describe an arm: joints in order, limits, masses, and the default
     /// scenario `--robot` would run on it; or why it cannot be used.
+    ///
+    /// Prints on standard output; --write-scenario FILE also writes the
+    /// default scenario as TOML.
     Robot {
         /// The URDF file.
         #[arg(value_name = "URDF")]
         path: PathBuf,
         /// Also write the default scenario to FILE as TOML, to edit and run
-        /// with `testbed sim FILE` (its `robot` key names the URDF).
+        /// with `testbed sim --scenario FILE` (its `robot` key names the URDF).
         #[arg(long, value_name = "FILE")]
         write_scenario: Option<PathBuf>,
     },
     /// Measure speed and timing on this machine: in process, lockstep, real
     /// time, and the machine's own timer floor.
+    ///
+    /// Prints a table (or JSON) on standard output; its runs' folders go
+    /// under --runs-dir.
     Bench(BenchArgs),
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
+    ///
+    /// Prints the summary on standard output; --csv FILE and --plots DIR
+    /// write there. The log is only read.
     Replay(ReplayArgs),
     /// Run several laws (the paper's, its ablations, baselines) on the same
     /// scenario and seeds, in process on every core, and score them.
+    ///
+    /// Prints the table (or JSON) on standard output; --csv FILE and
+    /// --plots DIR write there; progress goes to standard error on a
+    /// terminal.
     Compare(CompareArgs),
     /// Monte Carlo and parameter grids: run a sweep file on every core or
     /// on a Slurm cluster, and report it per cell.
+    ///
+    /// Results go to the folder given by --out (default runs/sweep-NAME),
+    /// one JSON line per run; `sweep report` prints on standard output.
     #[command(subcommand)]
     Sweep(sweep::SweepCommand),
-    /// List the shipped scenarios and what each one demonstrates.
+    /// List the shipped scenarios and what each one demonstrates (on
+    /// standard output).
     Scenarios,
     /// Write the wire contract for another language, generated from the
     /// Rust types (today: Python ctypes structures for the package in python/).
