@@ -13,6 +13,13 @@
 //! command τ = −Kp (q − q_d) − Kd (q̇ − q̇_d) and the diagnostics the log
 //! and the summary are made from. Other arguments the launcher adds (CPU
 //! placement) are ignored.
+//!
+//! It is also a law of its own for `testbed run --controller-cmd`: asked
+//! `--describe`, it declares its name and parameters (`kp`, `kd`), which
+//! the scenario's `[external]` table may set (docs/python.md explains
+//! the declaration; it is the same for any language). As a member of the
+//! workspace it builds with the testbed, reusing its build:
+//! `cargo build --release --bin example-pd-controller`.
 
 use std::process::ExitCode;
 use std::time::Duration;
@@ -21,10 +28,15 @@ use bus::{NodeLink, ReferenceWindow, RunPrefix, monotonic_ns, read_config};
 use controller::node::ControllerNodeConfig;
 use wire::{Command, ControllerDiagnostics, JointState, Mode, NodeKind, STATE_FINAL, Topic};
 
+/// The declared defaults of the law's own parameters.
 const KP: f64 = 400.0;
 const KD: f64 = 40.0;
 
 fn main() -> ExitCode {
+    if std::env::args().skip(1).eq(["--describe"]) {
+        println!(r#"{{"name": "pd-example", "params": {{"kp": {KP:?}, "kd": {KD:?}}}}}"#);
+        return ExitCode::SUCCESS;
+    }
     match run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -52,6 +64,16 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let (prefix, config, mode) = args()?;
     let config: ControllerNodeConfig = read_config(&config)?;
     let n = config.dof;
+    // The launcher's values for the declared parameters (defaults when it
+    // ran this binary by hand, with --external).
+    let own = |key: &str, default: f64| {
+        config
+            .own_params
+            .get(key)
+            .and_then(|v| v.as_f64())
+            .unwrap_or(default)
+    };
+    let (kp, kd) = (own("kp", KP), own("kd", KD));
     let mut link = NodeLink::connect(NodeKind::Controller, &prefix, None, mode)?;
     let states = link.bus.subscriber::<JointState>(Topic::JointState)?;
     let mut references = ReferenceWindow::new(&link, mode, config.reference_period())?;
@@ -88,7 +110,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 d.z1[i] = s.q_measured[i] - r.q_d[i];
                 d.z1g[i] = d.z1[i];
                 d.z2[i] = s.qd_measured[i] - r.qd_d[i];
-                d.tau[i] = -KP * d.z1[i] - KD * d.z2[i];
+                d.tau[i] = -kp * d.z1[i] - kd * d.z2[i];
                 d.tau_feedback[i] = d.tau[i];
             }
             d.header.wall_ns = monotonic_ns();

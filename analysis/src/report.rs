@@ -255,7 +255,7 @@ fn heading(out: &mut String, r: &Report) {
         (Some(l), Some(cmd)) => {
             let _ = writeln!(
                 out,
-                "law {} (external: `{cmd}`; its parameters: {}; its gains are the scenario's)",
+                "law {} (external: `{cmd}`; its parameters: {})",
                 l.name,
                 if l.parameters.is_empty() {
                     "none"

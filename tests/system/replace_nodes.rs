@@ -188,3 +188,25 @@ fn an_external_node_with_the_wrong_mode_fails_the_run() {
     let status = wait_bounded(&mut run, 60);
     assert!(!status.success(), "the run went on");
 }
+
+/// #29: the Rust template is a law of its own under `--controller-cmd`:
+/// it declares `pd-example` with `kp` and `kd`, the scenario sets `kp`,
+/// and the summary names both.
+#[test]
+fn the_rust_template_declares_its_law_and_parameters() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = dir.path().join("s.toml");
+    std::fs::write(&s, "duration_s = 3.0\n[external]\nkp = 900\n").unwrap();
+    let out = crate::util::ok(
+        crate::util::testbed()
+            .args(["run", "--mode", "lockstep", "--json", "--controller-cmd"])
+            .arg(env!("CARGO_BIN_EXE_example-pd-controller"))
+            .arg("--scenario")
+            .arg(&s)
+            .arg("--runs-dir")
+            .arg(dir.path()),
+    );
+    let r = crate::util::json(&out);
+    assert_eq!(r["controller_law"]["name"], "pd-example", "{r}");
+    assert_eq!(r["controller_law"]["parameters"], "kd=40.0,kp=900", "{r}");
+}
