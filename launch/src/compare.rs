@@ -14,6 +14,7 @@ use serde::Serialize;
 
 use crate::sim::{self, StepCosts};
 use analysis::law_info::LawInfo;
+use analysis::stats::{MedianInterval, SignedRank, median_interval, quantile, signed_rank};
 use analysis::summary::{Summary, SummaryBuilder};
 use analysis::timing::Percentiles;
 
@@ -108,6 +109,18 @@ pub struct LawRow {
     pub runs: Vec<LawRun>,
     /// Per metric, the median over seeds.
     pub median: Stats,
+    /// Per metric, the first quartile over seeds (linear interpolation).
+    pub q1: Stats,
+    /// Per metric, the third quartile.
+    pub q3: Stats,
+    /// Per metric, the low end of the 95 % interval of the median
+    /// ([`analysis::stats::median_interval`]: order statistics).
+    pub ci95_low: Stats,
+    /// Per metric, its high end.
+    pub ci95_high: Stats,
+    /// The interval's ranks k, n + 1 − k and its coverage (the same for
+    /// every metric).
+    pub ci95: Option<MedianInterval>,
     /// Per metric, the worst seed's value.
     pub worst: Stats,
     /// Seeds whose run kept |e| < k_c for every t ≥ T_c, finite.
@@ -133,7 +146,27 @@ pub struct Comparison {
     pub wall_time_s: f64,
     /// One row per law.
     pub laws: Vec<LawRow>,
+    /// The first law against each other law on the same seeds (with two
+    /// seeds or more).
+    pub paired: Vec<Paired>,
 }
+
+/// A paired test of the first law against another on one metric.
+#[derive(Debug, Clone, Serialize)]
+pub struct Paired {
+    /// The first law of the comparison (`nac` by default).
+    pub law: LawName,
+    /// The law it is tested against.
+    pub versus: LawName,
+    /// The metric.
+    pub metric: &'static str,
+    /// Wilcoxon signed-rank of law − versus, seed by seed: `a_smaller` is
+    /// the seeds where `law` did better.
+    pub test: SignedRank,
+}
+
+/// The metrics of the paired tests: error, peak error, effort.
+pub const PAIRED_METRICS: [&str; 3] = ["iae", "max_abs_error", "effort_after_tc"];
 
 /// One value per metric of [`METRICS`], in order (JSON: an object; an
 /// infinite value, i.e. a missing one counted as the worst, is null).
@@ -226,16 +259,23 @@ const fn m(
     }
 }
 
-/// The plan of `testbed sim --law <law>` with seed `plan.seed + s`.
+/// The plan of `testbed sim --law <law>` with seed `plan.seed + s`: the
+/// scenario before its draws, for `law`, with that seed's `[randomise]`
+/// draws (the same for every law).
 pub fn plan_for(plan: &Plan, law: LawName, s: u64) -> Result<Plan, CompareError> {
-    let mut p = plan.clone();
-    p.scenario.controller = plan.scenario.controller.for_law(law);
-    p.scenario.seed = plan.scenario.seed.wrapping_add(s);
-    let seed = p.scenario.seed;
-    p.scenario
-        .validate(&plan.source)
-        .map_err(|cause| CompareError::Plan { law, seed, cause })?;
-    Ok(p)
+    let mut scenario = plan.undrawn.clone();
+    scenario.controller = scenario.controller.for_law(law);
+    scenario.seed = plan.undrawn.seed.wrapping_add(s);
+    let seed = scenario.seed;
+    let fail = |cause| CompareError::Plan { law, seed, cause };
+    scenario.validate(&plan.source).map_err(fail)?;
+    scenario::plan(
+        scenario,
+        plan.source.clone(),
+        plan.toml.clone(),
+        plan.robot.clone(),
+    )
+    .map_err(fail)
 }
 
 /// Runs every law on every seed and scores them.
@@ -276,7 +316,8 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
             let mine: Vec<LawRun> = runs.by_ref().take(opts.seeds as usize).collect();
             row(LawInfo::of(&plan.scenario.controller.for_law(law)), mine)
         })
-        .collect();
+        .collect::<Vec<_>>();
+    let paired = paired(&laws);
     Ok(Comparison {
         scenario: plan.scenario.name.clone(),
         scenario_source: plan.source.clone(),
@@ -286,6 +327,7 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
         threads,
         wall_time_s,
         laws,
+        paired,
     })
 }
 
@@ -389,31 +431,77 @@ pub fn failed_because(failure: Option<&str>, s: &Summary) -> Option<String> {
 }
 
 fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
-    let mut median = Vec::new();
-    let mut worst = Vec::new();
+    let mut rows: [Vec<(&'static str, f64)>; 6] = Default::default();
+    let mut ci95 = None;
     for metric in METRICS {
         let mut v: Vec<f64> = runs.iter().map(|r| value(metric, r)).collect();
         v.sort_by(f64::total_cmp);
-        median.push((metric.name, median_of(&v)));
         let w = if metric.larger_is_worse {
             v[v.len() - 1]
         } else {
             v[0]
         };
-        worst.push((metric.name, w));
+        ci95 = median_interval(&v);
+        let (lo, hi) = ci95.map_or((f64::NAN, f64::NAN), |c| (c.low, c.high));
+        let values = [
+            median_of(&v),
+            quantile(&v, 0.25),
+            quantile(&v, 0.75),
+            lo,
+            hi,
+            w,
+        ];
+        for (r, x) in rows.iter_mut().zip(values) {
+            r.push((metric.name, x));
+        }
     }
     let kept = runs
         .iter()
         .filter(|r| r.failed.is_none())
         .filter(|r| r.summary.constraint_satisfied_after_tc)
         .count() as u64;
+    let [median, q1, q3, ci95_low, ci95_high, worst] = rows.map(Stats);
     LawRow {
         law,
         runs,
-        median: Stats(median),
-        worst: Stats(worst),
+        median,
+        q1,
+        q3,
+        ci95_low,
+        ci95_high,
+        ci95,
+        worst,
         kept_envelope: kept,
     }
+}
+
+/// The first law against every other, per [`PAIRED_METRICS`], seed by
+/// seed (seeds are the same runs' draws for every law).
+fn paired(laws: &[LawRow]) -> Vec<Paired> {
+    let Some((first, others)) = laws.split_first() else {
+        return Vec::new();
+    };
+    if first.runs.len() < 2 {
+        return Vec::new();
+    }
+    let values = |row: &LawRow, name: &str| -> Vec<f64> {
+        let metric = METRICS.iter().find(|m| m.name == name);
+        row.runs
+            .iter()
+            .map(|r| metric.map_or(f64::NAN, |m| value(m, r)))
+            .collect()
+    };
+    others
+        .iter()
+        .flat_map(|other| {
+            PAIRED_METRICS.iter().map(move |&metric| Paired {
+                law: first.law.law,
+                versus: other.law.law,
+                metric,
+                test: signed_rank(&values(first, metric), &values(other, metric)),
+            })
+        })
+        .collect()
 }
 
 /// The median of sorted values (mean of the middle two for an even count).

@@ -32,6 +32,8 @@ pub const SHIPPED: &[Shipped] = shipped![
     "saturation_slow_reference",
     "three_link_limits",
     "paper_per_input",
+    "paper_randomised",
+    "ur5_randomised",
 ];
 
 impl Shipped {

@@ -19,6 +19,7 @@ mod gains;
 mod plan;
 mod posture;
 mod probe;
+mod randomise;
 mod robot;
 pub mod sweep_file;
 
@@ -32,6 +33,7 @@ pub use default_for_arm::{ArmDefault, GRIPPER_LOCK};
 pub use gains::{GainChoice, JointGain};
 pub use plan::{Overrides, Plan, load, plan};
 pub use probe::Probe;
+pub use randomise::{Dist, Randomise, drawn};
 pub use robot::RobotSource;
 pub use wire::ns_to_s;
 
@@ -165,6 +167,9 @@ pub struct Scenario {
     pub controller: ControllerParams,
     /// Plant integration settings and effects.
     pub plant: PlantConfig,
+    /// What each seed varies besides the plant's noise (default: nothing).
+    #[serde(skip_serializing_if = "Randomise::is_empty")]
+    pub randomise: Randomise,
 }
 
 impl Default for Scenario {
@@ -180,6 +185,7 @@ impl Default for Scenario {
             envelope: EnvelopeConfig::paper(),
             controller: ControllerParams::default(),
             plant: PlantConfig::default(),
+            randomise: Randomise::default(),
         }
     }
 }
@@ -262,6 +268,7 @@ impl Scenario {
                 file: file.to_string(),
                 cause,
             })?;
+        self.randomise.validate(file)?;
         self.plant
             .validate()
             .map_err(|cause| ScenarioError::Plant {

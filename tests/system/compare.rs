@@ -285,3 +285,83 @@ fn a_faulted_run_is_a_failure_everywhere() {
         "{shift}"
     );
 }
+
+/// #26 item 3: a randomised scenario gives each seed its own run, the
+/// same run for the same seed (in `compare`, `sim` and lockstep), and
+/// `compare` reports quartiles, a 95 % interval and paired tests.
+#[test]
+fn randomised_trials_differ_per_seed_and_repeat_per_seed() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmp = json(&ok(testbed().args([
+        "compare",
+        "--scenario",
+        "paper_randomised",
+        "--duration",
+        "2.5",
+        "--laws",
+        "nac,pd",
+        "--seeds",
+        "20",
+        "--json",
+    ])));
+    let nac = &cmp["laws"][0];
+    let runs = nac["runs"].as_array().unwrap();
+    let mut iae: Vec<f64> = runs
+        .iter()
+        .map(|r| r["summary"]["metrics"]["iae_after_tc"].as_f64().unwrap())
+        .collect();
+    iae.sort_by(f64::total_cmp);
+    iae.dedup();
+    assert_eq!(iae.len(), 20, "every seed its own run: {iae:?}");
+    let (lo, med, hi) = (
+        nac["ci95_low"]["iae"].as_f64().unwrap(),
+        nac["median"]["iae"].as_f64().unwrap(),
+        nac["ci95_high"]["iae"].as_f64().unwrap(),
+    );
+    assert!(lo < med && med < hi, "{lo} {med} {hi}");
+    assert_eq!(
+        (iae[5], iae[14]),
+        (lo, hi),
+        "order statistics 6 and 15 of 20"
+    );
+    assert_eq!(nac["ci95"]["k"], 6);
+    assert!(nac["q1"]["iae"].as_f64().unwrap() < nac["q3"]["iae"].as_f64().unwrap());
+    let paired = cmp["paired"].as_array().unwrap();
+    let p = paired
+        .iter()
+        .find(|p| p["versus"] == "pd" && p["metric"] == "iae")
+        .expect("nac vs pd on IAE");
+    assert_eq!(p["law"], "nac");
+    assert_eq!(p["test"]["pairs"], 20);
+    assert!((0.0..=1.0).contains(&p["test"]["p_value"].as_f64().unwrap()));
+    // Seed 3's row is `sim` of the scenario with seed 3, and lockstep too.
+    let base =
+        std::fs::read_to_string(crate::util::repo_root().join("scenarios/paper_randomised.toml"))
+            .unwrap();
+    let file = dir.path().join("seed3.toml");
+    std::fs::write(&file, format!("seed = 3\n{base}")).unwrap();
+    let (sim_csv, run_csv) = (dir.path().join("sim.csv"), dir.path().join("run.csv"));
+    let common = ["--duration", "2.5", "--json", "--law", "nac", "--csv"];
+    let sim = json(&ok(testbed()
+        .arg("sim")
+        .args(common)
+        .arg(&sim_csv)
+        .arg("--scenario")
+        .arg(&file)));
+    let row = runs.iter().find(|r| r["seed"] == 3).unwrap();
+    for key in SUMMARY_KEYS {
+        assert_eq!(row["summary"][key], sim[key], "seed 3: {key}");
+    }
+    ok(testbed()
+        .args(["run", "--mode", "lockstep", "--runs-dir"])
+        .arg(dir.path())
+        .args(common)
+        .arg(&run_csv)
+        .arg("--scenario")
+        .arg(&file));
+    assert_same_csv(
+        "randomised seed 3: lockstep vs sim",
+        &std::fs::read(&run_csv).unwrap(),
+        &std::fs::read(&sim_csv).unwrap(),
+    );
+}

@@ -164,6 +164,10 @@ pub(crate) fn table(c: &Comparison) -> String {
         "\nkept: runs with |e| < k_c for every t >= T_c; enter: when every joint was inside for good; \
          breach: steps the barrier's guard or the funnel's clamp acted"
     );
+    if c.seeds > 1 {
+        out.push_str(&spread(c));
+        out.push_str(&paired(c));
+    }
     let failed: Vec<String> = c
         .laws
         .iter()
@@ -183,6 +187,97 @@ pub(crate) fn table(c: &Comparison) -> String {
         );
     }
     out
+}
+
+/// The metrics of the spread table: (metric, heading, decimals).
+const SPREAD: [(&str, &str, usize); 3] = [
+    ("iae", "IAE", 4),
+    ("max_abs_error", "max|e|", 5),
+    ("effort_after_tc", "eff>Tc", 1),
+];
+
+/// Median, 95 % interval of the median and IQR of a few metrics per law.
+fn spread(c: &Comparison) -> String {
+    let mut out = String::new();
+    let ci = c.laws.first().and_then(|l| l.ci95);
+    let _ = writeln!(
+        out,
+        "\nover {} seeds: median [95 % interval of the median] (interquartile range q3 - q1){}",
+        c.seeds,
+        ci.map_or(String::new(), |ci| format!(
+            "; the interval is order statistics x({}) .. x({}), coverage {:.1} %",
+            ci.k,
+            c.seeds as usize + 1 - ci.k,
+            100.0 * ci.coverage
+        ))
+    );
+    let _ = write!(out, "{:<16}", "law");
+    for (_, h, _) in SPREAD {
+        let _ = write!(out, " {h:>34}");
+    }
+    let _ = writeln!(out);
+    for row in &c.laws {
+        let _ = write!(out, "{:<16}", row.law.law.to_string());
+        for (key, _, prec) in SPREAD {
+            let get = |s: &compare::Stats| s.get(key);
+            let iqr = match (get(&row.q1), get(&row.q3)) {
+                (Some(a), Some(b)) if a.is_finite() && b.is_finite() => Some(b - a),
+                _ => Some(f64::INFINITY),
+            };
+            let text = format!(
+                "{} [{}, {}] ({})",
+                cell(get(&row.median), prec),
+                cell(get(&row.ci95_low), prec),
+                cell(get(&row.ci95_high), prec),
+                cell(iqr, prec)
+            );
+            let _ = write!(out, " {text:>34}");
+        }
+        let _ = writeln!(out);
+    }
+    out
+}
+
+/// The paired tests, one line per law and metric.
+fn paired(c: &Comparison) -> String {
+    let mut out = String::new();
+    let Some(first) = c.paired.first() else {
+        return out;
+    };
+    let _ = writeln!(
+        out,
+        "\npaired on the same seeds, {} against each law: Wilcoxon signed-rank, two-sided \
+         (better/worse/ties: seeds where {} did better, worse, the same; diff: median of {} - law)",
+        first.law, first.law, first.law
+    );
+    let _ = writeln!(
+        out,
+        "{:<16} {:<16} {:>6} {:>6} {:>5} {:>12} {:>10}",
+        "law", "metric", "better", "worse", "ties", "diff", "p"
+    );
+    for p in &c.paired {
+        let t = &p.test;
+        let _ = writeln!(
+            out,
+            "{:<16} {:<16} {:>6} {:>6} {:>5} {:>12} {:>10.2e}",
+            p.versus.to_string(),
+            p.metric,
+            t.a_smaller,
+            t.b_smaller,
+            t.ties,
+            signed(t.median_difference),
+            t.p_value
+        );
+    }
+    out
+}
+
+fn signed(x: f64) -> String {
+    match x {
+        x if x == f64::INFINITY => "+worst".into(),
+        x if x == f64::NEG_INFINITY => "-worst".into(),
+        x => format!("{x:.3e}"),
+    }
 }
 
 /// One row per law and seed: `law,model_based,seed,failed,` then every metric.
