@@ -7,7 +7,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use controller::LawName;
+use controller::{LawName, Tuning};
 use rayon::prelude::*;
 use scenario::Plan;
 use serde::Serialize;
@@ -68,6 +68,8 @@ pub struct CompareOptions {
     pub threads: Option<usize>,
     /// Keep the first seed's error, envelope and torque per law, for figures.
     pub series: bool,
+    /// The tuning rule of the laws that take one (None: the scenario's).
+    pub tuning: Option<Tuning>,
 }
 
 /// The first seed's curves of one law, for the overlay figures.
@@ -262,9 +264,17 @@ const fn m(
 /// The plan of `testbed sim --law <law>` with seed `plan.seed + s`: the
 /// scenario before its draws, for `law`, with that seed's `[randomise]`
 /// draws (the same for every law).
-pub fn plan_for(plan: &Plan, law: LawName, s: u64) -> Result<Plan, CompareError> {
+pub fn plan_for(
+    plan: &Plan,
+    law: LawName,
+    s: u64,
+    tuning: Option<Tuning>,
+) -> Result<Plan, CompareError> {
     let mut scenario = plan.undrawn.clone();
     scenario.controller = scenario.controller.for_law(law);
+    if let Some(t) = tuning.filter(|_| law.takes("tuning")) {
+        scenario.controller.tuning = t;
+    }
     scenario.seed = plan.undrawn.seed.wrapping_add(s);
     let seed = scenario.seed;
     let fail = |cause| CompareError::Plan { law, seed, cause };
@@ -288,7 +298,7 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
     let mut jobs = Vec::new();
     for &law in &opts.laws {
         for s in 0..opts.seeds {
-            jobs.push((law, s, plan_for(plan, law, s)?));
+            jobs.push((law, s, plan_for(plan, law, s, opts.tuning)?));
         }
     }
     let threads = opts
@@ -314,7 +324,14 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
         .iter()
         .map(|&law| {
             let mine: Vec<LawRun> = runs.by_ref().take(opts.seeds as usize).collect();
-            row(LawInfo::of(&plan.scenario.controller.for_law(law)), mine)
+            let info = jobs
+                .iter()
+                .find(|(l, _, _)| *l == law)
+                .map(|(_, _, p)| LawInfo::of(&p.scenario.controller));
+            row(
+                info.unwrap_or_else(|| LawInfo::of(&plan.scenario.controller.for_law(law))),
+                mine,
+            )
         })
         .collect::<Vec<_>>();
     let paired = paired(&laws);
@@ -539,6 +556,7 @@ mod tests {
             seeds: 1,
             threads: Some(1),
             series: false,
+            tuning: None,
         };
         assert!(compare(&plan, &opts).is_err());
     }

@@ -161,3 +161,119 @@ fn bar_panel<DB: DrawingBackend>(
         .map_err(err)?;
     Ok(())
 }
+
+/// Writes `compare_tradeoff` (PNG and SVG): IAE after T_c against effort
+/// after T_c, log-log, one polyline per law through its gain scales;
+/// filled markers are the law's Pareto front, failed scales are left out
+/// and counted in the legend.
+pub fn write_tradeoff(
+    dir: &Path,
+    t: &crate::compare_tradeoff::Tradeoff,
+    scenario: &str,
+) -> Result<usize, PlotError> {
+    std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
+    let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
+    let png = dir.join("compare_tradeoff.png");
+    draw_tradeoff(
+        &BitMapBackend::new(&png, (1000, 750)).into_drawing_area(),
+        t,
+        scenario,
+    )
+    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
+    let svg = dir.join("compare_tradeoff.svg");
+    draw_tradeoff(
+        &SVGBackend::new(&svg, (1000, 750)).into_drawing_area(),
+        t,
+        scenario,
+    )
+    .map_err(|e| PlotError(format!("{}: {e}", svg.display())))?;
+    Ok(1)
+}
+
+fn draw_tradeoff<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    t: &crate::compare_tradeoff::Tradeoff,
+    scenario: &str,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(err)?;
+    let ok: Vec<(f64, f64)> = t
+        .points
+        .iter()
+        .filter_map(|p| p.effort.zip(p.iae))
+        .filter(|(e, i)| *e > 0.0 && *i > 0.0)
+        .collect();
+    if ok.is_empty() {
+        return Err("no law has a finite, positive IAE and effort at any scale".into());
+    }
+    let span = |v: Vec<f64>| {
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(0.0, f64::max);
+        (lo / 1.5)..(hi * 1.5)
+    };
+    let x = span(ok.iter().map(|p| p.0).collect());
+    let y = span(ok.iter().map(|p| p.1).collect());
+    let scales: Vec<String> = t.scales.iter().map(|s| format!("{s}")).collect();
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            format!(
+                "Trade-off per law ({scenario}): gain scales {} (filled: Pareto front)",
+                scales.join(", ")
+            ),
+            (FAMILY, 18),
+        )
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x.log_scale(), y.log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("effort ∫τ² dt after T_c [N² m² s] (median over seeds)")
+        .y_desc("IAE after T_c [rad s]")
+        .label_style((FAMILY, 13))
+        .draw()
+        .map_err(err)?;
+    let mut laws: Vec<controller::LawName> = t.points.iter().map(|p| p.law).collect();
+    laws.dedup();
+    for (k, law) in laws.iter().enumerate() {
+        let color = COLORS[k % COLORS.len()];
+        let mine: Vec<_> = t.points.iter().filter(|p| p.law == *law).collect();
+        let line: Vec<(f64, f64)> = mine
+            .iter()
+            .filter_map(|p| p.effort.zip(p.iae))
+            .filter(|(e, i)| *e > 0.0 && *i > 0.0)
+            .collect();
+        let failed = mine.iter().filter(|p| p.iae.is_none()).count();
+        let label = if failed > 0 {
+            format!("{law} ({failed} scale(s) failed)")
+        } else {
+            law.to_string()
+        };
+        chart
+            .draw_series(LineSeries::new(line, color.stroke_width(2)))
+            .map_err(err)?
+            .label(label)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+        chart
+            .draw_series(mine.iter().filter_map(|p| {
+                let (e, i) = p.effort.zip(p.iae)?;
+                let style = if p.on_front {
+                    color.filled()
+                } else {
+                    color.stroke_width(2)
+                };
+                Some(Circle::new((e, i), 5, style))
+            }))
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FAMILY, 13))
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)
+}

@@ -365,3 +365,54 @@ fn randomised_trials_differ_per_seed_and_repeat_per_seed() {
         &std::fs::read(&sim_csv).unwrap(),
     );
 }
+
+/// #26 item 2: matched tuning gives ctc pd's error dynamics (it keeps the
+/// envelope under the payload, where its textbook poles fail), makes ppc
+/// a pd near e = 0, and names itself in the law's parameters; the
+/// trade-off mode reports every law at every gain scale.
+#[test]
+fn matched_tuning_and_the_trade_off_mode() {
+    let run = |tuning: &str| {
+        json(&ok(testbed().args([
+            "compare",
+            "--scenario",
+            "payload_pickup",
+            "--laws",
+            "pd,ctc,ppc",
+            "--tuning",
+            tuning,
+            "--json",
+        ])))
+    };
+    let (given, matched) = (run("as-given"), run("matched"));
+    let kept = |c: &serde_json::Value, k: usize| c["laws"][k]["kept_envelope"].as_u64();
+    assert_eq!((kept(&given, 1), kept(&matched, 1)), (Some(0), Some(1)));
+    assert_eq!(matched["laws"][1]["law"]["parameters"]["tuning"], "matched");
+    let iae = |c: &serde_json::Value, k: usize| c["laws"][k]["median"]["iae"].as_f64().unwrap();
+    let (pd, ppc) = (iae(&matched, 0), iae(&matched, 2));
+    assert!((ppc / pd - 1.0).abs() < 0.1, "matched ppc {ppc} vs pd {pd}");
+    assert!(iae(&given, 2) < 0.6 * pd, "as given, ppc is a stiffer pd");
+    let t = json(&ok(testbed().args([
+        "compare",
+        "--duration",
+        "3",
+        "--laws",
+        "nac,pd",
+        "--gain-scales",
+        "0.5,1,2",
+        "--json",
+    ])));
+    let points = t["points"].as_array().unwrap();
+    assert_eq!(points.len(), 6);
+    let nac: Vec<f64> = points[..3]
+        .iter()
+        .map(|p| p["iae"].as_f64().unwrap())
+        .collect();
+    assert!(
+        nac[0] > nac[1] && nac[1] > nac[2],
+        "stiffer, smaller error: {nac:?}"
+    );
+    assert!(points.iter().any(|p| p["on_front"] == true));
+    let e = fails(testbed().args(["compare", "--gain-scales", "1,-2"]));
+    assert!(e.contains("--gain-scales -2"), "{e}");
+}

@@ -56,7 +56,16 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
         seeds: args.seeds,
         threads: super::worker_threads(args.threads),
         series: args.plots.is_some(),
+        tuning: match args.tuning.as_deref() {
+            Some("matched") => Some(controller::Tuning::Matched),
+            Some("as-given") => Some(controller::Tuning::AsGiven),
+            Some(other) => bail!("--tuning {other}: must be as-given or matched"),
+            None => None,
+        },
     };
+    if !args.gain_scales.is_empty() {
+        return tradeoff(&args, &plan, &opts);
+    }
     let result =
         compare::compare(&plan, &opts).with_context(|| format!("comparing on {}", plan.source))?;
     if let Some((path, file)) = csv {
@@ -89,6 +98,49 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     for f in &failed {
         eprintln!("testbed: warning: {f}");
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `--gain-scales`: the trade-off table (or JSON) and figure.
+fn tradeoff(args: &CompareArgs, plan: &scenario::Plan, opts: &CompareOptions) -> Result<ExitCode> {
+    if args.csv.is_some() {
+        bail!("--csv with --gain-scales: the trade-off has no per-run CSV; use --json");
+    }
+    let t = launch::compare_tradeoff::tradeoff(plan, opts, &args.gain_scales)
+        .with_context(|| format!("trade-off on {}", plan.source))?;
+    if let Some(dir) = &args.plots {
+        let n = launch::compare_plots::write_tradeoff(dir, &t, &plan.scenario.name)
+            .with_context(|| format!("writing figures to {}", dir.display()))?;
+        eprintln!("testbed: wrote {n} figures to {}", dir.display());
+    }
+    if args.json {
+        super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&t)?))?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "trade-off on {} ({}): K1 and K2 times each scale; medians over {} seed(s); * = on the law's Pareto front\n",
+        plan.scenario.name, plan.source, opts.seeds
+    );
+    let _ = writeln!(
+        out,
+        "{:<16} {:>7} {:>12} {:>14} {:>7} {:>6}",
+        "law", "scale", "IAE>Tc", "effort>Tc", "failed", "front"
+    );
+    for p in &t.points {
+        let _ = writeln!(
+            out,
+            "{:<16} {:>7} {:>12} {:>14} {:>7} {:>6}",
+            p.law.to_string(),
+            p.scale,
+            cell(p.iae.or(Some(f64::INFINITY)), 4),
+            cell(p.effort.or(Some(f64::INFINITY)), 1),
+            p.failed,
+            if p.on_front { "*" } else { "" }
+        );
+    }
+    super::write_stdout(&out)?;
     Ok(ExitCode::SUCCESS)
 }
 
