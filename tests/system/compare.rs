@@ -190,6 +190,8 @@ fn compare_writes_its_table_csv_and_figures() {
         "compare_errors.svg",
         "compare_bars.png",
         "compare_bars.svg",
+        "compare_error_ratio.png",
+        "compare_error_ratio.svg",
     ] {
         assert!(
             dir.path().join("fig").join(f).metadata().unwrap().len() > 1000,
@@ -284,6 +286,13 @@ fn a_faulted_run_is_a_failure_everywhere() {
         shift.starts_with("nac-no-shift,false,0,true,false,"),
         "{shift}"
     );
+    // The figures say so too: a grey "FAILED" bar, a "FAILED" panel title.
+    let fig = dir.path().join("fig");
+    ok(testbed().args(args).arg("--plots").arg(&fig));
+    for f in ["compare_bars.svg", "compare_error_ratio.svg"] {
+        let svg = std::fs::read_to_string(fig.join(f)).unwrap();
+        assert!(svg.contains("FAILED"), "{f} does not mark the failed law");
+    }
 }
 
 /// #26 item 3: a randomised scenario gives each seed its own run, the
