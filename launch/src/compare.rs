@@ -151,6 +151,8 @@ pub struct Comparison {
     /// The first law against each other law on the same seeds (with two
     /// seeds or more).
     pub paired: Vec<Paired>,
+    /// What this says about the paper's claims ([`crate::compare_findings`]).
+    pub findings: Vec<crate::compare_findings::Finding>,
 }
 
 /// A paired test of the first law against another on one metric.
@@ -335,7 +337,7 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
         })
         .collect::<Vec<_>>();
     let paired = paired(&laws);
-    Ok(Comparison {
+    let mut c = Comparison {
         scenario: plan.scenario.name.clone(),
         scenario_source: plan.source.clone(),
         robot: plan.robot.label(),
@@ -345,7 +347,10 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
         wall_time_s,
         laws,
         paired,
-    })
+        findings: Vec::new(),
+    };
+    c.findings = crate::compare_findings::findings(&c);
+    Ok(c)
 }
 
 /// One in-process run, exactly as `testbed sim` makes it.

@@ -15,6 +15,7 @@ pub mod bench;
 pub mod bench_controller;
 pub mod bench_peer;
 pub mod compare;
+pub mod compare_findings;
 pub mod compare_plots;
 pub mod compare_ratio_plot;
 pub mod compare_tradeoff;

@@ -343,6 +343,16 @@ fn randomised_trials_differ_per_seed_and_repeat_per_seed() {
     assert_eq!(p["law"], "nac");
     assert_eq!(p["test"]["pairs"], 20);
     assert!((0.0..=1.0).contains(&p["test"]["p_value"].as_f64().unwrap()));
+    // #26 item 5: the findings, by their rules, in the JSON.
+    let findings = cmp["findings"].as_array().unwrap();
+    assert_eq!(findings[0]["verdict"], "holds", "{findings:?}");
+    assert!(findings[2]["claim"].as_str().unwrap().contains("vs pd"));
+    assert!(
+        findings[2]["evidence"]
+            .as_str()
+            .unwrap()
+            .contains("Wilcoxon p")
+    );
     // Seed 3's row is `sim` of the scenario with seed 3, and lockstep too.
     let base =
         std::fs::read_to_string(crate::util::repo_root().join("scenarios/paper_randomised.toml"))

@@ -228,6 +228,10 @@ pub(crate) struct CompareArgs {
     /// scales and report IAE after T_c against effort (a Pareto front per law).
     #[arg(long, value_name = "S,…", value_delimiter = ',')]
     pub(crate) gain_scales: Vec<f64>,
+    /// Print, after the table, which of the paper's claims hold on this
+    /// scenario and the numbers they rest on (the JSON always has them).
+    #[arg(long)]
+    pub(crate) findings: bool,
 }
 
 /// `--law` and `--laws`: the names come from the law table, and `--help`

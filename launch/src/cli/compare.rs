@@ -82,7 +82,11 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     if args.json {
         super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&result)?))?;
     } else {
-        super::write_stdout(&table(&result))?;
+        let mut text = table(&result);
+        if args.findings {
+            text.push_str(&findings(&result));
+        }
+        super::write_stdout(&text)?;
     }
     let failed: Vec<String> = result
         .laws
@@ -237,6 +241,18 @@ pub(crate) fn table(c: &Comparison) -> String {
             "FAILED (their metrics count as the worst, never the best):\n{}",
             failed.join("\n")
         );
+    }
+    out
+}
+
+/// The findings, one claim per line with its evidence.
+fn findings(c: &Comparison) -> String {
+    let mut out = format!(
+        "\nfindings on {} (rules: docs/compare-and-sweeps.md#findings-the-papers-claims-checked):\n",
+        c.scenario
+    );
+    for f in &c.findings {
+        let _ = writeln!(out, "  [{}] {}\n      {}", f.verdict, f.claim, f.evidence);
     }
     out
 }
