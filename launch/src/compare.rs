@@ -230,6 +230,9 @@ pub const METRICS: &[Metric] = &[
     m("effort_after_tc", "N² m² s", true, |r| {
         Some(r.summary.metrics.effort_after_tc)
     }),
+    m("energy_after_tc", "J", true, |r| {
+        Some(r.summary.metrics.energy_after_tc)
+    }),
     m("torque_rate", "N² m²/s", true, |r| {
         Some(r.summary.metrics.torque_rate)
     }),

@@ -250,15 +250,49 @@ fn draw_tradeoff<DB: DrawingBackend>(
     t: &crate::compare_tradeoff::Tradeoff,
     scenario: &str,
 ) -> Result<(), String> {
+    use crate::compare_tradeoff::TradeoffPoint as P;
     root.fill(&WHITE).map_err(err)?;
-    let ok: Vec<(f64, f64)> = t
-        .points
-        .iter()
-        .filter_map(|p| p.effort.zip(p.iae))
-        .filter(|(e, i)| *e > 0.0 && *i > 0.0)
-        .collect();
+    let scales: Vec<String> = t.scales.iter().map(|s| format!("{s}")).collect();
+    let title = format!(
+        "Trade-off per law ({scenario}): K1, K2 times {} (filled: the law's Pareto front)",
+        scales.join(", ")
+    );
+    let root = root.titled(&title, (FAMILY, 18)).map_err(err)?;
+    let (left, right) = root.split_horizontally(root.dim_in_pixel().0 / 2);
+    tradeoff_panel(
+        &left,
+        t,
+        (|p: &P| p.effort, |p: &P| p.on_front),
+        "effort ∫τ² dt after T_c [N² m² s]",
+    )?;
+    tradeoff_panel(
+        &right,
+        t,
+        (|p: &P| p.energy, |p: &P| p.on_energy_front),
+        "energy ∫|τ q̇| dt after T_c [J]",
+    )?;
+    root.present().map_err(err)
+}
+
+/// A point's cost and whether it is on the front for that cost.
+type CostOf = (
+    fn(&crate::compare_tradeoff::TradeoffPoint) -> Option<f64>,
+    fn(&crate::compare_tradeoff::TradeoffPoint) -> bool,
+);
+
+/// IAE against one cost, log-log, one polyline per law in scale order.
+fn tradeoff_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    t: &crate::compare_tradeoff::Tradeoff,
+    (cost, on_front): CostOf,
+    x_desc: &str,
+) -> Result<(), String> {
+    let xy = |p: &crate::compare_tradeoff::TradeoffPoint| {
+        cost(p).zip(p.iae).filter(|(e, i)| *e > 0.0 && *i > 0.0)
+    };
+    let ok: Vec<(f64, f64)> = t.points.iter().filter_map(xy).collect();
     if ok.is_empty() {
-        return Err("no law has a finite, positive IAE and effort at any scale".into());
+        return Err("no law has a finite, positive IAE and cost at any scale".into());
     }
     let span = |v: Vec<f64>| {
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
@@ -267,15 +301,7 @@ fn draw_tradeoff<DB: DrawingBackend>(
     };
     let x = span(ok.iter().map(|p| p.0).collect());
     let y = span(ok.iter().map(|p| p.1).collect());
-    let scales: Vec<String> = t.scales.iter().map(|s| format!("{s}")).collect();
-    let mut chart = ChartBuilder::on(root)
-        .caption(
-            format!(
-                "Trade-off per law ({scenario}): gain scales {} (filled: Pareto front)",
-                scales.join(", ")
-            ),
-            (FAMILY, 18),
-        )
+    let mut chart = ChartBuilder::on(area)
         .margin(15)
         .x_label_area_size(50)
         .y_label_area_size(80)
@@ -283,9 +309,9 @@ fn draw_tradeoff<DB: DrawingBackend>(
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc("effort ∫τ² dt after T_c [N² m² s] (median over seeds)")
+        .x_desc(format!("{x_desc} (median over seeds)"))
         .y_desc("IAE after T_c [rad s]")
-        .label_style((FAMILY, 13))
+        .label_style((FAMILY, 12))
         .draw()
         .map_err(err)?;
     let mut laws: Vec<controller::LawName> = t.points.iter().map(|p| p.law).collect();
@@ -293,11 +319,7 @@ fn draw_tradeoff<DB: DrawingBackend>(
     for (k, law) in laws.iter().enumerate() {
         let color = COLORS[k % COLORS.len()];
         let mine: Vec<_> = t.points.iter().filter(|p| p.law == *law).collect();
-        let line: Vec<(f64, f64)> = mine
-            .iter()
-            .filter_map(|p| p.effort.zip(p.iae))
-            .filter(|(e, i)| *e > 0.0 && *i > 0.0)
-            .collect();
+        let line: Vec<(f64, f64)> = mine.iter().filter_map(|p| xy(p)).collect();
         let failed = mine.iter().filter(|p| p.iae.is_none()).count();
         let label = if failed > 0 {
             format!("{law} ({failed} scale(s) failed)")
@@ -313,13 +335,12 @@ fn draw_tradeoff<DB: DrawingBackend>(
             });
         chart
             .draw_series(mine.iter().filter_map(|p| {
-                let (e, i) = p.effort.zip(p.iae)?;
-                let style = if p.on_front {
+                let style = if on_front(p) {
                     color.filled()
                 } else {
                     color.stroke_width(2)
                 };
-                Some(Circle::new((e, i), 5, style))
+                Some(Circle::new(xy(p)?, 5, style))
             }))
             .map_err(err)?;
     }
@@ -327,8 +348,8 @@ fn draw_tradeoff<DB: DrawingBackend>(
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .label_font((FAMILY, 13))
+        .label_font((FAMILY, 12))
         .draw()
         .map_err(err)?;
-    root.present().map_err(err)
+    Ok(())
 }

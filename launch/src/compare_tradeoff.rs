@@ -1,6 +1,7 @@
 //! `compare --gain-scales`: every law over a range of gain scales, as
-//! tracking error (IAE after T_c) against effort (∫τ² after T_c), so that a
-//! reader sees each law's whole trade-off, not one tuning's point.
+//! tracking error (IAE after T_c) against effort (∫τ² after T_c) and
+//! against mechanical energy (∫|τ q̇| after T_c), so that a reader sees each
+//! law's whole trade-off, not one tuning's point.
 //!
 //! A scale s multiplies K1 and K2 on every joint; each law then derives its
 //! own gains from them by the comparison's tuning rule.
@@ -22,11 +23,15 @@ pub struct TradeoffPoint {
     pub iae: Option<f64>,
     /// Median effort ∫τ² dt after T_c, N² m² s; null if failed.
     pub effort: Option<f64>,
+    /// Median mechanical energy ∫|τ q̇| dt after T_c, J; null if failed.
+    pub energy: Option<f64>,
     /// Seeds whose run failed.
     pub failed: u64,
     /// Not dominated by another scale of the same law (no other point has
     /// both less IAE and less effort).
     pub on_front: bool,
+    /// The same with energy in place of effort.
+    pub on_energy_front: bool,
 }
 
 /// Every law at every scale.
@@ -115,23 +120,39 @@ fn point(law: controller::LawName, scale: f64, row: &compare::LawRow) -> Tradeof
         scale,
         iae: finite(row.median.get("iae")),
         effort: finite(row.median.get("effort_after_tc")),
+        energy: finite(row.median.get("energy_after_tc")),
         failed: row.runs.iter().filter(|r| r.failed.is_some()).count() as u64,
         on_front: false,
+        on_energy_front: false,
     }
 }
 
-/// Marks the points no other point of the same law dominates.
+/// Marks the points no other point of the same law dominates, on effort
+/// and on energy.
 fn mark_front(mut points: Vec<TradeoffPoint>) -> Vec<TradeoffPoint> {
-    let pairs: Vec<Option<(f64, f64)>> = points.iter().map(|p| p.iae.zip(p.effort)).collect();
-    for (i, p) in points.iter_mut().enumerate() {
-        p.on_front = pairs[i].is_some_and(|(a, e)| {
-            !pairs
-                .iter()
-                .flatten()
-                .any(|&(b, f)| b <= a && f <= e && (b < a || f < e))
-        });
+    let effort = front(points.iter().map(|p| p.iae.zip(p.effort)).collect());
+    let energy = front(points.iter().map(|p| p.iae.zip(p.energy)).collect());
+    for (p, (a, b)) in points.iter_mut().zip(effort.into_iter().zip(energy)) {
+        p.on_front = a;
+        p.on_energy_front = b;
     }
     points
+}
+
+/// For each (error, cost) pair: whether no other pair is at least as good
+/// on both and better on one (a missing pair is never on the front).
+fn front(pairs: Vec<Option<(f64, f64)>>) -> Vec<bool> {
+    pairs
+        .iter()
+        .map(|p| {
+            p.is_some_and(|(a, e)| {
+                !pairs
+                    .iter()
+                    .flatten()
+                    .any(|&(b, f)| b <= a && f <= e && (b < a || f < e))
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -144,8 +165,10 @@ mod tests {
             scale: 1.0,
             iae: Some(iae),
             effort: Some(effort),
+            energy: Some(1.0 / effort),
             failed: 0,
             on_front: false,
+            on_energy_front: false,
         }
     }
 
@@ -153,11 +176,11 @@ mod tests {
     fn the_front_keeps_the_undominated_points() {
         let mut failed = p(0.0, 0.0);
         failed.iae = None;
-        let front: Vec<bool> = mark_front(vec![p(1.0, 5.0), p(2.0, 2.0), p(3.0, 3.0), failed])
-            .iter()
-            .map(|p| p.on_front)
-            .collect();
-        assert_eq!(front, [true, true, false, false]);
+        let marked = mark_front(vec![p(1.0, 5.0), p(2.0, 2.0), p(3.0, 3.0), failed]);
+        let on = |f: fn(&TradeoffPoint) -> bool| marked.iter().map(f).collect::<Vec<_>>();
+        assert_eq!(on(|p| p.on_front), [true, true, false, false]);
+        // Energy 1/effort: (1, 0.2), (2, 0.5), (3, 0.33): only the first.
+        assert_eq!(on(|p| p.on_energy_front), [true, false, false, false]);
     }
 
     #[test]

@@ -432,6 +432,11 @@ fn matched_tuning_and_the_trade_off_mode() {
         "stiffer, smaller error: {nac:?}"
     );
     assert!(points.iter().any(|p| p["on_front"] == true));
+    assert!(
+        points
+            .iter()
+            .all(|p| p["energy"].as_f64().is_some_and(|e| e > 0.0))
+    );
     let e = fails(testbed().args(["compare", "--gain-scales", "1,-2"]));
     assert!(e.contains("--gain-scales -2"), "{e}");
 }

@@ -124,24 +124,29 @@ fn tradeoff(args: &CompareArgs, plan: &scenario::Plan, opts: &CompareOptions) ->
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "trade-off on {} ({}): K1 and K2 times each scale; medians over {} seed(s); * = on the law's Pareto front\n",
+        "trade-off on {} ({}): K1 and K2 times each scale; medians over {} seed(s); * = on the law's Pareto front (IAE against effort, against energy)\n",
         plan.scenario.name, plan.source, opts.seeds
     );
     let _ = writeln!(
         out,
-        "{:<16} {:>7} {:>12} {:>14} {:>7} {:>6}",
-        "law", "scale", "IAE>Tc", "effort>Tc", "failed", "front"
+        "{:<16} {:>7} {:>12} {:>14} {:>12} {:>7} {:>6}",
+        "law", "scale", "IAE>Tc", "effort>Tc", "energy>Tc", "failed", "front"
     );
     for p in &t.points {
         let _ = writeln!(
             out,
-            "{:<16} {:>7} {:>12} {:>14} {:>7} {:>6}",
+            "{:<16} {:>7} {:>12} {:>14} {:>12} {:>7} {:>6}",
             p.law.to_string(),
             p.scale,
             cell(p.iae.or(Some(f64::INFINITY)), 4),
             cell(p.effort.or(Some(f64::INFINITY)), 1),
+            cell(p.energy.or(Some(f64::INFINITY)), 2),
             p.failed,
-            if p.on_front { "*" } else { "" }
+            format!(
+                "{}{}",
+                if p.on_front { "*" } else { "-" },
+                if p.on_energy_front { "*" } else { "-" }
+            )
         );
     }
     super::write_stdout(&out)?;
