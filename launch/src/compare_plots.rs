@@ -44,7 +44,10 @@ fn errors(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), String> {
                 .iter()
                 .enumerate()
                 .map(|(k, (row, s))| Line {
-                    label: row.law.law.to_string(),
+                    label: match row.runs.first().and_then(|r| r.failed.as_ref()) {
+                        Some(_) => format!("{} (FAILED)", row.law.law),
+                        None => row.law.law.to_string(),
+                    },
                     y: &s.e[i],
                     color: COLORS[k % COLORS.len()],
                     dashed: false,

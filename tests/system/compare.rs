@@ -289,7 +289,11 @@ fn a_faulted_run_is_a_failure_everywhere() {
     // The figures say so too: a grey "FAILED" bar, a "FAILED" panel title.
     let fig = dir.path().join("fig");
     ok(testbed().args(args).arg("--plots").arg(&fig));
-    for f in ["compare_bars.svg", "compare_error_ratio.svg"] {
+    for f in [
+        "compare_bars.svg",
+        "compare_error_ratio.svg",
+        "compare_errors.svg",
+    ] {
         let svg = std::fs::read_to_string(fig.join(f)).unwrap();
         assert!(svg.contains("FAILED"), "{f} does not mark the failed law");
     }
