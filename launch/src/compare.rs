@@ -169,8 +169,9 @@ pub struct Paired {
     pub test: SignedRank,
 }
 
-/// The metrics of the paired tests: error, peak error, effort.
-pub const PAIRED_METRICS: [&str; 3] = ["iae", "max_abs_error", "effort_after_tc"];
+/// The metrics of the paired tests: error, peak error, effort, energy.
+pub const PAIRED_METRICS: [&str; 4] =
+    ["iae", "max_abs_error", "effort_after_tc", "energy_after_tc"];
 
 /// One value per metric of [`METRICS`], in order (JSON: an object; an
 /// infinite value, i.e. a missing one counted as the worst, is null).

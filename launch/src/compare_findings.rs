@@ -7,7 +7,7 @@
 //!    envelope before T_c (violation before T_c > 0); holds when every
 //!    such run was inside for good by T_c and did not fail.
 //! 3. *Energy after T_c*: `nac`'s median effort ∫τ² after T_c against
-//!    `pd`'s and `blf`'s: holds against a law when it is lower by at least
+//!    `pd`'s and `blf`'s, and its mechanical energy ∫|τ q̇| against `pd`'s: holds against a law when it is lower by at least
 //!    [`MATTERS`] (or the other's median failed and `nac`'s did not) and,
 //!    with two seeds or more, the paired test agrees (p < [`ALPHA`], `nac`
 //!    better on more seeds).
@@ -74,6 +74,7 @@ pub fn findings(c: &Comparison) -> Vec<Finding> {
         out.push(better(c, nac, other, "effort_after_tc", CLAIMS[2]));
     }
     out.push(better(c, nac, LawName::NacNoNetworks, "iae", CLAIMS[3]));
+    out.push(better(c, nac, LawName::Pd, "energy_after_tc", CLAIMS[2]));
     out
 }
 
@@ -244,7 +245,8 @@ mod tests {
     fn the_paper_scenario_starts_outside_and_keeps_the_envelope() {
         let c = run(vec![LawName::Nac, LawName::Pd]);
         let f = findings(&c);
-        assert_eq!(f.len(), 5);
+        assert_eq!(f.len(), 6);
+        assert!(f[5].claim.contains("energy_after_tc"), "{:?}", f[5]);
         assert_eq!(f[0].verdict, Verdict::Holds, "{:?}", f[0]);
         assert_eq!(f[1].verdict, Verdict::Holds, "{:?}", f[1]);
         assert!(f[1].evidence.contains("outside before T_c = 2 s on 1 of 1"));
