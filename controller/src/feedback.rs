@@ -19,7 +19,6 @@ pub struct Feedback {
     /// `ctc`'s K_p', K_d' per joint; with matched tuning, set at the first
     /// step (they need the first reference posture).
     ctc_gains: Option<(Vec<f64>, Vec<f64>)>,
-    tuning: Tuning,
     /// The law's copy of the arm's model (model-based laws only).
     model: Option<Dynamics>,
     /// Scratch: q̈_d − K_d' ė − K_p' e for `ctc`.
@@ -63,7 +62,6 @@ impl Feedback {
             k1,
             k2,
             ctc_gains,
-            tuning: params.tuning,
             model,
             v: vec![0.0; dof],
         })
@@ -95,6 +93,7 @@ impl Feedback {
                 (FeedbackKind::Ctc, Some((kp, kd))) => {
                     self.v[i] = input.qdd_d[i] - kd[i] * ed - kp[i] * e
                 }
+                // Unreachable: the gains are set above.
                 (FeedbackKind::Ctc, None) => self.v[i] = 0.0,
                 (FeedbackKind::Pd | FeedbackKind::PdGravity, _) => {
                     out.tau_feedback[i] = -k1 * k2 * e - k2 * ed
@@ -108,17 +107,24 @@ impl Feedback {
     /// Matched `ctc` gains: `pd`'s joint i obeys m_i ë + K2 ė + K1 K2 e ≈ 0,
     /// so K_p' = K1 K2 / m_i and K_d' = K2 / m_i give the same poles, with
     /// m_i = 1 / (M⁻¹)_ii (the joint's effective inertia) at `q`, from the
-    /// law's own model. (As given when there is no model: `new` refuses that.)
+    /// law's own model. A joint whose m_i is not a finite positive number
+    /// (a singular model) keeps the as-given K1 K2, K1 + K2; so does every
+    /// joint without a model (`new` refuses that for `ctc`).
     fn matched_ctc_gains(&mut self, q: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        debug_assert_eq!(self.tuning, Tuning::Matched);
         let n = self.n;
         let m = match self.model.as_mut() {
             Some(d) => effective_inertia(d, q),
-            None => vec![1.0; n],
+            None => vec![f64::NAN; n],
         };
-        let kp = (0..n).map(|i| self.k1[i] * self.k2[i] / m[i]).collect();
-        let kd = (0..n).map(|i| self.k2[i] / m[i]).collect();
-        (kp, kd)
+        (0..n)
+            .map(|i| {
+                let (k1, k2) = (self.k1[i], self.k2[i]);
+                match m[i] {
+                    m if m.is_finite() && m > 0.0 => (k1 * k2 / m, k2 / m),
+                    _ => (k1 * k2, k1 + k2),
+                }
+            })
+            .unzip()
     }
 
     /// τ from the feedback and the model: G(q) for `pd-gravity`; for `ctc`
