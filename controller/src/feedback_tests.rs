@@ -156,6 +156,9 @@ fn matched_ctc_on_one_joint_is_pd_with_gravity() {
     };
     let pd_g = one(LawName::PdGravity, Tuning::AsGiven);
     let matched = one(LawName::Ctc, Tuning::Matched);
-    assert!((matched - pd_g).abs() < 1e-9 * pd_g.abs(), "{matched} vs {pd_g}");
+    assert!(
+        (matched - pd_g).abs() < 1e-9 * pd_g.abs(),
+        "{matched} vs {pd_g}"
+    );
     assert!((one(LawName::Ctc, Tuning::AsGiven) - pd_g).abs() > 0.1);
 }

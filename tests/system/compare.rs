@@ -443,4 +443,28 @@ fn matched_tuning_and_the_trade_off_mode() {
     );
     let e = fails(testbed().args(["compare", "--gain-scales", "1,-2"]));
     assert!(e.contains("--gain-scales -2"), "{e}");
+    // A scenario can ask for it: the lockstep stack gives sim's bits.
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("ctc.toml");
+    std::fs::write(&file, "[controller]\nlaw = \"ctc\"\ntuning = \"matched\"\n").unwrap();
+    let (run_csv, sim_csv) = (dir.path().join("run.csv"), dir.path().join("sim.csv"));
+    let common = ["--duration", "0.4", "--json", "--scenario"];
+    ok(testbed()
+        .args(["run", "--mode", "lockstep", "--runs-dir"])
+        .arg(dir.path())
+        .args(common)
+        .arg(&file)
+        .arg("--csv")
+        .arg(&run_csv));
+    ok(testbed()
+        .arg("sim")
+        .args(common)
+        .arg(&file)
+        .arg("--csv")
+        .arg(&sim_csv));
+    assert_same_csv(
+        "matched ctc: lockstep vs sim",
+        &std::fs::read(&run_csv).unwrap(),
+        &std::fs::read(&sim_csv).unwrap(),
+    );
 }
