@@ -117,12 +117,12 @@ pub fn signed_rank(a: &[f64], b: &[f64]) -> SignedRank {
     sorted.sort_by(f64::total_cmp);
     let nonzero: Vec<f64> = d.iter().copied().filter(|x| *x != 0.0).collect();
     let ranks = mid_ranks(&nonzero);
-    let w_plus: f64 = nonzero
+    // fold from +0.0: an empty `sum` of f64 is −0.0.
+    let w_plus = nonzero
         .iter()
         .zip(&ranks)
         .filter(|(d, _)| **d > 0.0)
-        .map(|(_, r)| r)
-        .sum();
+        .fold(0.0, |w, (_, r)| w + r);
     let n = nonzero.len();
     let (p_value, method) = if n == 0 {
         (1.0, "exact")

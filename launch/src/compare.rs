@@ -120,9 +120,8 @@ pub struct LawRow {
     pub ci95_low: Stats,
     /// Per metric, its high end.
     pub ci95_high: Stats,
-    /// The interval's ranks k, n + 1 − k and its coverage (the same for
-    /// every metric).
-    pub ci95: Option<MedianInterval>,
+    /// The interval's ranks and coverage (the same for every metric).
+    pub ci95: Option<IntervalRanks>,
     /// Per metric, the worst seed's value.
     pub worst: Stats,
     /// Seeds whose run kept |e| < k_c for every t ≥ T_c, finite.
@@ -167,6 +166,28 @@ pub struct Paired {
     /// Wilcoxon signed-rank of law − versus, seed by seed: `a_smaller` is
     /// the seeds where `law` did better.
     pub test: SignedRank,
+}
+
+/// Which order statistics bound the 95 % interval of the median, and its
+/// coverage ([`analysis::stats::median_interval`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct IntervalRanks {
+    /// The low end is the k-th smallest value (1-based).
+    pub k: usize,
+    /// The high end is the (n + 1 − k)-th.
+    pub high_rank: usize,
+    /// P(low ≤ median ≤ high) for a continuous distribution.
+    pub coverage: f64,
+}
+
+impl From<(MedianInterval, usize)> for IntervalRanks {
+    fn from((m, n): (MedianInterval, usize)) -> Self {
+        Self {
+            k: m.k,
+            high_rank: n + 1 - m.k,
+            coverage: m.coverage,
+        }
+    }
 }
 
 /// The metrics of the paired tests: error, peak error, effort, energy.
@@ -467,8 +488,9 @@ fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
         } else {
             v[0]
         };
-        ci95 = median_interval(&v);
-        let (lo, hi) = ci95.map_or((f64::NAN, f64::NAN), |c| (c.low, c.high));
+        let interval = median_interval(&v);
+        ci95 = interval.map(|i| IntervalRanks::from((i, v.len())));
+        let (lo, hi) = interval.map_or((f64::NAN, f64::NAN), |c| (c.low, c.high));
         let values = [
             median_of(&v),
             quantile(&v, 0.25),

@@ -280,7 +280,7 @@ fn spread(c: &Comparison) -> String {
         ci.map_or(String::new(), |ci| format!(
             "; the interval is order statistics x({}) .. x({}), coverage {:.1} %",
             ci.k,
-            c.seeds as usize + 1 - ci.k,
+            ci.high_rank,
             100.0 * ci.coverage
         ))
     );
