@@ -124,37 +124,87 @@ def arms_page() -> str:
 def compare_page() -> str:
     lines = header(
         "Laws compared, in process",
-        f"testbed compare --scenario NAME --laws {LAWS} --json",
+        f"testbed compare --scenario NAME --laws {LAWS} [--tuning matched] --json",
     )
     lines += [
         "One seed (these scenarios have no random effect); sums over joints,",
-        "after T_c unless marked. Gains as the scenario gives them (the",
-        "matching rule is [baselines.md](../baselines.md)).",
+        "after T_c unless marked. Per scenario two tables: the laws' textbook",
+        "gains (`as-given`) and the matching rule of",
+        "[baselines.md §6](../baselines.md#6-the-matching-rule) (`--tuning matched`:",
+        "every law with `pd`'s error dynamics; it changes `ctc` and `ppc`).",
         "",
     ]
     for name in COMPARED:
-        c = run_json(["compare", "--scenario", name, "--laws", LAWS])
+        lines += [f"## `{name}`", ""]
+        for tuning in ["as-given", "matched"]:
+            c = run_json(["compare", "--scenario", name, "--laws", LAWS, "--tuning", tuning])
+            lines += [f"### `{name}`, `--tuning {tuning}`", ""] + compare_table(c) + [""]
+    return "\n".join(lines)
+
+
+def compare_table(c: dict) -> list[str]:
+    lines = [
+        "| law | kept | IAE | max \\|e\\| | violation (whole run) | effort after T_c | ∫τ̇² | breaches | actor peak \\|τ\\| | failed |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for law in c["laws"]:
+        name_ = law["law"]["law"] + (" (URDF)" if law["law"]["model_based"] else "")
+        m = law["worst"]
+        kept = "yes" if law["kept_envelope"] else "**no**"
+        why = law["runs"][0]["failed"]
+        failed = f"**failed**: {why}" if why else "no"
+        if why:
+            # A failed run's metrics count as the worst: shown as such.
+            lines.append(f"| {name_} | {kept} | – | – | – | – | – | – | – | {failed} |")
+            continue
+        lines.append(
+            f"| {name_} | {kept} | {g(m['iae'])} | {g(m['max_abs_error'], 3)} | "
+            f"{g(m['violation_s'], 3)} s | {g(m['effort_after_tc'])} | {g(m['torque_rate'], 3)} | "
+            f"{int(m['breaches'])} | {g(m['peak_actor_torque'], 3)} | {failed} |"
+        )
+    return lines
+
+
+# (scenario, seeds): the randomised ones over seeds, so that the paired
+# tests decide; the others have one run per law.
+FINDINGS = [
+    ("paper", 1),
+    ("paper_per_input", 1),
+    ("payload_pickup", 1),
+    ("actuation_delay", 1),
+    ("paper_randomised", 20),
+    ("ur5_randomised", 20),
+]
+FINDINGS_LAWS = "nac,nac-no-shift,nac-no-networks,blf,pd"
+
+
+def findings_page() -> str:
+    lines = header(
+        "The paper's claims, checked",
+        f"testbed compare --scenario NAME --seeds N --laws {FINDINGS_LAWS} --json   # its findings",
+    )
+    lines += [
+        "Each verdict follows the rule stated in",
+        "[compare-and-sweeps.md](../compare-and-sweeps.md#findings-the-papers-claims-checked):",
+        "a difference counts when it is at least 1 % and, over seeds, the",
+        "Wilcoxon signed-rank test on the same seeds agrees (p < 0.05).",
+        "",
+    ]
+    for name, seeds in FINDINGS:
+        c = run_json(["compare", "--scenario", name, "--seeds", str(seeds), "--laws", FINDINGS_LAWS])
         lines += [
-            f"## `{name}`",
+            f"## `{name}`, {seeds} seed{'s' if seeds > 1 else ''}",
             "",
-            "| law | kept | IAE | max \\|e\\| | violation (whole run) | effort after T_c | ∫τ̇² | breaches | actor peak \\|τ\\| | failed |",
-            "|---|---|---|---|---|---|---|---|---|---|",
+            "| claim | verdict | evidence |",
+            "|---|---|---|",
         ]
-        for law in c["laws"]:
-            name_ = law["law"]["law"] + (" (URDF)" if law["law"]["model_based"] else "")
-            m = law["worst"]
-            kept = "yes" if law["kept_envelope"] else "**no**"
-            why = law["runs"][0]["failed"]
-            failed = f"**failed**: {why}" if why else "no"
-            if why:
-                # A failed run's metrics count as the worst: shown as such.
-                lines.append(f"| {name_} | {kept} | – | – | – | – | – | – | – | {failed} |")
-                continue
-            lines.append(
-                f"| {name_} | {kept} | {g(m['iae'])} | {g(m['max_abs_error'], 3)} | "
-                f"{g(m['violation_s'], 3)} s | {g(m['effort_after_tc'])} | {g(m['torque_rate'], 3)} | "
-                f"{int(m['breaches'])} | {g(m['peak_actor_torque'], 3)} | {failed} |"
-            )
+        for f in c["findings"]:
+            verdict = f["verdict"].replace("-", " ")
+            if verdict != "holds":
+                verdict = f"**{verdict}**"
+            evidence = f["evidence"].replace("|", "\\|")
+            claim = f["claim"].replace("|", "\\|")
+            lines.append(f"| {claim} | {verdict} | {evidence} |")
         lines.append("")
     return "\n".join(lines)
 
@@ -163,6 +213,7 @@ PAGES = {
     "scenarios.md": scenarios_page,
     "arms.md": arms_page,
     "compare.md": compare_page,
+    "findings.md": findings_page,
 }
 
 

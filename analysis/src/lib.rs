@@ -18,6 +18,7 @@ pub mod law_info;
 pub mod plots;
 pub mod record;
 pub mod report;
+pub mod stats;
 pub mod summary;
 pub mod timing;
 pub mod verify;

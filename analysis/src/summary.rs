@@ -105,6 +105,9 @@ pub struct ArmMetrics {
     pub effort: f64,
     /// Σ ∫τ² dt over t ≥ T_c.
     pub effort_after_tc: f64,
+    /// Σ ∫|τ q̇| dt over t ≥ T_c: the mechanical energy through the
+    /// motors, J (unlike ∫τ², holding a static load costs none).
+    pub energy_after_tc: f64,
     /// Σ ∫τ̇² dt.
     pub torque_rate: f64,
     /// max |τ| over joints and steps.
@@ -159,6 +162,7 @@ pub struct SummaryBuilder {
     torque_rate: Vec<f64>,
     peak_actor: f64,
     actor_effort: f64,
+    energy_after: f64,
     t_last: f64,
     breached: u64,
     faults: u64,
@@ -199,6 +203,7 @@ impl SummaryBuilder {
             torque_rate: vec![0.0; n],
             peak_actor: 0.0,
             actor_effort: 0.0,
+            energy_after: 0.0,
             t_last: 0.0,
             breached: 0,
             faults: 0,
@@ -270,6 +275,7 @@ impl SummaryBuilder {
             if after {
                 self.iae[i] += e * dt;
                 self.itae[i] += r.t * e * dt;
+                self.energy_after += (r.tau[i] * r.qd[i]).abs() * dt;
             }
             self.peak_actor = nan_max(self.peak_actor, r.tau_actor[i].abs());
             self.actor_effort += r.tau_actor[i] * r.tau_actor[i] * dt;
@@ -373,6 +379,7 @@ impl SummaryBuilder {
             violation_after_tc_s: self.any_violation_after,
             effort: sum(|j| j.effort_integral),
             effort_after_tc: sum(|j| j.effort_integral_after_tc),
+            energy_after_tc: self.energy_after,
             torque_rate: sum(|j| j.torque_rate_integral),
             peak_abs_torque: joints.iter().map(|j| j.max_abs_torque).fold(0.0, nan_max),
             saturated_s: self.saturated as f64 * self.dt,

@@ -7,7 +7,7 @@ use arm_model::dynamics::Dynamics;
 
 use crate::law_table::FeedbackKind;
 use crate::nac::{begin_plain_step, end_plain_step};
-use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics};
+use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Tuning};
 
 /// `pd`, `pd-gravity` or `ctc` for n joints.
 #[derive(Debug, Clone)]
@@ -16,6 +16,9 @@ pub struct Feedback {
     n: usize,
     k1: Vec<f64>,
     k2: Vec<f64>,
+    /// `ctc`'s K_p', K_d' per joint; with matched tuning, set at the first
+    /// step (they need the first reference posture).
+    ctc_gains: Option<(Vec<f64>, Vec<f64>)>,
     /// The law's copy of the arm's model (model-based laws only).
     model: Option<Dynamics>,
     /// Scratch: q̈_d − K_d' ė − K_p' e for `ctc`.
@@ -44,11 +47,21 @@ impl Feedback {
             }
             (true, None) => return Err(ControllerError::NeedsModel(law)),
         };
+        let k1 = params.k1.resolve("controller.k1", dof)?;
+        let k2 = params.k2.resolve("controller.k2", dof)?;
+        let ctc_gains = match params.tuning {
+            Tuning::AsGiven => Some((
+                k1.iter().zip(&k2).map(|(a, b)| a * b).collect(),
+                k1.iter().zip(&k2).map(|(a, b)| a + b).collect(),
+            )),
+            Tuning::Matched => None,
+        };
         Ok(Self {
             kind,
             n: dof,
-            k1: params.k1.resolve("controller.k1", dof)?,
-            k2: params.k2.resolve("controller.k2", dof)?,
+            k1,
+            k2,
+            ctc_gains,
             model,
             v: vec![0.0; dof],
         })
@@ -58,6 +71,9 @@ impl Feedback {
     pub fn step(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
         if !begin_plain_step(input, self.n, out) {
             return;
+        }
+        if self.kind == FeedbackKind::Ctc && self.ctc_gains.is_none() {
+            self.ctc_gains = Some(self.matched_ctc_gains(input.q_d));
         }
         for i in 0..self.n {
             let e = input.q[i] - input.q_d[i];
@@ -71,17 +87,44 @@ impl Feedback {
             out.tau_actor[i] = 0.0;
             out.tau_barrier[i] = 0.0;
             out.wa_norm[i] = 0.0;
-            // K_p = K1 K2, K_d = K2 (pd); K_p' = K1 K2, K_d' = K1 + K2 (ctc).
+            // K_p = K1 K2, K_d = K2 (pd); ctc's K_p', K_d' from `ctc_gains`.
             let (k1, k2) = (self.k1[i], self.k2[i]);
-            match self.kind {
-                FeedbackKind::Ctc => self.v[i] = input.qdd_d[i] - (k1 + k2) * ed - k1 * k2 * e,
-                FeedbackKind::Pd | FeedbackKind::PdGravity => {
+            match (self.kind, &self.ctc_gains) {
+                (FeedbackKind::Ctc, Some((kp, kd))) => {
+                    self.v[i] = input.qdd_d[i] - kd[i] * ed - kp[i] * e
+                }
+                // Unreachable: the gains are set above.
+                (FeedbackKind::Ctc, None) => self.v[i] = 0.0,
+                (FeedbackKind::Pd | FeedbackKind::PdGravity, _) => {
                     out.tau_feedback[i] = -k1 * k2 * e - k2 * ed
                 }
             }
         }
         self.model_terms(input, out);
         end_plain_step(out);
+    }
+
+    /// Matched `ctc` gains: `pd`'s joint i obeys m_i ë + K2 ė + K1 K2 e ≈ 0,
+    /// so K_p' = K1 K2 / m_i and K_d' = K2 / m_i give the same poles, with
+    /// m_i = 1 / (M⁻¹)_ii (the joint's effective inertia) at `q`, from the
+    /// law's own model. A joint whose m_i is not a finite positive number
+    /// (a singular model) keeps the as-given K1 K2, K1 + K2; so does every
+    /// joint without a model (`new` refuses that for `ctc`).
+    fn matched_ctc_gains(&mut self, q: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let n = self.n;
+        let m = match self.model.as_mut() {
+            Some(d) => effective_inertia(d, q),
+            None => vec![f64::NAN; n],
+        };
+        (0..n)
+            .map(|i| {
+                let (k1, k2) = (self.k1[i], self.k2[i]);
+                match m[i] {
+                    m if m.is_finite() && m > 0.0 => (k1 * k2 / m, k2 / m),
+                    _ => (k1 * k2, k1 + k2),
+                }
+            })
+            .unzip()
     }
 
     /// τ from the feedback and the model: G(q) for `pd-gravity`; for `ctc`
@@ -106,6 +149,28 @@ impl Feedback {
         for i in 0..n {
             out.tau[i] = out.tau_model[i] + out.tau_feedback[i];
         }
+    }
+}
+
+/// 1 / (M(q)⁻¹)_ii per joint; M's columns from inverse dynamics at rest
+/// (M e_k = τ(q, 0, e_k) − G(q)). A singular M falls back to M_ii.
+pub fn effective_inertia(d: &mut Dynamics, q: &[f64]) -> Vec<f64> {
+    let n = q.len();
+    let zero = vec![0.0; n];
+    let g = d.gravity(q).to_vec();
+    let mut m = nalgebra::DMatrix::zeros(n, n);
+    for k in 0..n {
+        let mut e = zero.clone();
+        e[k] = 1.0;
+        let col = d.inverse(q, &zero, &e);
+        for i in 0..n {
+            m[(i, k)] = col[i] - g[i];
+        }
+    }
+    let diag: Vec<f64> = (0..n).map(|i| m[(i, i)]).collect();
+    match m.try_inverse() {
+        Some(inv) => (0..n).map(|i| 1.0 / inv[(i, i)]).collect(),
+        None => diag,
     }
 }
 

@@ -121,3 +121,44 @@ fn a_non_finite_input_gives_zero_torque_and_a_fault() {
     assert_eq!(d.fault, Some(Fault::NonFiniteInput));
     assert_eq!(d.tau, [0.0, 0.0]);
 }
+
+/// BASELINES.md §6: on one joint M is a number m, so matched `ctc`
+/// (K_p' = K1 K2 / m, K_d' = K2 / m) at q̈_d = 0 is `pd-gravity` exactly;
+/// as given it is not.
+#[test]
+fn matched_ctc_on_one_joint_is_pd_with_gravity() {
+    let locks = arm_model::Locks::from([("joint2".to_string(), 0.4)]);
+    let model = ArmModel::from_urdf_str_locked(TWO_LINK_URDF, &locks).unwrap();
+    let one = |law: LawName, tuning: Tuning| {
+        let p = ControllerParams {
+            law,
+            k1: 2.0.into(),
+            k2: 3.0.into(),
+            tuning,
+            ..Default::default()
+        };
+        let mut f = new_feedback(&p, 1, Some(&model)).unwrap();
+        let mut d = Diagnostics::new(1);
+        f.step(
+            &ControllerInput {
+                t: 0.0,
+                q: &[0.5],
+                qd: &[1.0],
+                q_d: &[0.2],
+                qd_d: &[0.5],
+                qdd_d: &[0.0],
+                kc: &[0.5],
+                kc_dot: &[0.0],
+            },
+            &mut d,
+        );
+        d.tau[0]
+    };
+    let pd_g = one(LawName::PdGravity, Tuning::AsGiven);
+    let matched = one(LawName::Ctc, Tuning::Matched);
+    assert!(
+        (matched - pd_g).abs() < 1e-9 * pd_g.abs(),
+        "{matched} vs {pd_g}"
+    );
+    assert!((one(LawName::Ctc, Tuning::AsGiven) - pd_g).abs() > 0.1);
+}

@@ -182,12 +182,12 @@ impl LawName {
             LawName::Ctc => LawDecl {
                 name: "ctc",
                 kind: LawKind::Feedback(FeedbackKind::Ctc),
-                keys: &["model_scale"],
+                keys: &["model_scale", "tuning"],
             },
             LawName::Ppc => LawDecl {
                 name: "ppc",
                 kind: LawKind::Ppc,
-                keys: &["rho2_inf"],
+                keys: &["rho2_inf", "tuning"],
             },
         }
     }

@@ -47,12 +47,12 @@ mod shifting;
 mod weight_update;
 
 pub use dispatch::Law;
-pub use feedback::Feedback;
+pub use feedback::{Feedback, effective_inertia};
 pub use gain::Gain;
 pub use law_table::{BarrierParts, FeedbackKind, LawDecl, LawKind, LawName};
 pub use machine::ControllerMachine;
 pub use nac::{Controller, ControllerInput, barrier_lyapunov};
-pub use params::{BarrierMode, ControllerParams, Integrator, MAX_NEURONS, RbfLayout};
+pub use params::{BarrierMode, ControllerParams, Integrator, MAX_NEURONS, RbfLayout, Tuning};
 pub use ppc::{Ppc, XI_LIMIT};
 pub use rbf::Rbf;
 pub use shifting::shifting;

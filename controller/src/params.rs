@@ -40,6 +40,25 @@ pub enum RbfLayout {
     PerInput,
 }
 
+/// How `ctc` and `ppc` turn K1, K2 into their own gains (BASELINES.md §6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Tuning {
+    /// The textbook mapping: `ctc` poles at −K1, −K2; `ppc` k1 = K1, k2 = K2.
+    #[default]
+    AsGiven,
+    /// The matching rule: each law's error dynamics near e = 0 are `pd`'s
+    /// with the same K1, K2 on every joint (`ctc`: K_p' = K1 K2 / m_i,
+    /// K_d' = K2 / m_i, m_i = 1 / (M⁻¹)_ii at the first reference posture,
+    /// from the law's own model; `ppc`: k1 = K1 k_c(0) / 2,
+    /// k2 = K2 ρ2,∞ / 2).
+    Matched,
+}
+
+fn is_default<T: Default + PartialEq>(x: &T) -> bool {
+    *x == T::default()
+}
+
 /// Every parameter of the law. Unset keys take the paper's values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -99,6 +118,11 @@ pub struct ControllerParams {
     /// smallest power of two that keeps every shipped two-link scenario
     /// inside both funnels; 2 breaches under the 3 ms actuation delay).
     pub rho2_inf: f64,
+    /// `ctc`, `ppc`: how K1, K2 become the law's gains (default:
+    /// "as-given"; "matched" matches `pd`'s error dynamics). Unwritten at
+    /// its default so that existing scenarios keep their identity.
+    #[serde(skip_serializing_if = "is_default")]
+    pub tuning: Tuning,
 }
 
 impl Default for ControllerParams {
@@ -128,6 +152,7 @@ impl Default for ControllerParams {
             breach_epsilon: 1e-6,
             model_scale: 1.0,
             rho2_inf: 4.0,
+            tuning: Tuning::AsGiven,
         }
     }
 }
@@ -239,6 +264,7 @@ impl ControllerParams {
             ("breach_epsilon", self.breach_epsilon != d.breach_epsilon),
             ("model_scale", self.model_scale != d.model_scale),
             ("rho2_inf", self.rho2_inf != d.rho2_inf),
+            ("tuning", self.tuning != d.tuning),
         ];
         changed
             .iter()
@@ -297,7 +323,8 @@ impl ControllerParams {
             barrier,
             breach_epsilon,
             model_scale,
-            rho2_inf
+            rho2_inf,
+            tuning
         );
         p
     }

@@ -4,7 +4,7 @@
 //! deferred constraint on the same task.
 
 use crate::nac::{begin_plain_step, end_plain_step};
-use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics};
+use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Tuning};
 
 /// ξ is clamped to ±(1 − this) where the law is undefined (|ξ| ≥ 1).
 pub const XI_LIMIT: f64 = 1e-6;
@@ -18,19 +18,28 @@ pub struct Ppc {
     /// Decay rate l = 3 / T_c.
     l: f64,
     rho2_inf: f64,
+    /// Matched tuning: k1 is scaled by k_c(0) / 2 at the first step.
+    tuning: Tuning,
     /// Time and funnel starts of the first step: (t0, ρ1,0, ρ2,0) per joint.
     start: Option<(f64, Vec<f64>, Vec<f64>)>,
 }
 
 impl Ppc {
-    /// With k1 = K1, k2 = K2 and `params.rho2_inf`.
+    /// With k1 = K1, k2 = K2 and `params.rho2_inf`; matched (near e = 0,
+    /// ε ≈ 2 ξ, so the law is `pd` with K1_eff = 2 k1 / ρ1 and
+    /// K2_eff = 2 k2 / ρ2): k1 = K1 k_c(0) / 2 and k2 = K2 ρ2,∞ / 2.
     pub fn new(params: &ControllerParams, dof: usize) -> Result<Self, ControllerError> {
+        let mut k2 = params.k2.resolve("controller.k2", dof)?;
+        if params.tuning == Tuning::Matched {
+            k2.iter_mut().for_each(|k| *k *= params.rho2_inf / 2.0);
+        }
         Ok(Self {
             n: dof,
             k1: params.k1.resolve("controller.k1", dof)?,
-            k2: params.k2.resolve("controller.k2", dof)?,
+            k2,
             l: 3.0 / params.tc,
             rho2_inf: params.rho2_inf,
+            tuning: params.tuning,
             start: None,
         })
     }
@@ -40,6 +49,12 @@ impl Ppc {
     pub fn step(&mut self, input: &ControllerInput<'_>, out: &mut Diagnostics) {
         if !begin_plain_step(input, self.n, out) {
             return;
+        }
+        if self.start.is_none() && self.tuning == Tuning::Matched {
+            // ρ1,∞ = k_c: the funnel's final width, taken at the first step.
+            for (k, kc) in self.k1.iter_mut().zip(input.kc) {
+                *k *= kc / 2.0;
+            }
         }
         let (t0, rho1_0, rho2_0) = self.start.get_or_insert_with(|| {
             let rho1_0: Vec<f64> = (0..input.q.len())

@@ -77,3 +77,30 @@ fn a_non_finite_input_gives_zero_torque_and_a_fault() {
     assert_eq!(d.fault, Some(crate::Fault::NonFiniteInput));
     assert_eq!(d.tau, [0.0]);
 }
+
+/// BASELINES.md §6: matched, the funnel law near e = 0 with its funnels
+/// at their final widths is `pd` with the same K1, K2.
+#[test]
+fn matched_tuning_is_pd_near_zero_error() {
+    let matched = ControllerParams {
+        tuning: crate::Tuning::Matched,
+        ..params()
+    };
+    let mut p = Ppc::new(&matched, 1).unwrap();
+    let kc = [0.3];
+    let mut out = Diagnostics::new(1);
+    p.step(&input(0.0, &[0.0], &[0.0], &kc), &mut out);
+    let (e, ed) = (1e-5, 3e-5);
+    p.step(&input(100.0, &[e], &[ed], &kc), &mut out);
+    let pd = -3.0 * (ed + 2.0 * e);
+    assert!(
+        (out.tau[0] - pd).abs() < 1e-6 * pd.abs(),
+        "{} vs {pd}",
+        out.tau[0]
+    );
+    // As given, the same step is a far stiffer pd (K1_eff = 2 k1 / k_c).
+    let mut q = Ppc::new(&params(), 1).unwrap();
+    q.step(&input(0.0, &[0.0], &[0.0], &kc), &mut out);
+    q.step(&input(100.0, &[e], &[ed], &kc), &mut out);
+    assert!((out.tau[0] - pd).abs() > 0.5 * pd.abs());
+}

@@ -1,5 +1,5 @@
-//! `testbed compare` on the paper scenario with one seed, and a sweep of
-//! 16 runs: each on every core and on one, so that the ratio shows the
+//! `testbed compare` on the paper scenario with one seed, on the randomised
+//! paper scenario with 20 seeds, and a sweep of 16 runs: each on every core and on one, so that the ratio shows the
 //! cores are used.
 //!
 //! `cargo bench -p launch --bench compare` (each sample is a whole
@@ -21,11 +21,34 @@ fn paper_compare(c: &mut Criterion) {
             seeds: 1,
             threads: Some(threads),
             series: false,
+            tuning: None,
         };
         group.bench_function(format!("{threads}_threads"), |b| {
             b.iter(|| compare(&plan, &opts).unwrap())
         });
     }
+    group.finish();
+}
+
+/// `compare --seeds 20` on the randomised paper scenario (5 s runs): 160
+/// runs with their draws, quartiles, intervals and paired tests.
+fn randomised_compare(c: &mut Criterion) {
+    let path = scenario::find_shipped("paper_randomised").unwrap().path();
+    let overrides = scenario::Overrides {
+        duration_s: Some(5.0),
+        ..Default::default()
+    };
+    let plan = scenario::load(Some(&path), &overrides).unwrap();
+    let opts = CompareOptions {
+        laws: DEFAULT_LAWS.to_vec(),
+        seeds: 20,
+        threads: None,
+        series: false,
+        tuning: None,
+    };
+    let mut group = c.benchmark_group("compare_randomised_20_seeds");
+    group.sample_size(10);
+    group.bench_function("all_threads", |b| b.iter(|| compare(&plan, &opts).unwrap()));
     group.finish();
 }
 
@@ -64,5 +87,5 @@ fn sweep_throughput(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, paper_compare, sweep_throughput);
+criterion_group!(benches, paper_compare, randomised_compare, sweep_throughput);
 criterion_main!(benches);

@@ -7,13 +7,14 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use controller::LawName;
+use controller::{LawName, Tuning};
 use rayon::prelude::*;
 use scenario::Plan;
 use serde::Serialize;
 
 use crate::sim::{self, StepCosts};
 use analysis::law_info::LawInfo;
+use analysis::stats::{MedianInterval, SignedRank, median_interval, quantile, signed_rank};
 use analysis::summary::{Summary, SummaryBuilder};
 use analysis::timing::Percentiles;
 
@@ -67,6 +68,8 @@ pub struct CompareOptions {
     pub threads: Option<usize>,
     /// Keep the first seed's error, envelope and torque per law, for figures.
     pub series: bool,
+    /// The tuning rule of the laws that take one (None: the scenario's).
+    pub tuning: Option<Tuning>,
 }
 
 /// The first seed's curves of one law, for the overlay figures.
@@ -108,6 +111,17 @@ pub struct LawRow {
     pub runs: Vec<LawRun>,
     /// Per metric, the median over seeds.
     pub median: Stats,
+    /// Per metric, the first quartile over seeds (linear interpolation).
+    pub q1: Stats,
+    /// Per metric, the third quartile.
+    pub q3: Stats,
+    /// Per metric, the low end of the 95 % interval of the median
+    /// ([`analysis::stats::median_interval`]: order statistics).
+    pub ci95_low: Stats,
+    /// Per metric, its high end.
+    pub ci95_high: Stats,
+    /// The interval's ranks and coverage (the same for every metric).
+    pub ci95: Option<IntervalRanks>,
     /// Per metric, the worst seed's value.
     pub worst: Stats,
     /// Seeds whose run kept |e| < k_c for every t ≥ T_c, finite.
@@ -133,7 +147,52 @@ pub struct Comparison {
     pub wall_time_s: f64,
     /// One row per law.
     pub laws: Vec<LawRow>,
+    /// The first law against each other law on the same seeds (with two
+    /// seeds or more).
+    pub paired: Vec<Paired>,
+    /// What this says about the paper's claims ([`crate::compare_findings`]).
+    pub findings: Vec<crate::compare_findings::Finding>,
 }
+
+/// A paired test of the first law against another on one metric.
+#[derive(Debug, Clone, Serialize)]
+pub struct Paired {
+    /// The first law of the comparison (`nac` by default).
+    pub law: LawName,
+    /// The law it is tested against.
+    pub versus: LawName,
+    /// The metric.
+    pub metric: &'static str,
+    /// Wilcoxon signed-rank of law − versus, seed by seed: `a_smaller` is
+    /// the seeds where `law` did better.
+    pub test: SignedRank,
+}
+
+/// Which order statistics bound the 95 % interval of the median, and its
+/// coverage ([`analysis::stats::median_interval`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct IntervalRanks {
+    /// The low end is the k-th smallest value (1-based).
+    pub k: usize,
+    /// The high end is the (n + 1 − k)-th.
+    pub high_rank: usize,
+    /// P(low ≤ median ≤ high) for a continuous distribution.
+    pub coverage: f64,
+}
+
+impl From<(MedianInterval, usize)> for IntervalRanks {
+    fn from((m, n): (MedianInterval, usize)) -> Self {
+        Self {
+            k: m.k,
+            high_rank: n + 1 - m.k,
+            coverage: m.coverage,
+        }
+    }
+}
+
+/// The metrics of the paired tests: error, peak error, effort, energy.
+pub const PAIRED_METRICS: [&str; 4] =
+    ["iae", "max_abs_error", "effort_after_tc", "energy_after_tc"];
 
 /// One value per metric of [`METRICS`], in order (JSON: an object; an
 /// infinite value, i.e. a missing one counted as the worst, is null).
@@ -193,6 +252,9 @@ pub const METRICS: &[Metric] = &[
     m("effort_after_tc", "N² m² s", true, |r| {
         Some(r.summary.metrics.effort_after_tc)
     }),
+    m("energy_after_tc", "J", true, |r| {
+        Some(r.summary.metrics.energy_after_tc)
+    }),
     m("torque_rate", "N² m²/s", true, |r| {
         Some(r.summary.metrics.torque_rate)
     }),
@@ -226,16 +288,31 @@ const fn m(
     }
 }
 
-/// The plan of `testbed sim --law <law>` with seed `plan.seed + s`.
-pub fn plan_for(plan: &Plan, law: LawName, s: u64) -> Result<Plan, CompareError> {
-    let mut p = plan.clone();
-    p.scenario.controller = plan.scenario.controller.for_law(law);
-    p.scenario.seed = plan.scenario.seed.wrapping_add(s);
-    let seed = p.scenario.seed;
-    p.scenario
-        .validate(&plan.source)
-        .map_err(|cause| CompareError::Plan { law, seed, cause })?;
-    Ok(p)
+/// The plan of `testbed sim --law <law>` with seed `plan.seed + s`: the
+/// scenario before its draws, for `law`, with that seed's `[randomise]`
+/// draws (the same for every law).
+pub fn plan_for(
+    plan: &Plan,
+    law: LawName,
+    s: u64,
+    tuning: Option<Tuning>,
+) -> Result<Plan, CompareError> {
+    let mut scenario = plan.undrawn.clone();
+    scenario.controller = scenario.controller.for_law(law);
+    if let Some(t) = tuning.filter(|_| law.takes("tuning")) {
+        scenario.controller.tuning = t;
+    }
+    scenario.seed = plan.undrawn.seed.wrapping_add(s);
+    let seed = scenario.seed;
+    let fail = |cause| CompareError::Plan { law, seed, cause };
+    scenario.validate(&plan.source).map_err(fail)?;
+    scenario::plan(
+        scenario,
+        plan.source.clone(),
+        plan.toml.clone(),
+        plan.robot.clone(),
+    )
+    .map_err(fail)
 }
 
 /// Runs every law on every seed and scores them.
@@ -248,7 +325,7 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
     let mut jobs = Vec::new();
     for &law in &opts.laws {
         for s in 0..opts.seeds {
-            jobs.push((law, s, plan_for(plan, law, s)?));
+            jobs.push((law, s, plan_for(plan, law, s, opts.tuning)?));
         }
     }
     let threads = opts
@@ -274,10 +351,18 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
         .iter()
         .map(|&law| {
             let mine: Vec<LawRun> = runs.by_ref().take(opts.seeds as usize).collect();
-            row(LawInfo::of(&plan.scenario.controller.for_law(law)), mine)
+            let info = jobs
+                .iter()
+                .find(|(l, _, _)| *l == law)
+                .map(|(_, _, p)| LawInfo::of(&p.scenario.controller));
+            row(
+                info.unwrap_or_else(|| LawInfo::of(&plan.scenario.controller.for_law(law))),
+                mine,
+            )
         })
-        .collect();
-    Ok(Comparison {
+        .collect::<Vec<_>>();
+    let paired = paired(&laws);
+    let mut c = Comparison {
         scenario: plan.scenario.name.clone(),
         scenario_source: plan.source.clone(),
         robot: plan.robot.label(),
@@ -286,7 +371,11 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
         threads,
         wall_time_s,
         laws,
-    })
+        paired,
+        findings: Vec::new(),
+    };
+    c.findings = crate::compare_findings::findings(&c);
+    Ok(c)
 }
 
 /// One in-process run, exactly as `testbed sim` makes it.
@@ -389,31 +478,78 @@ pub fn failed_because(failure: Option<&str>, s: &Summary) -> Option<String> {
 }
 
 fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
-    let mut median = Vec::new();
-    let mut worst = Vec::new();
+    let mut rows: [Vec<(&'static str, f64)>; 6] = Default::default();
+    let mut ci95 = None;
     for metric in METRICS {
         let mut v: Vec<f64> = runs.iter().map(|r| value(metric, r)).collect();
         v.sort_by(f64::total_cmp);
-        median.push((metric.name, median_of(&v)));
         let w = if metric.larger_is_worse {
             v[v.len() - 1]
         } else {
             v[0]
         };
-        worst.push((metric.name, w));
+        let interval = median_interval(&v);
+        ci95 = interval.map(|i| IntervalRanks::from((i, v.len())));
+        let (lo, hi) = interval.map_or((f64::NAN, f64::NAN), |c| (c.low, c.high));
+        let values = [
+            median_of(&v),
+            quantile(&v, 0.25),
+            quantile(&v, 0.75),
+            lo,
+            hi,
+            w,
+        ];
+        for (r, x) in rows.iter_mut().zip(values) {
+            r.push((metric.name, x));
+        }
     }
     let kept = runs
         .iter()
         .filter(|r| r.failed.is_none())
         .filter(|r| r.summary.constraint_satisfied_after_tc)
         .count() as u64;
+    let [median, q1, q3, ci95_low, ci95_high, worst] = rows.map(Stats);
     LawRow {
         law,
         runs,
-        median: Stats(median),
-        worst: Stats(worst),
+        median,
+        q1,
+        q3,
+        ci95_low,
+        ci95_high,
+        ci95,
+        worst,
         kept_envelope: kept,
     }
+}
+
+/// The first law against every other, per [`PAIRED_METRICS`], seed by
+/// seed (seeds are the same runs' draws for every law).
+fn paired(laws: &[LawRow]) -> Vec<Paired> {
+    let Some((first, others)) = laws.split_first() else {
+        return Vec::new();
+    };
+    if first.runs.len() < 2 {
+        return Vec::new();
+    }
+    let values = |row: &LawRow, name: &str| -> Vec<f64> {
+        let metric = METRICS.iter().find(|m| m.name == name);
+        row.runs
+            .iter()
+            .map(|r| metric.map_or(f64::NAN, |m| value(m, r)))
+            .collect()
+    };
+    others
+        .iter()
+        .flat_map(|other| {
+            PAIRED_METRICS.iter().map(move |&metric| Paired {
+                law: first.law.law,
+                versus: other.law.law,
+                metric,
+                test: signed_rank(&values(first, metric), &values(other, metric)),
+            })
+        })
+        .collect()
 }
 
 /// The median of sorted values (mean of the middle two for an even count).
@@ -451,6 +587,7 @@ mod tests {
             seeds: 1,
             threads: Some(1),
             series: false,
+            tuning: None,
         };
         assert!(compare(&plan, &opts).is_err());
     }

@@ -50,6 +50,15 @@ pub struct PlantConfig {
     /// held where the coupling puts it (default: none; the default scenario
     /// of an arm locks its gripper and finger joints).
     pub lock: Locks,
+    /// Every link's mass and inertia times this, in the plant only: model
+    /// error the controller does not know of (default: 1, the URDF's).
+    /// Unwritten at 1 so that scenarios' identities (sweep keys) keep.
+    #[serde(skip_serializing_if = "is_one")]
+    pub mass_scale: f64,
+}
+
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
 }
 
 impl Default for PlantConfig {
@@ -68,6 +77,7 @@ impl Default for PlantConfig {
             lock: Locks::new(),
             urdf_dynamics: true,
             armature: PerJoint::default(),
+            mass_scale: 1.0,
         }
     }
 }
@@ -320,6 +330,13 @@ impl PlantConfig {
             e.check("plant.effort_limit")?;
         }
         self.armature.check("plant.armature")?;
+        if !(self.mass_scale > 0.0 && self.mass_scale <= 1e3) {
+            return Err(invalid(
+                "plant.mass_scale",
+                self.mass_scale,
+                "a factor in (0, 1000]",
+            ));
+        }
         if let Some((name, v)) = self.lock.iter().find(|(_, v)| !v.is_finite()) {
             return Err(invalid(
                 &format!("plant.lock.{name}"),

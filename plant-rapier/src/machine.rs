@@ -38,6 +38,13 @@ impl PlantMachine {
         if model.dof() > MAX_DOF {
             return Err(PlantError::TooManyJoints(model.dof()));
         }
+        let scaled;
+        let model = if config.mass_scale == 1.0 {
+            model
+        } else {
+            scaled = scale_masses(model, config.mass_scale);
+            &scaled
+        };
         let mut rig = Rig::new(model, config, seed, period_ns)?;
         rig.set_state(q0, qd0)?;
         let n = rig.dof();
@@ -126,4 +133,15 @@ impl PlantMachine {
         }
         self.rig.step(cmd.map(|c| &c.tau[..self.n]))
     }
+}
+
+/// `model` with every link's mass and inertia times `s` (the plant's
+/// `mass_scale`; the centres of mass stay).
+fn scale_masses(model: &ArmModel, s: f64) -> ArmModel {
+    let mut m = model.clone();
+    for link in &mut m.links {
+        link.mass *= s;
+        link.inertia = link.inertia.map(|x| x * s);
+    }
+    m
 }

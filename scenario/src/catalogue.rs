@@ -34,6 +34,8 @@ pub const SHIPPED: &[Shipped] = shipped![
     "paper_per_input",
     "iiwa_waypoints",
     "iiwa_csv",
+    "paper_randomised",
+    "ur5_randomised",
 ];
 
 impl Shipped {

@@ -19,6 +19,7 @@ mod gains;
 mod plan;
 mod posture;
 mod probe;
+mod randomise;
 mod robot;
 pub mod sweep_file;
 
@@ -37,6 +38,7 @@ pub use default_for_arm::{ArmDefault, GRIPPER_LOCK};
 pub use gains::{ArmatureFor, GainChoice, JointGain};
 pub use plan::{Overrides, Plan, load, parse_set, plan};
 pub use probe::Probe;
+pub use randomise::{Dist, Randomise, drawn};
 pub use robot::RobotSource;
 pub use wire::ns_to_s;
 
@@ -175,6 +177,9 @@ pub struct Scenario {
     /// declaration before the run, passed to it as `own_params`.
     #[serde(skip_serializing_if = "toml::Table::is_empty")]
     pub external: toml::Table,
+    /// What each seed varies besides the plant's noise (default: nothing).
+    #[serde(skip_serializing_if = "Randomise::is_empty")]
+    pub randomise: Randomise,
 }
 
 impl Default for Scenario {
@@ -191,6 +196,7 @@ impl Default for Scenario {
             controller: ControllerParams::default(),
             plant: PlantConfig::default(),
             external: toml::Table::new(),
+            randomise: Randomise::default(),
         }
     }
 }
@@ -305,6 +311,7 @@ impl Scenario {
                 file: file.to_string(),
                 cause,
             })?;
+        self.randomise.validate(file)?;
         self.plant
             .validate()
             .map_err(|cause| ScenarioError::Plant {

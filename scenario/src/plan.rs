@@ -11,8 +11,11 @@ use crate::{PAPER_TOML, RobotSource, Scenario, ScenarioError};
 /// A scenario checked against its robot: everything a run needs.
 #[derive(Debug, Clone)]
 pub struct Plan {
-    /// The scenario as loaded.
+    /// The scenario as it runs: as loaded, with its seed's `[randomise]`
+    /// draws applied.
     pub scenario: Scenario,
+    /// The scenario before the draws: what another seed draws from.
+    pub undrawn: Scenario,
     /// Where the scenario came from ("built-in paper scenario" or a path).
     pub source: String,
     /// The scenario's TOML text as written by its author, for logs.
@@ -282,6 +285,11 @@ pub fn plan(
             return Err(mismatch(key, len));
         }
     }
+    let undrawn = scenario.clone();
+    let scenario = crate::drawn(&scenario, dof);
+    if scenario != undrawn {
+        scenario.validate(&format!("{source} (seed {} drawn)", scenario.seed))?;
+    }
     let c = &scenario.controller;
     for (key, gain) in [("controller.k1", &c.k1), ("controller.k2", &c.k2)] {
         gain.resolve(key, dof)
@@ -329,6 +337,7 @@ pub fn plan(
     }
     Ok(Plan {
         scenario,
+        undrawn,
         source,
         toml,
         robot,

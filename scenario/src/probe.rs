@@ -70,3 +70,26 @@ impl Probe {
             .fold(0.0, f64::max)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `ctc`'s matched gains use 1/(M⁻¹)_ii from its Newton–Euler model:
+    /// the same as the plant's response to unit torques.
+    #[test]
+    fn the_laws_effective_inertia_is_the_plants() {
+        let model = ArmModel::from_urdf_str(plant_rapier::TWO_LINK_URDF).unwrap();
+        let q = [0.3, 1.1];
+        let probe = Probe::at(&model, &q, &[0.0, 0.0]).unwrap();
+        let mut d = arm_model::dynamics::Dynamics::new(&model, 1.0);
+        let m = controller::effective_inertia(&mut d, &q);
+        for (i, got) in m.iter().enumerate() {
+            let want = 1.0 / probe.minv[(i, i)];
+            assert!(
+                (got - want).abs() < 1e-3 * want,
+                "joint {i}: {got} vs {want}"
+            );
+        }
+    }
+}

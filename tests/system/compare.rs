@@ -190,6 +190,8 @@ fn compare_writes_its_table_csv_and_figures() {
         "compare_errors.svg",
         "compare_bars.png",
         "compare_bars.svg",
+        "compare_error_ratio.png",
+        "compare_error_ratio.svg",
     ] {
         assert!(
             dir.path().join("fig").join(f).metadata().unwrap().len() > 1000,
@@ -283,5 +285,189 @@ fn a_faulted_run_is_a_failure_everywhere() {
     assert!(
         shift.starts_with("nac-no-shift,false,0,true,false,"),
         "{shift}"
+    );
+    // The figures say so too: a grey "FAILED" bar, a "FAILED" panel title.
+    let fig = dir.path().join("fig");
+    ok(testbed().args(args).arg("--plots").arg(&fig));
+    for f in [
+        "compare_bars.svg",
+        "compare_error_ratio.svg",
+        "compare_errors.svg",
+    ] {
+        let svg = std::fs::read_to_string(fig.join(f)).unwrap();
+        assert!(svg.contains("FAILED"), "{f} does not mark the failed law");
+    }
+}
+
+/// #26 item 3: a randomised scenario gives each seed its own run, the
+/// same run for the same seed (in `compare`, `sim` and lockstep), and
+/// `compare` reports quartiles, a 95 % interval and paired tests.
+#[test]
+fn randomised_trials_differ_per_seed_and_repeat_per_seed() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmp = json(&ok(testbed().args([
+        "compare",
+        "--scenario",
+        "paper_randomised",
+        "--duration",
+        "2.5",
+        "--laws",
+        "nac,pd",
+        "--seeds",
+        "20",
+        "--json",
+    ])));
+    let nac = &cmp["laws"][0];
+    let runs = nac["runs"].as_array().unwrap();
+    let mut iae: Vec<f64> = runs
+        .iter()
+        .map(|r| r["summary"]["metrics"]["iae_after_tc"].as_f64().unwrap())
+        .collect();
+    iae.sort_by(f64::total_cmp);
+    iae.dedup();
+    assert_eq!(iae.len(), 20, "every seed its own run: {iae:?}");
+    let (lo, med, hi) = (
+        nac["ci95_low"]["iae"].as_f64().unwrap(),
+        nac["median"]["iae"].as_f64().unwrap(),
+        nac["ci95_high"]["iae"].as_f64().unwrap(),
+    );
+    assert!(lo < med && med < hi, "{lo} {med} {hi}");
+    assert_eq!(
+        (iae[5], iae[14]),
+        (lo, hi),
+        "order statistics 6 and 15 of 20"
+    );
+    assert_eq!(
+        (nac["ci95"]["k"].as_u64(), nac["ci95"]["high_rank"].as_u64()),
+        (Some(6), Some(15))
+    );
+    assert!(nac["q1"]["iae"].as_f64().unwrap() < nac["q3"]["iae"].as_f64().unwrap());
+    let paired = cmp["paired"].as_array().unwrap();
+    let p = paired
+        .iter()
+        .find(|p| p["versus"] == "pd" && p["metric"] == "iae")
+        .expect("nac vs pd on IAE");
+    assert_eq!(p["law"], "nac");
+    assert_eq!(p["test"]["pairs"], 20);
+    assert!((0.0..=1.0).contains(&p["test"]["p_value"].as_f64().unwrap()));
+    // #26 item 5: the findings, by their rules, in the JSON.
+    let findings = cmp["findings"].as_array().unwrap();
+    assert_eq!(findings[0]["verdict"], "holds", "{findings:?}");
+    assert!(findings[2]["claim"].as_str().unwrap().contains("vs pd"));
+    assert!(
+        findings[2]["evidence"]
+            .as_str()
+            .unwrap()
+            .contains("Wilcoxon p")
+    );
+    // Seed 3's row is `sim` of the scenario with seed 3, and lockstep too.
+    let base =
+        std::fs::read_to_string(crate::util::repo_root().join("scenarios/paper_randomised.toml"))
+            .unwrap();
+    let file = dir.path().join("seed3.toml");
+    std::fs::write(&file, format!("seed = 3\n{base}")).unwrap();
+    let (sim_csv, run_csv) = (dir.path().join("sim.csv"), dir.path().join("run.csv"));
+    let common = ["--duration", "2.5", "--json", "--law", "nac", "--csv"];
+    let sim = json(&ok(testbed()
+        .arg("sim")
+        .args(common)
+        .arg(&sim_csv)
+        .arg("--scenario")
+        .arg(&file)));
+    let row = runs.iter().find(|r| r["seed"] == 3).unwrap();
+    for key in SUMMARY_KEYS {
+        assert_eq!(row["summary"][key], sim[key], "seed 3: {key}");
+    }
+    ok(testbed()
+        .args(["run", "--mode", "lockstep", "--runs-dir"])
+        .arg(dir.path())
+        .args(common)
+        .arg(&run_csv)
+        .arg("--scenario")
+        .arg(&file));
+    assert_same_csv(
+        "randomised seed 3: lockstep vs sim",
+        &std::fs::read(&run_csv).unwrap(),
+        &std::fs::read(&sim_csv).unwrap(),
+    );
+}
+
+/// #26 item 2: matched tuning gives ctc pd's error dynamics (it keeps the
+/// envelope under the payload, where its textbook poles fail), makes ppc
+/// a pd near e = 0, and names itself in the law's parameters; the
+/// trade-off mode reports every law at every gain scale.
+#[test]
+fn matched_tuning_and_the_trade_off_mode() {
+    let run = |tuning: &str| {
+        json(&ok(testbed().args([
+            "compare",
+            "--scenario",
+            "payload_pickup",
+            "--laws",
+            "pd,ctc,ppc",
+            "--tuning",
+            tuning,
+            "--json",
+        ])))
+    };
+    let (given, matched) = (run("as-given"), run("matched"));
+    let kept = |c: &serde_json::Value, k: usize| c["laws"][k]["kept_envelope"].as_u64();
+    assert_eq!((kept(&given, 1), kept(&matched, 1)), (Some(0), Some(1)));
+    assert_eq!(matched["laws"][1]["law"]["parameters"]["tuning"], "matched");
+    let iae = |c: &serde_json::Value, k: usize| c["laws"][k]["median"]["iae"].as_f64().unwrap();
+    let (pd, ppc) = (iae(&matched, 0), iae(&matched, 2));
+    assert!((ppc / pd - 1.0).abs() < 0.1, "matched ppc {ppc} vs pd {pd}");
+    assert!(iae(&given, 2) < 0.6 * pd, "as given, ppc is a stiffer pd");
+    let t = json(&ok(testbed().args([
+        "compare",
+        "--duration",
+        "3",
+        "--laws",
+        "nac,pd",
+        "--gain-scales",
+        "0.5,1,2",
+        "--json",
+    ])));
+    let points = t["points"].as_array().unwrap();
+    assert_eq!(points.len(), 6);
+    let nac: Vec<f64> = points[..3]
+        .iter()
+        .map(|p| p["iae"].as_f64().unwrap())
+        .collect();
+    assert!(
+        nac[0] > nac[1] && nac[1] > nac[2],
+        "stiffer, smaller error: {nac:?}"
+    );
+    assert!(points.iter().any(|p| p["on_front"] == true));
+    assert!(
+        points
+            .iter()
+            .all(|p| p["energy"].as_f64().is_some_and(|e| e > 0.0))
+    );
+    let e = fails(testbed().args(["compare", "--gain-scales", "1,-2"]));
+    assert!(e.contains("--gain-scales -2"), "{e}");
+    // A scenario can ask for it: the lockstep stack gives sim's bits.
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("ctc.toml");
+    std::fs::write(&file, "[controller]\nlaw = \"ctc\"\ntuning = \"matched\"\n").unwrap();
+    let (run_csv, sim_csv) = (dir.path().join("run.csv"), dir.path().join("sim.csv"));
+    let common = ["--duration", "0.4", "--json", "--scenario"];
+    ok(testbed()
+        .args(["run", "--mode", "lockstep", "--runs-dir"])
+        .arg(dir.path())
+        .args(common)
+        .arg(&file)
+        .arg("--csv")
+        .arg(&run_csv));
+    ok(testbed()
+        .arg("sim")
+        .args(common)
+        .arg(&file)
+        .arg("--csv")
+        .arg(&sim_csv));
+    assert_same_csv(
+        "matched ctc: lockstep vs sim",
+        &std::fs::read(&run_csv).unwrap(),
+        &std::fs::read(&sim_csv).unwrap(),
     );
 }

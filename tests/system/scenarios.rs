@@ -52,6 +52,8 @@ fn every_shipped_scenario_keeps_its_envelope() {
             "actuation_delay" => &["delayed", "command_dropped", "command_held"],
             "tight_envelope" => &["disturbance"],
             "saturation_slow_reference" => &["saturated"],
+            "paper_randomised" => &["sensor_noise", "disturbance"],
+            "ur5_randomised" => &["disturbance"],
             _ => &[],
         };
         for w in want {

@@ -262,3 +262,57 @@ fn a_results_folder_removed_mid_sweep_fails_the_sweep() {
         "{err}"
     );
 }
+
+/// A sweep of a randomised scenario draws per seed as `compare` does: each
+/// run is the `compare` row of its seed, and the seeds differ.
+#[test]
+fn a_randomised_sweep_draws_per_seed_like_compare() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("r.toml");
+    std::fs::write(
+        &file,
+        "name = \"r\"\nscenario = \"paper_randomised\"\nseeds = 3\nlaws = [\"nac\"]\n\
+         [set]\nduration_s = 2.5\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    ok(testbed()
+        .args(["sweep", "run", "--no-progress", "--out"])
+        .arg(&out)
+        .arg(&file));
+    let cmp = json(&ok(testbed().args([
+        "compare",
+        "--scenario",
+        "paper_randomised",
+        "--duration",
+        "2.5",
+        "--laws",
+        "nac",
+        "--seeds",
+        "3",
+        "--json",
+    ])));
+    let mut runs: Vec<serde_json::Value> = std::fs::read_dir(&out)
+        .unwrap()
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().starts_with("results-"))
+        .flat_map(|e| {
+            std::fs::read_to_string(e.path())
+                .unwrap()
+                .lines()
+                .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    runs.sort_by_key(|r| r["seed"].as_u64());
+    assert_eq!(runs.len(), 3);
+    for (run, row) in runs.iter().zip(cmp["laws"][0]["runs"].as_array().unwrap()) {
+        assert_eq!(run["seed"], row["seed"]);
+        assert_eq!(
+            run["summary"]["metrics"], row["summary"]["metrics"],
+            "seed {}",
+            run["seed"]
+        );
+    }
+    assert_ne!(runs[0]["summary"]["metrics"], runs[1]["summary"]["metrics"]);
+}

@@ -261,6 +261,19 @@ pub(crate) struct CompareArgs {
     /// Write the comparison figures (PNG and SVG) here.
     #[arg(long, value_name = "DIR")]
     pub(crate) plots: Option<PathBuf>,
+    /// How ctc and ppc turn K1, K2 into their gains: `matched` gives every
+    /// law pd's error dynamics near e = 0 (docs/baselines.md §6)
+    /// [default: the scenario's, as-given unless it says otherwise].
+    #[arg(long, value_name = "RULE", value_parser = ["as-given", "matched"])]
+    pub(crate) tuning: Option<String>,
+    /// Trade-off mode: run every law with K1 and K2 times each of these
+    /// scales and report IAE after T_c against effort (a Pareto front per law).
+    #[arg(long, value_name = "S,…", value_delimiter = ',')]
+    pub(crate) gain_scales: Vec<f64>,
+    /// Print, after the table, which of the paper's claims hold on this
+    /// scenario and the numbers they rest on (the JSON always has them).
+    #[arg(long)]
+    pub(crate) findings: bool,
 }
 
 /// `--law` and `--laws`: the names come from the law table, and `--help`

@@ -58,7 +58,16 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
         seeds: args.seeds,
         threads: super::worker_threads(args.threads),
         series: args.plots.is_some(),
+        tuning: match args.tuning.as_deref() {
+            Some("matched") => Some(controller::Tuning::Matched),
+            Some("as-given") => Some(controller::Tuning::AsGiven),
+            Some(other) => bail!("--tuning {other}: must be as-given or matched"),
+            None => None,
+        },
     };
+    if !args.gain_scales.is_empty() {
+        return tradeoff(&args, &plan, &opts);
+    }
     let result =
         compare::compare(&plan, &opts).with_context(|| format!("comparing on {}", plan.source))?;
     if let Some((path, file)) = csv {
@@ -75,7 +84,11 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     if args.json {
         super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&result)?))?;
     } else {
-        super::write_stdout(&table(&result))?;
+        let mut text = table(&result);
+        if args.findings {
+            text.push_str(&findings(&result));
+        }
+        super::write_stdout(&text)?;
     }
     let failed: Vec<String> = result
         .laws
@@ -91,6 +104,54 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     for f in &failed {
         eprintln!("testbed: warning: {f}");
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `--gain-scales`: the trade-off table (or JSON) and figure.
+fn tradeoff(args: &CompareArgs, plan: &scenario::Plan, opts: &CompareOptions) -> Result<ExitCode> {
+    if args.csv.is_some() {
+        bail!("--csv with --gain-scales: the trade-off has no per-run CSV; use --json");
+    }
+    let t = launch::compare_tradeoff::tradeoff(plan, opts, &args.gain_scales)
+        .with_context(|| format!("trade-off on {}", plan.source))?;
+    if let Some(dir) = &args.plots {
+        let n = launch::compare_plots::write_tradeoff(dir, &t, &plan.scenario.name)
+            .with_context(|| format!("writing figures to {}", dir.display()))?;
+        eprintln!("testbed: wrote {n} figures to {}", dir.display());
+    }
+    if args.json {
+        super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&t)?))?;
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "trade-off on {} ({}): K1 and K2 times each scale; medians over {} seed(s); * = on the law's Pareto front (IAE against effort, against energy)\n",
+        plan.scenario.name, plan.source, opts.seeds
+    );
+    let _ = writeln!(
+        out,
+        "{:<16} {:>7} {:>12} {:>14} {:>12} {:>7} {:>6}",
+        "law", "scale", "IAE>Tc", "effort>Tc", "energy>Tc", "failed", "front"
+    );
+    for p in &t.points {
+        let _ = writeln!(
+            out,
+            "{:<16} {:>7} {:>12} {:>14} {:>12} {:>7} {:>6}",
+            p.law.to_string(),
+            p.scale,
+            cell(p.iae.or(Some(f64::INFINITY)), 4),
+            cell(p.effort.or(Some(f64::INFINITY)), 1),
+            cell(p.energy.or(Some(f64::INFINITY)), 2),
+            p.failed,
+            format!(
+                "{}{}",
+                if p.on_front { "*" } else { "-" },
+                if p.on_energy_front { "*" } else { "-" }
+            )
+        );
+    }
+    super::write_stdout(&out)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -166,6 +227,10 @@ pub(crate) fn table(c: &Comparison) -> String {
         "\nkept: runs with |e| < k_c for every t >= T_c; enter: when every joint was inside for good; \
          breach: steps the barrier's guard or the funnel's clamp acted"
     );
+    if c.seeds > 1 {
+        out.push_str(&spread(c));
+        out.push_str(&paired(c));
+    }
     let failed: Vec<String> = c
         .laws
         .iter()
@@ -185,6 +250,109 @@ pub(crate) fn table(c: &Comparison) -> String {
         );
     }
     out
+}
+
+/// The findings, one claim per line with its evidence.
+fn findings(c: &Comparison) -> String {
+    let mut out = format!(
+        "\nfindings on {} (rules: docs/compare-and-sweeps.md#findings-the-papers-claims-checked):\n",
+        c.scenario
+    );
+    for f in &c.findings {
+        let _ = writeln!(out, "  [{}] {}\n      {}", f.verdict, f.claim, f.evidence);
+    }
+    out
+}
+
+/// The metrics of the spread table: (metric, heading, decimals).
+const SPREAD: [(&str, &str, usize); 3] = [
+    ("iae", "IAE", 4),
+    ("max_abs_error", "max|e|", 5),
+    ("effort_after_tc", "eff>Tc", 1),
+];
+
+/// Median, 95 % interval of the median and IQR of a few metrics per law.
+fn spread(c: &Comparison) -> String {
+    let mut out = String::new();
+    let ci = c.laws.first().and_then(|l| l.ci95);
+    let _ = writeln!(
+        out,
+        "\nover {} seeds: median [95 % interval of the median] (interquartile range q3 - q1){}",
+        c.seeds,
+        ci.map_or(String::new(), |ci| format!(
+            "; the interval is order statistics x({}) .. x({}), coverage {:.1} %",
+            ci.k,
+            ci.high_rank,
+            100.0 * ci.coverage
+        ))
+    );
+    let _ = write!(out, "{:<16}", "law");
+    for (_, h, _) in SPREAD {
+        let _ = write!(out, " {h:>34}");
+    }
+    let _ = writeln!(out);
+    for row in &c.laws {
+        let _ = write!(out, "{:<16}", row.law.law.to_string());
+        for (key, _, prec) in SPREAD {
+            let get = |s: &compare::Stats| s.get(key);
+            let iqr = match (get(&row.q1), get(&row.q3)) {
+                (Some(a), Some(b)) if a.is_finite() && b.is_finite() => Some(b - a),
+                _ => Some(f64::INFINITY),
+            };
+            let text = format!(
+                "{} [{}, {}] ({})",
+                cell(get(&row.median), prec),
+                cell(get(&row.ci95_low), prec),
+                cell(get(&row.ci95_high), prec),
+                cell(iqr, prec)
+            );
+            let _ = write!(out, " {text:>34}");
+        }
+        let _ = writeln!(out);
+    }
+    out
+}
+
+/// The paired tests, one line per law and metric.
+fn paired(c: &Comparison) -> String {
+    let mut out = String::new();
+    let Some(first) = c.paired.first() else {
+        return out;
+    };
+    let _ = writeln!(
+        out,
+        "\npaired on the same seeds, {} against each law: Wilcoxon signed-rank, two-sided \
+         (better/worse/ties: seeds where {} did better, worse, the same; diff: median of {} - law)",
+        first.law, first.law, first.law
+    );
+    let _ = writeln!(
+        out,
+        "{:<16} {:<16} {:>6} {:>6} {:>5} {:>12} {:>10}",
+        "law", "metric", "better", "worse", "ties", "diff", "p"
+    );
+    for p in &c.paired {
+        let t = &p.test;
+        let _ = writeln!(
+            out,
+            "{:<16} {:<16} {:>6} {:>6} {:>5} {:>12} {:>10.2e}",
+            p.versus.to_string(),
+            p.metric,
+            t.a_smaller,
+            t.b_smaller,
+            t.ties,
+            signed(t.median_difference),
+            t.p_value
+        );
+    }
+    out
+}
+
+fn signed(x: f64) -> String {
+    match x {
+        x if x == f64::INFINITY => "+worst".into(),
+        x if x == f64::NEG_INFINITY => "-worst".into(),
+        x => format!("{x:.3e}"),
+    }
 }
 
 /// One row per law and seed: `law,model_based,seed,failed,` then every metric.

@@ -177,7 +177,12 @@ fn heatmap<DB: DrawingBackend>(
         .collect();
     let lo = medians.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = medians.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let areas = root.split_evenly((1, laws.len().max(1)));
+    let width = root.dim_in_pixel().0 as i32;
+    let (main, bar) = root.split_horizontally(width - 130);
+    if lo.is_finite() && hi.is_finite() {
+        colour_bar(&bar, lo, hi)?;
+    }
+    let areas = main.split_evenly((1, laws.len().max(1)));
     for (area, law) in areas.iter().zip(laws) {
         let mut chart = ChartBuilder::on(area)
             .caption(
@@ -216,8 +221,7 @@ fn heatmap<DB: DrawingBackend>(
                 .find(|m| m.metric == "iae")
                 .map_or(f64::NAN, |m| m.median);
             let color = if m.is_finite() {
-                let f = if hi > lo { (m - lo) / (hi - lo) } else { 0.5 };
-                HSLColor(0.66 * (1.0 - f), 0.8, 0.5).to_rgba()
+                heat(if hi > lo { (m - lo) / (hi - lo) } else { 0.5 })
             } else {
                 BLACK.to_rgba()
             };
@@ -238,4 +242,45 @@ fn heatmap<DB: DrawingBackend>(
         }
     }
     root.present().map_err(err)
+}
+
+/// The heat map's colour for f in [0, 1] (blue: least, red: most).
+fn heat(f: f64) -> RGBAColor {
+    HSLColor(0.66 * (1.0 - f), 0.8, 0.5).to_rgba()
+}
+
+/// The heat map's colour scale: median IAE from `lo` to `hi`; black is a
+/// cell without a value (every run failed).
+fn colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    lo: f64,
+    hi: f64,
+) -> Result<(), String> {
+    let top = if hi > lo { hi } else { lo + 1e-12 };
+    let mut chart = ChartBuilder::on(area)
+        .caption("IAE", (FAMILY, 13))
+        .margin(12)
+        .margin_top(40)
+        .right_y_label_area_size(70)
+        .build_cartesian_2d(0.0..1.0, lo..top)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(6)
+        .y_label_formatter(&|v| format!("{v:.3}"))
+        .label_style((FAMILY, 11))
+        .draw()
+        .map_err(err)?;
+    let steps = 64;
+    let h = (top - lo) / steps as f64;
+    chart
+        .draw_series((0..steps).map(|k| {
+            let y = lo + k as f64 * h;
+            let f = (k as f64 + 0.5) / steps as f64;
+            Rectangle::new([(0.0, y), (1.0, y + h)], heat(f).filled())
+        }))
+        .map_err(err)?;
+    Ok(())
 }

@@ -182,20 +182,7 @@ fn cell_report(
     }
 }
 
-/// The p-quantile of sorted values by linear interpolation (NaN if empty).
-pub fn quantile(v: &[f64], p: f64) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    let h = (v.len() - 1) as f64 * p;
-    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
-    let (a, b) = (v[lo], v[hi]);
-    if a == b {
-        a
-    } else {
-        a + (h - lo as f64) * (b - a)
-    }
-}
+pub use analysis::stats::quantile;
 
 /// The report as CSV: one row per cell; axis columns, `law`, `runs`,
 /// `found`, `success_rate`, then `<metric>_median,_q1,_q3,_worst`.

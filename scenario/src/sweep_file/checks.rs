@@ -114,7 +114,7 @@ pub(super) fn check_key(
         file: file.to_string(),
         reason: format!("{what} {key}: {reason}"),
     };
-    let mut tree = match toml::Value::try_from(&base.scenario) {
+    let mut tree = match toml::Value::try_from(&base.undrawn) {
         Ok(toml::Value::Table(t)) => t,
         _ => return Err(bad("cannot write the base scenario".into())),
     };

@@ -418,9 +418,9 @@ fn resolve(
     dir: &Path,
     file: &str,
 ) -> Result<Plan, SweepFileError> {
-    let mut scenario = base.scenario.clone();
+    let mut scenario = base.undrawn.clone();
     scenario.controller = scenario.controller.for_law(law);
-    scenario.seed = base.scenario.seed.wrapping_add(s);
+    scenario.seed = base.undrawn.seed.wrapping_add(s);
     let cannot = |e: String| SweepFileError::File {
         file: file.to_string(),
         reason: format!("cannot write the base scenario: {e}"),
