@@ -8,14 +8,16 @@ use crate::util::testbed;
 /// a full device is a named error; neither panics.
 #[test]
 fn a_closed_pipe_and_a_full_device_are_not_panics() {
-    let mut child = testbed()
+    // The reader is gone before the command starts: its write always
+    // meets a closed pipe (closing it after the spawn raced the write).
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let child = testbed()
         .args(["sim", "--json", "--duration", "0.5"])
-        .stdout(Stdio::piped())
+        .stdout(writer)
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // The reader goes away before the summary is written.
-    drop(child.stdout.take());
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(141), "{err}");
