@@ -17,6 +17,9 @@ fn paper_compare(c: &mut Criterion) {
     group.sample_size(10);
     for threads in [cores, 1] {
         let opts = CompareOptions {
+            external: Vec::new(),
+            runs_dir: std::path::PathBuf::from("runs"),
+            progress: false,
             laws: DEFAULT_LAWS.to_vec(),
             seeds: 1,
             threads: Some(threads),
@@ -40,6 +43,9 @@ fn randomised_compare(c: &mut Criterion) {
     };
     let plan = scenario::load(Some(&path), &overrides).unwrap();
     let opts = CompareOptions {
+        external: Vec::new(),
+        runs_dir: std::path::PathBuf::from("runs"),
+        progress: false,
         laws: DEFAULT_LAWS.to_vec(),
         seeds: 20,
         threads: None,

@@ -70,6 +70,32 @@ pub struct CompareOptions {
     pub series: bool,
     /// The tuning rule of the laws that take one (None: the scenario's).
     pub tuning: Option<Tuning>,
+    /// Users' controllers, scored beside the built-in laws: each seed runs
+    /// through the lockstep stack with the command as the controller node.
+    pub external: Vec<ExternalSpec>,
+    /// Where the external controllers' run folders go.
+    pub runs_dir: std::path::PathBuf,
+    /// Show a progress bar on standard error (a terminal).
+    pub progress: bool,
+}
+
+/// A user's controller in the table: its row's label and its command.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExternalSpec {
+    /// The row's name.
+    pub label: String,
+    /// The program and its arguments.
+    pub command: Vec<String>,
+}
+
+/// What a row of a user's controller says about it.
+#[derive(Debug, Clone, Serialize)]
+pub struct ExternalRow {
+    /// The command.
+    pub command: String,
+    /// The law it declared (`CMD --describe`) with its parameters, if it
+    /// declared one.
+    pub declared: Option<analysis::report::ExternalLaw>,
 }
 
 /// The first seed's curves of one law, for the overlay figures.
@@ -105,8 +131,14 @@ pub struct LawRun {
 /// One law over every seed.
 #[derive(Debug, Clone, Serialize)]
 pub struct LawRow {
-    /// The law, whether it is model-based, and its parameters.
+    /// The row's name: the law's, or the label of a user's controller.
+    pub name: String,
+    /// The law, whether it is model-based, and its parameters (for a
+    /// user's controller: the scenario's law, whose gains it was given).
     pub law: LawInfo,
+    /// A user's controller: its command and what it declared.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub external: Option<ExternalRow>,
     /// Each seed's run.
     pub runs: Vec<LawRun>,
     /// Per metric, the median over seeds.
@@ -157,10 +189,10 @@ pub struct Comparison {
 /// A paired test of the first law against another on one metric.
 #[derive(Debug, Clone, Serialize)]
 pub struct Paired {
-    /// The first law of the comparison (`nac` by default).
-    pub law: LawName,
-    /// The law it is tested against.
-    pub versus: LawName,
+    /// The first row of the comparison (`nac` by default).
+    pub law: String,
+    /// The row it is tested against.
+    pub versus: String,
     /// The metric.
     pub metric: &'static str,
     /// Wilcoxon signed-rank of law − versus, seed by seed: `a_smaller` is
@@ -317,7 +349,7 @@ pub fn plan_for(
 
 /// Runs every law on every seed and scores them.
 pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, CompareError> {
-    if opts.laws.is_empty() || opts.seeds == 0 {
+    if (opts.laws.is_empty() && opts.external.is_empty()) || opts.seeds == 0 {
         return Err(CompareError::Empty(
             "compare needs at least one law and one seed",
         ));
@@ -339,12 +371,19 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
             cause: e.to_string(),
         })?;
     let start = std::time::Instant::now();
+    let total = jobs.len() + opts.external.len() * opts.seeds as usize;
+    let bar = crate::sweep::progress_bar(opts.progress, total);
     let runs: Vec<LawRun> = pool.install(|| {
         jobs.par_iter()
-            .map(|(_, s, p)| run_one(p, opts.series && *s == 0))
+            .map(|(_, s, p)| {
+                let r = run_one(p, opts.series && *s == 0);
+                if let Some(b) = &bar {
+                    b.inc(1);
+                }
+                r
+            })
             .collect()
     });
-    let wall_time_s = start.elapsed().as_secs_f64();
     let mut runs = runs.into_iter();
     let laws = opts
         .laws
@@ -361,6 +400,14 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
             )
         })
         .collect::<Vec<_>>();
+    let mut laws = laws;
+    for spec in &opts.external {
+        laws.push(external_row(plan, spec, opts, bar.as_ref())?);
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let wall_time_s = start.elapsed().as_secs_f64();
     let paired = paired(&laws);
     let mut c = Comparison {
         scenario: plan.scenario.name.clone(),
@@ -477,6 +524,80 @@ pub fn failed_because(failure: Option<&str>, s: &Summary) -> Option<String> {
     (!why.is_empty()).then(|| why.join("; "))
 }
 
+/// A user's controller over every seed: each seed's plan (the scenario's
+/// law and gains, that seed's draws) run in lockstep with the command as
+/// the controller node, one run at a time.
+fn external_row(
+    plan: &Plan,
+    spec: &ExternalSpec,
+    opts: &CompareOptions,
+    bar: Option<&indicatif::ProgressBar>,
+) -> Result<LawRow, CompareError> {
+    let law = plan.undrawn.controller.law;
+    let mut runs = Vec::new();
+    let mut declared = None;
+    for s in 0..opts.seeds {
+        let p = plan_for(plan, law, s, opts.tuning)?;
+        let seed = p.scenario.seed;
+        let run = crate::run::run(crate::run::RunOptions {
+            plan: p,
+            mode: wire::Mode::Lockstep,
+            csv: None,
+            external: Vec::new(),
+            runs_dir: opts.runs_dir.clone(),
+            name: None,
+            progress: false,
+            realtime_setup: false,
+            verbose: false,
+            controller_cmd: Some(spec.command.clone()),
+            live: None,
+            log_compression: logger::LogCompression::default(),
+        });
+        if let Some(b) = bar {
+            b.inc(1);
+        }
+        runs.push(match run {
+            Ok(o) => {
+                let meta = |k: &str| o.analysis.contents.run.get(k).cloned().unwrap_or_default();
+                let name = meta("controller_name");
+                declared = (!name.is_empty()).then(|| analysis::report::ExternalLaw {
+                    name,
+                    parameters: meta("controller_params"),
+                });
+                let summary = o.analysis.summary;
+                LawRun {
+                    seed,
+                    failed: failed_because(None, &summary),
+                    failure: None,
+                    summary,
+                    compute_us: o.analysis.timing.controller_compute_us,
+                    series: None,
+                }
+            }
+            Err(e) => {
+                let why = format!("the run failed: {e}");
+                let names = plan.robot.model.joint_names();
+                let empty = SummaryBuilder::new(names, plan.dt(), plan.scenario.controller.tc);
+                LawRun {
+                    seed,
+                    failed: Some(why.clone()),
+                    failure: Some(why),
+                    summary: empty.finish(),
+                    compute_us: Percentiles::of(Vec::new()),
+                    series: None,
+                }
+            }
+        });
+    }
+    let mut r = row(LawInfo::of(&plan.undrawn.controller), runs);
+    r.name = spec.label.clone();
+    r.external = Some(ExternalRow {
+        command: shell_words::join(&spec.command),
+        declared,
+    });
+    Ok(r)
+}
+
 fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
     let mut rows: [Vec<(&'static str, f64)>; 6] = Default::default();
     let mut ci95 = None;
@@ -510,7 +631,9 @@ fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
         .count() as u64;
     let [median, q1, q3, ci95_low, ci95_high, worst] = rows.map(Stats);
     LawRow {
+        name: law.law.to_string(),
         law,
+        external: None,
         runs,
         median,
         q1,
@@ -543,8 +666,8 @@ fn paired(laws: &[LawRow]) -> Vec<Paired> {
         .iter()
         .flat_map(|other| {
             PAIRED_METRICS.iter().map(move |&metric| Paired {
-                law: first.law.law,
-                versus: other.law.law,
+                law: first.name.clone(),
+                versus: other.name.clone(),
                 metric,
                 test: signed_rank(&values(first, metric), &values(other, metric)),
             })
@@ -583,6 +706,9 @@ mod tests {
     fn no_law_is_an_error() {
         let plan = scenario::load(None, &scenario::Overrides::default()).unwrap();
         let opts = CompareOptions {
+            external: Vec::new(),
+            runs_dir: std::path::PathBuf::from("runs"),
+            progress: false,
             laws: vec![],
             seeds: 1,
             threads: Some(1),

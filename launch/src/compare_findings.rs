@@ -86,7 +86,9 @@ const CLAIMS: [&str; 4] = [
 ];
 
 fn row(c: &Comparison, law: LawName) -> Option<&LawRow> {
-    c.laws.iter().find(|r| r.law.law == law)
+    c.laws
+        .iter()
+        .find(|r| r.law.law == law && r.external.is_none())
 }
 
 fn inside(nac: &LawRow) -> Finding {
@@ -204,9 +206,9 @@ fn better(c: &Comparison, nac: &LawRow, other: LawName, metric: &str, claim: &st
 }
 
 fn paired<'a>(c: &'a Comparison, other: LawName, metric: &str) -> Option<&'a Paired> {
-    c.paired
-        .iter()
-        .find(|p| p.law == LawName::Nac && p.versus == other && p.metric == metric)
+    c.paired.iter().find(|p| {
+        p.law == LawName::Nac.to_string() && p.versus == other.to_string() && p.metric == metric
+    })
 }
 
 fn num(x: Option<f64>) -> String {
@@ -232,6 +234,9 @@ mod tests {
         )
         .unwrap();
         let opts = CompareOptions {
+            external: Vec::new(),
+            runs_dir: std::path::PathBuf::from("runs"),
+            progress: false,
             laws,
             seeds: 1,
             threads: Some(1),

@@ -45,8 +45,8 @@ fn errors(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), String> {
                 .enumerate()
                 .map(|(k, (row, s))| Line {
                     label: match row.runs.first().and_then(|r| r.failed.as_ref()) {
-                        Some(_) => format!("{} (FAILED)", row.law.law),
-                        None => row.law.law.to_string(),
+                        Some(_) => format!("{} (FAILED)", row.name),
+                        None => row.name.clone(),
                     },
                     y: &s.e[i],
                     color: COLORS[k % COLORS.len()],
@@ -167,7 +167,7 @@ fn bar_panel<DB: DrawingBackend>(
         .y_label_area_size(70)
         .build_cartesian_2d(-0.5..(n as f64 - 0.5), 0.0..top * 1.15)
         .map_err(err)?;
-    let names: Vec<String> = c.laws.iter().map(|r| r.law.law.to_string()).collect();
+    let names: Vec<String> = c.laws.iter().map(|r| r.name.clone()).collect();
     chart
         .configure_mesh()
         .disable_x_mesh()

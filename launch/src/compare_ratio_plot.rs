@@ -100,9 +100,9 @@ fn draw<DB: DrawingBackend>(
     for (k, (area, (row, (t, r)))) in areas.iter().zip(&curves).enumerate() {
         let failed = row.runs.first().and_then(|x| x.failed.as_ref()).is_some();
         let caption = if failed {
-            format!("{} — FAILED", row.law.law)
+            format!("{} — FAILED", row.name)
         } else {
-            row.law.law.to_string()
+            row.name.clone()
         };
         let style = (FAMILY, 15)
             .into_font()

@@ -190,6 +190,9 @@ mod tests {
         assert_eq!(s.undrawn.controller.k1, Gain::All(30.0));
         assert_eq!(s.scenario.controller.k2, Gain::All(30.0));
         let opts = CompareOptions {
+            external: Vec::new(),
+            runs_dir: std::path::PathBuf::from("runs"),
+            progress: false,
             laws: vec![controller::LawName::Pd],
             seeds: 1,
             threads: Some(1),

@@ -361,3 +361,54 @@ fn a_python_pid_declares_its_law_and_takes_its_own_parameter() {
     );
     assert!(err.contains("is for an external controller"), "{err}");
 }
+
+/// #26 item 4: Python laws as rows of `compare`, scored like the built-in
+/// ones. The PD example computes the `pd` law (same bits, so the same
+/// scores); the PID example declares its law, and its logs name it.
+#[test]
+fn python_laws_are_rows_of_compare() {
+    let dir = tempfile::tempdir().unwrap();
+    let runs = dir.path().join("runs");
+    let out = ok(testbed()
+        .args([
+            "compare",
+            "--json",
+            "--laws",
+            "pd",
+            "--duration",
+            "3",
+            "--seeds",
+            "2",
+        ])
+        .arg("--controller-cmd")
+        .arg(format!("pypd={}", example("pd.py")))
+        .arg("--controller-cmd")
+        .arg(format!("pid={}", example("pid.py")))
+        .arg("--runs-dir")
+        .arg(&runs));
+    let c = json(&out);
+    let rows = c["laws"].as_array().unwrap();
+    let names: Vec<&str> = rows.iter().map(|r| r["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["pd", "pypd", "pid"]);
+    assert_eq!(rows[1]["median"]["iae"], rows[0]["median"]["iae"], "{c}");
+    assert_eq!(rows[1]["runs"].as_array().unwrap().len(), 2);
+    assert_eq!(rows[2]["external"]["declared"]["name"], "pid", "{c}");
+    assert_ne!(rows[2]["median"]["iae"], rows[0]["median"]["iae"]);
+    // The paired test is against the first row, pd, on the same seeds.
+    assert!(
+        c["paired"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|p| p["versus"] == "pid"),
+        "{c}"
+    );
+    // Each seed of each user law left a run folder whose log names the law.
+    let mut named = 0;
+    for e in std::fs::read_dir(&runs).unwrap() {
+        let log = e.unwrap().path().join("run.mcap");
+        let r = json(&ok(testbed().arg("replay").arg("--json").arg(&log)));
+        named += usize::from(r["controller_law"]["name"] == "pid");
+    }
+    assert_eq!(named, 2);
+}

@@ -111,6 +111,24 @@ fn parse_live_addr(s: &str) -> Result<std::net::SocketAddr, String> {
         .ok_or_else(|| format!("{s:?} names no address"))
 }
 
+/// `NAME=CMD` of `compare --controller-cmd`.
+fn parse_external_law(s: &str) -> Result<(String, String), String> {
+    let (name, cmd) = s
+        .split_once('=')
+        .ok_or_else(|| format!("{s:?} is not NAME=CMD (e.g. pid=\"python3 my.py\")"))?;
+    let ok = !name.is_empty()
+        && name.len() <= 40
+        && name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_');
+    if !ok {
+        return Err(format!(
+            "{name:?} is not a row name (1 to 40 of a-z, 0-9, '-', '_')"
+        ));
+    }
+    Ok((name.to_string(), cmd.to_string()))
+}
+
 /// A run folder's name: one path component of printable characters.
 fn parse_run_name(s: &str) -> Result<String, String> {
     let ok = !s.is_empty()
@@ -246,6 +264,15 @@ pub(crate) struct CompareArgs {
     /// The laws, comma-separated [default: every law but pd-gravity].
     #[arg(long, value_name = "LAW,…", value_delimiter = ',', value_parser = law_parser())]
     pub(crate) laws: Vec<controller::LawName>,
+    /// Your own controller as a row of the table (repeatable):
+    /// `--controller-cmd pid="python3 python/examples/pid.py"`. Each seed
+    /// runs it through the lockstep stack, given the scenario's law's
+    /// gains; its run folders go under --runs-dir.
+    #[arg(long, value_name = "NAME=CMD", value_parser = parse_external_law)]
+    pub(crate) controller_cmd: Vec<(String, String)>,
+    /// Folder for the run folders of --controller-cmd rows.
+    #[arg(long, value_name = "DIR", default_value = "runs")]
+    pub(crate) runs_dir: PathBuf,
     /// Seeds per law: the scenario's seed, seed + 1, … (table: median and worst).
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub(crate) seeds: u64,

@@ -4,6 +4,8 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::process::ExitCode;
 
+use std::io::IsTerminal;
+
 use anyhow::{Context, Result, bail};
 use launch::compare::{self, CompareOptions, Comparison, METRICS};
 
@@ -47,13 +49,33 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
         set: args.set.clone(),
     };
     let plan = super::load(&common, None)?;
-    super::no_external(&plan, "compare")?;
+    if args.controller_cmd.is_empty() {
+        super::no_external(&plan, "compare")?;
+    }
+    let mut external = Vec::new();
+    for (label, cmd) in &args.controller_cmd {
+        if args.laws.iter().any(|l| l.to_string() == *label) {
+            anyhow::bail!(
+                "--controller-cmd {label}=…: {label} is a built-in law's name; name your row otherwise"
+            );
+        }
+        let command = super::args::command_words(cmd)?;
+        launch::run::spawn::check_program(&command)
+            .with_context(|| format!("--controller-cmd {label}={cmd}"))?;
+        external.push(compare::ExternalSpec {
+            label: label.clone(),
+            command,
+        });
+    }
     let laws = if args.laws.is_empty() {
         compare::DEFAULT_LAWS.to_vec()
     } else {
         args.laws.clone()
     };
     let opts = CompareOptions {
+        external,
+        runs_dir: args.runs_dir.clone(),
+        progress: std::io::stderr().is_terminal(),
         laws,
         seeds: args.seeds,
         threads: super::worker_threads(args.threads),
@@ -97,7 +119,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
             l.runs.iter().filter_map(|r| {
                 r.failure
                     .as_ref()
-                    .map(|f| format!("{} seed {}: {f}", l.law.law, r.seed))
+                    .map(|f| format!("{} seed {}: {f}", l.name, r.seed))
             })
         })
         .collect();
@@ -209,11 +231,15 @@ pub(crate) fn table(c: &Comparison) -> String {
         };
         for (which, s) in stats {
             let name = if which.is_empty() || which == "median" {
-                row.law.law.to_string()
+                row.name.clone()
             } else {
                 format!("  ({which})")
             };
-            let model = if row.law.model_based { "URDF" } else { "free" };
+            let model = match (&row.external, row.law.model_based) {
+                (Some(_), _) => "ext",
+                (None, true) => "URDF",
+                (None, false) => "free",
+            };
             let kept = format!("{}/{}", row.kept_envelope, row.runs.len());
             let _ = write!(out, "{name:<16} {model:<5} {kept:>6}");
             for (key, _, prec) in COLUMNS {
@@ -227,6 +253,19 @@ pub(crate) fn table(c: &Comparison) -> String {
         "\nkept: runs with |e| < k_c for every t >= T_c; enter: when every joint was inside for good; \
          breach: steps the barrier's guard or the funnel's clamp acted"
     );
+    for row in &c.laws {
+        if let Some(e) = &row.external {
+            let declared = e.declared.as_ref().map_or_else(
+                || "declares no law".to_string(),
+                |d| format!("law {} ({})", d.name, d.parameters),
+            );
+            let _ = writeln!(
+                out,
+                "{}: `{}` in lockstep, {declared}, given the gains of {}",
+                row.name, e.command, row.law.law
+            );
+        }
+    }
     if c.seeds > 1 {
         out.push_str(&spread(c));
         out.push_str(&paired(c));
@@ -238,7 +277,7 @@ pub(crate) fn table(c: &Comparison) -> String {
             l.runs.iter().filter_map(move |r| {
                 r.failed
                     .as_ref()
-                    .map(|why| format!("  {} seed {}: {why}", l.law.law, r.seed))
+                    .map(|why| format!("  {} seed {}: {why}", l.name, r.seed))
             })
         })
         .collect();
@@ -292,7 +331,7 @@ fn spread(c: &Comparison) -> String {
     }
     let _ = writeln!(out);
     for row in &c.laws {
-        let _ = write!(out, "{:<16}", row.law.law.to_string());
+        let _ = write!(out, "{:<16}", row.name.clone());
         for (key, _, prec) in SPREAD {
             let get = |s: &compare::Stats| s.get(key);
             let iqr = match (get(&row.q1), get(&row.q3)) {
@@ -381,7 +420,7 @@ fn write_csv(w: &mut impl std::io::Write, c: &Comparison) -> std::io::Result<()>
             writeln!(
                 w,
                 "{},{},{},{},{},{}",
-                row.law.law,
+                row.name,
                 row.law.model_based,
                 run.seed,
                 run.failed.is_some(),

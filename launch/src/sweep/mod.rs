@@ -208,7 +208,8 @@ fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool, SweepError> {
         .map_err(|e| SweepError::Options(format!("cannot start {n} worker threads: {e}")))
 }
 
-fn progress_bar(show: bool, len: usize) -> Option<indicatif::ProgressBar> {
+/// A bar of `len` runs on standard error, if `show` (a terminal).
+pub(crate) fn progress_bar(show: bool, len: usize) -> Option<indicatif::ProgressBar> {
     if !show || len == 0 {
         return None;
     }
