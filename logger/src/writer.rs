@@ -1,6 +1,6 @@
 //! Writing a run log.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use mcap::records::MessageHeader;
 use mcap::{Attachment, WriteOptions, Writer};
 
-use super::channels::ChannelSpec;
+use super::channels::{ChannelSpec, MESSAGE_ENCODING, PROFILE, SCHEMA_ENCODING};
 use super::compression::LogCompression;
 use super::json::LogMessage;
 use super::{LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
@@ -70,7 +70,9 @@ pub struct RunMetadata {
 /// `testbed.run` metadata (a log without it is format 1). Format 2 adds the
 /// data path's stamps: `JointState.command_seq` and `applied_wall_ns`,
 /// `Command.started_wall_ns`, `reference_t_ns` and `stale_references`.
-pub const LOG_FORMAT: u32 = 2;
+/// Format 3 is the ROS 2 one: the `ros2` profile, CDR messages and
+/// `ros2msg` schemas ([`crate::ros2`]) instead of JSON with JSON schemas.
+pub const LOG_FORMAT: u32 = 3;
 
 impl RunMetadata {
     /// The `testbed.run` record: every field as text (lists joined by
@@ -104,9 +106,12 @@ impl RunMetadata {
 pub struct LogWriter {
     writer: Writer<BufWriter<File>>,
     path: PathBuf,
-    channels: HashMap<&'static str, (u16, u32)>,
+    /// Topic, channel id and last sequence number of each open channel: a
+    /// handful, searched by the topic's address first (every caller passes
+    /// the same constants), which costs less than hashing it per message.
+    channels: Vec<(&'static str, u16, u32)>,
     last_flush: Instant,
-    /// One message's JSON, reused from message to message.
+    /// One message's CDR, reused from message to message.
     scratch: Vec<u8>,
 }
 
@@ -138,7 +143,7 @@ impl LogWriter {
             // CPU by default) compete with the plant and the controller.
             .compression_threads(0)
             .chunk_size(Some(CHUNK_BYTES))
-            .profile("")
+            .profile(PROFILE)
             .library(format!("testbed {}", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::new(file))
             .map_err(mcap_err)?;
@@ -164,7 +169,7 @@ impl LogWriter {
         Ok(Self {
             writer,
             path: path.to_path_buf(),
-            channels: HashMap::new(),
+            channels: Vec::new(),
             last_flush: Instant::now(),
             scratch: Vec::with_capacity(4096),
         })
@@ -181,60 +186,62 @@ impl LogWriter {
 
     /// Registers the channel of `M` (done on first write otherwise).
     pub fn add_channel<M: LogMessage>(&mut self) -> Result<u16, LogError> {
-        match self.channels.get(M::LOG_TOPIC) {
-            Some((id, _)) => Ok(*id),
+        match self.find(M::LOG_TOPIC) {
+            Some(i) => Ok(self.channels[i].1),
             None => self.add_channel_spec(&ChannelSpec::of::<M>()),
         }
     }
 
     /// Registers a channel (once: a topic registered before keeps its id).
     pub fn add_channel_spec(&mut self, spec: &ChannelSpec) -> Result<u16, LogError> {
-        if let Some((id, _)) = self.channels.get(spec.topic) {
-            return Ok(*id);
+        if let Some(i) = self.find(spec.topic) {
+            return Ok(self.channels[i].1);
         }
-        let schema = serde_json::to_vec(&spec.schema).map_err(|cause| LogError::Encode {
-            path: self.path.display().to_string(),
-            topic: spec.topic,
-            cause,
-        })?;
         let schema_id = self
             .writer
-            .add_schema(spec.schema_name, "jsonschema", &schema)
+            .add_schema(&spec.schema_name, SCHEMA_ENCODING, spec.schema.as_bytes())
             .map_err(self.err())?;
         let id = self
             .writer
-            .add_channel(schema_id, spec.topic, "json", &BTreeMap::new())
+            .add_channel(schema_id, spec.topic, MESSAGE_ENCODING, &BTreeMap::new())
             .map_err(self.err())?;
-        self.channels.insert(spec.topic, (id, 0));
+        self.channels.push((spec.topic, id, 0));
         Ok(id)
     }
 
-    /// Appends one message; gives back its JSON (for the live view).
+    fn find(&self, topic: &str) -> Option<usize> {
+        let same = |t: &&str| std::ptr::eq(*t, topic);
+        (self.channels.iter().position(|c| same(&c.0)))
+            .or_else(|| self.channels.iter().position(|c| c.0 == topic))
+    }
+
+    /// Appends one message; gives back its CDR (for the live view).
     pub fn write<M: LogMessage>(&mut self, msg: &M) -> Result<&[u8], LogError> {
         self.add_channel::<M>()?;
         let h = msg.header();
         let mut data = std::mem::take(&mut self.scratch);
         data.clear();
-        msg.encode(&mut data);
-        let res = self.write_json(M::LOG_TOPIC, h.t_ns, h.wall_ns, &data);
+        crate::ros2::encode(msg, &mut data);
+        let res = self.write_raw(M::LOG_TOPIC, h.t_ns, h.wall_ns, &data);
         self.scratch = data;
         res.map(|()| self.scratch.as_slice())
     }
 
-    /// Appends one message already in JSON to a registered channel.
-    pub fn write_json(
+    /// Appends one message already encoded (CDR) to a registered channel.
+    pub fn write_raw(
         &mut self,
         topic: &'static str,
         log_time: u64,
         publish_time: u64,
-        json: &[u8],
+        data: &[u8],
     ) -> Result<(), LogError> {
-        let Some((id, seq)) = self.channels.get_mut(topic) else {
+        let Some(i) = self.find(topic) else {
             return Err(LogError::UnknownChannel {
                 path: self.path.display().to_string(),
                 topic,
             });
         };
+        let (_, id, seq) = &mut self.channels[i];
         *seq = seq.wrapping_add(1);
         let header = MessageHeader {
             channel_id: *id,
@@ -242,7 +249,7 @@ impl LogWriter {
             log_time,
             publish_time,
         };
-        let res = self.writer.write_to_known_channel(&header, json);
+        let res = self.writer.write_to_known_channel(&header, data);
         res.map_err(self.err())
     }
 

@@ -9,6 +9,8 @@ use crate::{Header, Joints};
 /// are trimmed to the message's `dof`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FieldRef<'a> {
+    /// Unsigned 32-bit integer.
+    U32(u32),
     /// Unsigned integer.
     U(u64),
     /// Signed integer.
@@ -115,7 +117,7 @@ macro_rules! data_message {
 #[macro_export]
 macro_rules! field_visit {
     (U32, $s:ident, $f:ident, $out:ident) => {
-        $out(stringify!($f), $crate::FieldRef::U($s.$f.into()))
+        $out(stringify!($f), $crate::FieldRef::U32($s.$f))
     };
     (U64, $s:ident, $f:ident, $out:ident) => {
         $out(stringify!($f), $crate::FieldRef::U($s.$f))
@@ -203,6 +205,7 @@ mod tests {
         let mut out = Vec::new();
         m.visit(&mut |name, f| {
             let v = match f {
+                FieldRef::U32(x) => vec![x as f64],
                 FieldRef::U(x) => vec![x as f64],
                 FieldRef::I(x) => vec![x as f64],
                 FieldRef::F(x) => vec![x],
