@@ -32,6 +32,7 @@ impl<'a> CdrWriter<'a> {
         Self { out, start }
     }
 
+    #[inline]
     fn align(&mut self, n: usize) {
         let pad = (n - (self.out.len() - self.start) % n) % n;
         self.out.extend_from_slice(&[0u8; 8][..pad]);
@@ -43,36 +44,42 @@ impl<'a> CdrWriter<'a> {
     }
 
     /// A uint32.
+    #[inline]
     pub fn u32(&mut self, x: u32) {
         self.align(4);
         self.out.extend_from_slice(&x.to_le_bytes());
     }
 
     /// An int32.
+    #[inline]
     pub fn i32(&mut self, x: i32) {
         self.align(4);
         self.out.extend_from_slice(&x.to_le_bytes());
     }
 
     /// A uint64.
+    #[inline]
     pub fn u64(&mut self, x: u64) {
         self.align(8);
         self.out.extend_from_slice(&x.to_le_bytes());
     }
 
     /// An int64.
+    #[inline]
     pub fn i64(&mut self, x: i64) {
         self.align(8);
         self.out.extend_from_slice(&x.to_le_bytes());
     }
 
     /// A float64.
+    #[inline]
     pub fn f64(&mut self, x: f64) {
         self.align(8);
         self.out.extend_from_slice(&x.to_le_bytes());
     }
 
     /// A float32.
+    #[inline]
     pub fn f32(&mut self, x: f32) {
         self.align(4);
         self.out.extend_from_slice(&x.to_le_bytes());

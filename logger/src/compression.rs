@@ -43,12 +43,4 @@ impl LogCompression {
             )),
         }
     }
-
-    pub(crate) fn mcap(self) -> Option<mcap::Compression> {
-        match self {
-            Self::Zstd => Some(mcap::Compression::Zstd),
-            Self::Lz4 => Some(mcap::Compression::Lz4),
-            Self::None => None,
-        }
-    }
 }

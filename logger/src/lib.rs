@@ -32,6 +32,7 @@ mod json;
 mod json_object;
 mod layout;
 pub mod live;
+mod mcap_out;
 pub mod node;
 mod outputs;
 mod reader;

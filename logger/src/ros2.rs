@@ -128,7 +128,7 @@ pub fn encode<M: LogMessage>(m: &M, out: &mut Vec<u8>) {
     w.header(h.t_ns, "");
     w.u64(h.seq);
     w.u64(h.wall_ns);
-    m.visit(&mut |_, f| match f {
+    m.each_field(|_, f| match f {
         FieldRef::U32(x) => w.u32(x),
         FieldRef::U(x) => w.u64(x),
         FieldRef::I(x) => w.i64(x),

@@ -2,23 +2,20 @@
 
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-
-use mcap::records::MessageHeader;
-use mcap::{Attachment, WriteOptions, Writer};
 
 use super::channels::{ChannelSpec, MESSAGE_ENCODING, PROFILE, SCHEMA_ENCODING};
 use super::compression::LogCompression;
 use super::json::LogMessage;
+use super::mcap_out::McapOut;
 use super::{LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
 
 /// A chunk is closed at least this often, so a crash loses at most this
 /// much wall time of data (an unfinished MCAP file loses only its open chunk).
 const FLUSH_EVERY: Duration = Duration::from_millis(500);
-/// Chunks are also closed when they reach this size (compressed input).
-const CHUNK_BYTES: u64 = 1 << 20;
+/// Chunks are also closed when they reach this size (uncompressed).
+const CHUNK_BYTES: usize = 1 << 20;
 
 /// What the `testbed.run` metadata record says.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -104,7 +101,7 @@ impl RunMetadata {
 
 /// An open log.
 pub struct LogWriter {
-    writer: Writer<BufWriter<File>>,
+    writer: McapOut,
     path: PathBuf,
     /// Topic, channel id and last sequence number of each open channel: a
     /// handful, searched by the topic's address first (every caller passes
@@ -133,39 +130,35 @@ impl LogWriter {
             path: p.clone(),
             cause,
         })?;
-        let mcap_err = |cause| LogError::mcap(&p, cause);
-        let mut writer = WriteOptions::new()
-            .compression(compression.mcap())
-            // Level 1, not zstd's default 3: in lockstep the logger paces
-            // the run, and this is its largest cost (the files grow 4 %).
-            .compression_level(1)
-            // In this process: zstd's worker threads (one per physical
-            // CPU by default) compete with the plant and the controller.
-            .compression_threads(0)
-            .chunk_size(Some(CHUNK_BYTES))
-            .profile(PROFILE)
-            .library(format!("testbed {}", env!("CARGO_PKG_VERSION")))
-            .create(BufWriter::new(file))
-            .map_err(mcap_err)?;
+        let io = |cause| LogError::Io {
+            path: p.clone(),
+            cause,
+        };
+        // Level 1, not zstd's default 3: the logger's largest cost is
+        // compressing, and level 3 makes the files only a few % smaller.
+        let mut writer = McapOut::create(
+            file,
+            PROFILE,
+            &format!("testbed {}", env!("CARGO_PKG_VERSION")),
+            compression,
+            1,
+        )
+        .map_err(io)?;
+        let map = meta.to_map().map_err(|cause| LogError::Encode {
+            path: p.clone(),
+            topic: RUN_METADATA,
+            cause,
+        })?;
+        writer.metadata(RUN_METADATA, &map).map_err(io)?;
         writer
-            .write_metadata(&mcap::records::Metadata {
-                name: RUN_METADATA.into(),
-                metadata: meta.to_map().map_err(|cause| LogError::Encode {
-                    path: path.display().to_string(),
-                    topic: RUN_METADATA,
-                    cause,
-                })?,
-            })
-            .map_err(mcap_err)?;
-        writer
-            .attach(&Attachment {
-                log_time: 0,
-                create_time: meta.start_time_unix_ns,
-                name: URDF_ATTACHMENT.into(),
-                media_type: "application/xml".into(),
-                data: std::borrow::Cow::Borrowed(urdf.as_bytes()),
-            })
-            .map_err(mcap_err)?;
+            .attach(
+                0,
+                meta.start_time_unix_ns,
+                URDF_ATTACHMENT,
+                "application/xml",
+                urdf.as_bytes(),
+            )
+            .map_err(io)?;
         Ok(Self {
             writer,
             path: path.to_path_buf(),
@@ -180,8 +173,11 @@ impl LogWriter {
         &self.path
     }
 
-    fn err(&self) -> impl Fn(mcap::McapError) -> LogError + '_ {
-        |cause| LogError::mcap(&self.path.display().to_string(), cause)
+    fn err(&self) -> impl Fn(std::io::Error) -> LogError + '_ {
+        |cause| LogError::Io {
+            path: self.path.display().to_string(),
+            cause,
+        }
     }
 
     /// Registers the channel of `M` (done on first write otherwise).
@@ -203,7 +199,7 @@ impl LogWriter {
             .map_err(self.err())?;
         let id = self
             .writer
-            .add_channel(schema_id, spec.topic, MESSAGE_ENCODING, &BTreeMap::new())
+            .add_channel(schema_id, spec.topic, MESSAGE_ENCODING)
             .map_err(self.err())?;
         self.channels.push((spec.topic, id, 0));
         Ok(id)
@@ -243,14 +239,12 @@ impl LogWriter {
         };
         let (_, id, seq) = &mut self.channels[i];
         *seq = seq.wrapping_add(1);
-        let header = MessageHeader {
-            channel_id: *id,
-            sequence: *seq,
-            log_time,
-            publish_time,
-        };
-        let res = self.writer.write_to_known_channel(&header, data);
-        res.map_err(self.err())
+        self.writer.message(*id, *seq, log_time, publish_time, data);
+        if self.writer.chunk_len() >= CHUNK_BYTES {
+            let res = self.writer.close_chunk();
+            res.map_err(self.err())?;
+        }
+        Ok(())
     }
 
     /// Closes the open chunk if it is older than the flush period.
@@ -264,21 +258,21 @@ impl LogWriter {
     /// Closes the open chunk and pushes it to the file.
     pub fn flush(&mut self) -> Result<(), LogError> {
         self.last_flush = Instant::now();
-        let res = self.writer.flush();
+        let res = self.writer.close_chunk().and_then(|()| self.writer.flush());
         res.map_err(self.err())
     }
 
     /// Writes the `testbed.log_stats` record, the summary and the footer.
-    /// Checked: mcap's own `Drop` would throw a failure away.
     pub fn finish(mut self, stats: BTreeMap<String, String>) -> Result<(), LogError> {
-        let res = self.writer.write_metadata(&mcap::records::Metadata {
-            name: STATS_METADATA.into(),
-            metadata: stats,
-        });
+        let res = self
+            .writer
+            .close_chunk()
+            .and_then(|()| self.writer.metadata(STATS_METADATA, &stats));
         res.map_err(self.err())?;
-        let res = self.writer.finish();
-        res.map_err(self.err())?;
-        Ok(())
+        let path = self.path.display().to_string();
+        self.writer
+            .finish()
+            .map_err(|cause| LogError::Io { path, cause })
     }
 }
 

@@ -46,6 +46,9 @@ pub trait MessageFields: Sized + Copy + Default {
     fn header(&self) -> Header;
     /// Calls `f` with every field but the header and padding, in order.
     fn visit(&self, f: &mut dyn FnMut(&'static str, FieldRef<'_>));
+    /// [`MessageFields::visit`] with `f` known at compile time, so that a
+    /// hot encoder (the log's CDR) is inlined field by field.
+    fn each_field<F: FnMut(&'static str, FieldRef<'_>)>(&self, f: F);
     /// The message from `header` and each field of `source`.
     fn decode(header: Header, source: &dyn FieldSource) -> Result<Self, String>;
 }
@@ -98,6 +101,10 @@ macro_rules! data_message {
                 self.header
             }
             fn visit(&self, f: &mut dyn FnMut(&'static str, $crate::FieldRef<'_>)) {
+                $( $crate::field_visit!($kind, self, $field, f); )*
+            }
+            #[inline]
+            fn each_field<F: FnMut(&'static str, $crate::FieldRef<'_>)>(&self, mut f: F) {
                 $( $crate::field_visit!($kind, self, $field, f); )*
             }
             fn decode(
