@@ -58,6 +58,13 @@ enum Command {
     /// Measure speed and timing on this machine: in process, lockstep, real
     /// time, and the machine's own timer floor.
     Bench(BenchArgs),
+    /// The other side of `bench`'s iceoryx2 ping-pong (started by `bench`).
+    #[command(name = "bench-pong", hide = true)]
+    BenchPong {
+        /// The ping's run prefix.
+        #[arg(long)]
+        prefix: String,
+    },
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
     Replay(ReplayArgs),
     /// Run several laws (the paper's, its ablations, baselines) on the same
@@ -142,6 +149,10 @@ pub fn run() -> Result<ExitCode> {
         Command::Run(args) => run::run_stack(args, cli.verbose),
         Command::Replay(args) => replay::replay(args),
         Command::Bench(args) => bench::bench(args),
+        Command::BenchPong { prefix } => {
+            launch::bench_pingpong::pong(&prefix)?;
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Compare(args) => compare::compare(args),
         Command::Sweep(cmd) => sweep::sweep(cmd),
         Command::Bindings { lang, out } => {
