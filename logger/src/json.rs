@@ -1,4 +1,7 @@
-//! Messages as JSON for the log, and their JSON schemas.
+//! Messages as JSON, as logs of formats 1 and 2 hold them (format 3 is
+//! CDR, [`crate::ros2`]): the reader decodes them with [`LogMessage::parse`];
+//! the writer side (`to_json`, `encode`, `schema`) stays for tools and tests
+//! that want a message as JSON.
 //!
 //! Each message type lists its fields once, where the wire defines it
 //! ([`wire::data_message!`]); the JSON object, the schema and the way back
