@@ -53,7 +53,7 @@ pub use layout::foxglove_layout;
 pub use reader::{
     Encoding, LogContents, MessageError, OnMessage, read_log, read_log_bytes, read_log_head,
 };
-pub use writer::{LOG_FORMAT, LogWriter, RunMetadata};
+pub use writer::{LOG_FORMAT, LogWriter, RunMetadata, ZSTD_LEVEL};
 
 /// Checks a message nothing decodes further (the arm's frames and figure,
 /// the standard views): JSON text, or CDR with its header.
