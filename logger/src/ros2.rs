@@ -142,7 +142,7 @@ enum Val {
     U(u64),
     I(i64),
     F(f64),
-    J(Joints),
+    J(Box<Joints>),
 }
 
 /// A message's fields read from its CDR, in the order its field list
@@ -183,7 +183,7 @@ impl FieldSource for CdrFields {
     }
     fn j(&self, k: &str) -> Result<Joints, String> {
         match self.get(k)? {
-            Val::J(x) => Ok(*x),
+            Val::J(x) => Ok(**x),
             _ => Err(format!("field '{k}' is not an array")),
         }
     }
@@ -221,7 +221,7 @@ pub fn decode<M: LogMessage>(data: &[u8]) -> Result<M, DecodeError> {
                         xs.len()
                     )))
                 } else {
-                    Ok(Val::J(joints(&xs)))
+                    Ok(Val::J(Box::new(joints(&xs))))
                 }
             }),
         };
