@@ -435,7 +435,7 @@ pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchR
         "iceoryx2 ping-pong, {} round trips x {}",
         paper.steps, opts.repeats
     ));
-    let pingpong = crate::bench_pingpong::measure(paper.steps, opts.repeats)?;
+    let pingpong = crate::bench_pingpong::measure(paper.steps, opts.repeats, opts.realtime_setup)?;
     let rtt = pingpong.round_trip_us;
     let mut arms = vec![bench_arm(&paper, opts, rtt, &mut progress)?];
     arms.push(bench_arm(&large, opts, rtt, &mut progress)?);

@@ -8,7 +8,9 @@
 //! to it.
 //!
 //! The other process is the `testbed` binary itself (`testbed bench-pong`,
-//! hidden from the help), so nothing else needs building.
+//! hidden from the help), so nothing else needs building. Placed as
+//! lockstep places the plant and the controller (both on the loop's CPU),
+//! unless the bench runs with `--no-realtime-setup`.
 
 use std::process::{Child, Stdio};
 use std::time::{Duration, Instant};
@@ -18,6 +20,9 @@ use serde::Serialize;
 use wire::{Command, Delivery, JointState, STATE_FINAL, Topic};
 
 use crate::bench::BenchError;
+use crate::mode::Mode;
+use crate::node::placement::{self, Placement};
+use wire::NodeKind;
 
 /// The hidden subcommand the other process runs.
 pub const PONG_COMMAND: &str = "bench-pong";
@@ -60,8 +65,31 @@ fn answer(
     }
 }
 
-/// One ping-pong of `rounds` timed round trips: µs per round trip.
-fn once(rounds: u64) -> Result<f64, BenchError> {
+/// Where lockstep puts `kind` (nowhere in particular without `pinned`).
+fn lockstep_placement(kind: NodeKind, pinned: bool) -> Placement {
+    if pinned {
+        placement::for_node(kind, Mode::Lockstep, placement::cpu_count())
+    } else {
+        Placement::default()
+    }
+}
+
+/// One ping-pong of `rounds` timed round trips on a thread of its own
+/// (placed as lockstep's plant): µs per round trip.
+fn once(rounds: u64, pinned: bool) -> Result<f64, BenchError> {
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            // What the system refuses only makes the floor less like
+            // lockstep's; the figures are still a floor.
+            let _ = lockstep_placement(NodeKind::Plant, pinned).apply();
+            ping(rounds, pinned)
+        })
+        .join()
+        .unwrap_or_else(|_| Err(err("the ping thread panicked")))
+    })
+}
+
+fn ping(rounds: u64, pinned: bool) -> Result<f64, BenchError> {
     let prefix = RunPrefix::unique();
     let bus = Bus::new(&prefix, "bench-ping").map_err(err)?;
     let states = bus
@@ -71,6 +99,7 @@ fn once(rounds: u64) -> Result<f64, BenchError> {
     let exe = std::env::current_exe().map_err(err)?;
     let mut pong = std::process::Command::new(exe)
         .args([PONG_COMMAND, "--prefix", prefix.as_str()])
+        .args(lockstep_placement(NodeKind::Controller, pinned).to_args())
         .stdin(Stdio::null())
         .spawn()
         .map_err(err)?;
@@ -112,11 +141,12 @@ fn once(rounds: u64) -> Result<f64, BenchError> {
     Ok(us)
 }
 
-/// The median of `repeats` ping-pongs of `rounds` round trips each.
-pub fn measure(rounds: u64, repeats: usize) -> Result<PingPong, BenchError> {
+/// The median of `repeats` ping-pongs of `rounds` round trips each, both
+/// sides placed as lockstep's plant and controller if `pinned`.
+pub fn measure(rounds: u64, repeats: usize, pinned: bool) -> Result<PingPong, BenchError> {
     let mut us = Vec::new();
     for _ in 0..repeats.max(1) {
-        us.push(once(rounds)?);
+        us.push(once(rounds, pinned)?);
     }
     Ok(PingPong {
         rounds,
@@ -126,7 +156,8 @@ pub fn measure(rounds: u64, repeats: usize) -> Result<PingPong, BenchError> {
 
 /// The other process: answers every joint state with a command of the same
 /// header until the final one.
-pub fn pong(prefix: &str) -> anyhow::Result<()> {
+pub fn pong(prefix: &str, placement: &Placement) -> anyhow::Result<()> {
+    let _ = placement.apply();
     let prefix = RunPrefix::parse(prefix)?;
     let bus = Bus::new(&prefix, "bench-pong")?;
     let states = bus.subscriber::<JointState>(Topic::JointState)?;

@@ -64,6 +64,9 @@ enum Command {
         /// The ping's run prefix.
         #[arg(long)]
         prefix: String,
+        /// Where to run (as lockstep's controller).
+        #[command(flatten)]
+        placement: launch::node::placement::Placement,
     },
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
     Replay(ReplayArgs),
@@ -149,8 +152,8 @@ pub fn run() -> Result<ExitCode> {
         Command::Run(args) => run::run_stack(args, cli.verbose),
         Command::Replay(args) => replay::replay(args),
         Command::Bench(args) => bench::bench(args),
-        Command::BenchPong { prefix } => {
-            launch::bench_pingpong::pong(&prefix)?;
+        Command::BenchPong { prefix, placement } => {
+            launch::bench_pingpong::pong(&prefix, &placement)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Compare(args) => compare::compare(args),
