@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Creates (once) a Python virtual environment with the testbed_controller
-# package (editable) and what it needs: the iceoryx2 wheel and numpy; with
+# package (editable) and what it needs: the iceoryx2 wheel, numpy, and the
+# official MCAP readers (mcap, mcap-ros2-support) for its log reader; with
 # --peer also MuJoCo, for the Python + MuJoCo loop of `testbed bench --peer`.
 #   bash python/setup-venv.sh [--peer] [DIR]     (default: target/python-venv)
 # Prints the environment's python on success. Safe to run from several
@@ -15,7 +16,14 @@ python="${PYTHON:-python3}"
 mkdir -p "$(dirname "$venv")"
 exec 9>"$venv.lock"
 flock 9
-ready() { [ -x "$venv/bin/python3" ] && "$venv/bin/python3" -c "import testbed_controller, iceoryx2, numpy" 2>/dev/null; }
+# Ready: everything imports, and the package is this checkout's (a venv
+# copied from another worktree would import that one's).
+ready() {
+    [ -x "$venv/bin/python3" ] && "$venv/bin/python3" -c "
+import os, sys, testbed_controller, iceoryx2, numpy, mcap, mcap_ros2
+here = os.path.realpath(os.path.dirname(testbed_controller.__file__))
+sys.exit(here != os.path.realpath('$root/python/testbed_controller'))" 2>/dev/null
+}
 if ! ready; then
     rm -rf "$venv"
     "$python" -m venv "$venv" >&2

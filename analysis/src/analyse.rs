@@ -16,7 +16,7 @@ use crate::summary::{Summary, SummaryBuilder};
 use crate::timing::{RunFacts, TimingStats, TimingSummary, judge};
 use crate::verify::Verifier;
 use logger::{
-    DecodeError, LogContents, LogError, LogMessage, MessageError, read_log, read_log_head,
+    DecodeError, Encoding, LogContents, LogError, LogMessage, MessageError, read_log, read_log_head,
 };
 use wire::Mode;
 
@@ -217,10 +217,10 @@ struct Analyser<'a, 'o> {
 }
 
 impl Analyser<'_, '_> {
-    fn on_message(&mut self, topic: &str, v: &[u8]) -> Result<(), MessageError> {
+    fn on_message(&mut self, topic: &str, enc: Encoding, v: &[u8]) -> Result<(), MessageError> {
         match topic {
             t if t == JointState::LOG_TOPIC => {
-                let s = JointState::parse(v)?;
+                let s = JointState::decode_as(enc, v)?;
                 check_dof(s.dof, self.n)?;
                 self.wall = (
                     self.wall.0.min(s.header.wall_ns),
@@ -233,7 +233,7 @@ impl Analyser<'_, '_> {
                 self.assembler.push_state(s);
             }
             t if t == ControllerDiagnostics::LOG_TOPIC => {
-                let d = ControllerDiagnostics::parse(v)?;
+                let d = ControllerDiagnostics::decode_as(enc, v)?;
                 check_dof(d.dof, self.n)?;
                 if let Some(ver) = self.verifier.as_mut() {
                     ver.push_diag(d);
@@ -241,19 +241,20 @@ impl Analyser<'_, '_> {
                 self.assembler.push_diag(d);
             }
             t if t == Command::LOG_TOPIC => {
-                let c = Command::parse(v)?;
+                let c = Command::decode_as(enc, v)?;
                 self.data_path.add_command(&c);
                 if let Some(ver) = self.verifier.as_mut() {
                     ver.push_command(c);
                 }
             }
-            t if t == Timing::LOG_TOPIC => self.on_timing(&Timing::parse(v)?),
+            t if t == Timing::LOG_TOPIC => self.on_timing(&Timing::decode_as(enc, v)?),
             t if t == ReferenceSample::LOG_TOPIC => {
-                ReferenceSample::parse(v)?;
+                ReferenceSample::decode_as(enc, v)?;
             }
-            // The arm's frames and figure: not analysed, but a log whose
-            // message is not JSON is damaged there.
-            _ => logger::JsonObject::check(v)?,
+            // The arm's frames and figure, the standard views: not
+            // analysed, but a log whose message is not JSON (formats 1 and
+            // 2) or CDR (format 3) is damaged there.
+            _ => logger::check_message(enc, v)?,
         }
         let (summary, series, csv) = (&mut self.summary, &mut self.series, &mut self.csv);
         self.assembler.emit(|r| {
@@ -324,7 +325,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         csv,
         wall: (u64::MAX, 0),
     };
-    let contents = match read_log(path, Some(&mut |t, v| a.on_message(t, v))) {
+    let contents = match read_log(path, Some(&mut |t, e, v| a.on_message(t, e, v))) {
         Err(LogError::Sink { cause, .. }) => return Err(out_err(cause)),
         other => other?,
     };

@@ -7,14 +7,14 @@ use logger::LogMessage;
 use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
 
 fuzz_target!(|data: &[u8]| {
-    let mut decode = |topic: &str, v: &[u8]| {
+    let mut decode = |topic: &str, e: logger::Encoding, v: &[u8]| {
         let _ = match topic {
-            t if t == JointState::LOG_TOPIC => JointState::parse(v).map(|_| ()),
-            t if t == ReferenceSample::LOG_TOPIC => ReferenceSample::parse(v).map(|_| ()),
-            t if t == Command::LOG_TOPIC => Command::parse(v).map(|_| ()),
-            t if t == ControllerDiagnostics::LOG_TOPIC => ControllerDiagnostics::parse(v).map(|_| ()),
-            t if t == Timing::LOG_TOPIC => Timing::parse(v).map(|_| ()),
-            _ => Ok(()),
+            t if t == JointState::LOG_TOPIC => JointState::decode_as(e, v).map(|_| ()),
+            t if t == ReferenceSample::LOG_TOPIC => ReferenceSample::decode_as(e, v).map(|_| ()),
+            t if t == Command::LOG_TOPIC => Command::decode_as(e, v).map(|_| ()),
+            t if t == ControllerDiagnostics::LOG_TOPIC => ControllerDiagnostics::decode_as(e, v).map(|_| ()),
+            t if t == Timing::LOG_TOPIC => Timing::decode_as(e, v).map(|_| ()),
+            _ => logger::check_message(e, v),
         };
         Ok(())
     };

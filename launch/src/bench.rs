@@ -62,6 +62,9 @@ pub enum BenchError {
     /// The Python + MuJoCo loop of `--peer` failed.
     #[error("bench --peer: {0}")]
     Peer(String),
+    /// The iceoryx2 ping-pong failed.
+    #[error("bench ping-pong: {0}")]
+    PingPong(String),
 }
 
 /// The machine the bench ran on.
@@ -122,6 +125,11 @@ pub struct ArmBench {
     pub lockstep_realtime_factor: f64,
     /// Lockstep wall / in-process wall.
     pub lockstep_to_inprocess_ratio: f64,
+    /// The fastest any lockstep over events could be here: steps × the
+    /// ping-pong's round trip + the in-process wall, s.
+    pub lockstep_floor_s: f64,
+    /// Lockstep wall / that floor.
+    pub lockstep_to_floor_ratio: f64,
     /// Controller step (median), µs.
     pub controller_step_us: f64,
     /// Plant step (median, all substeps), µs.
@@ -144,6 +152,10 @@ pub struct BenchReport {
     pub machine: Machine,
     /// Repeats per part.
     pub repeats: usize,
+    /// A bare two-process iceoryx2 ping-pong (state out, command back, as
+    /// lockstep's plant and controller exchange them), the floor of any
+    /// lockstep over events ([`crate::bench_pingpong`]).
+    pub pingpong: crate::bench_pingpong::PingPong,
     /// Whether the nodes were pinned and, in real time, ran under SCHED_FIFO.
     pub realtime_setup: bool,
     /// The paper scenario's figures (its `timer_floor` among them), at the
@@ -326,6 +338,7 @@ pub(crate) fn realtime_part(
 fn bench_arm(
     plan: &Plan,
     opts: &BenchOptions,
+    round_trip_us: f64,
     progress: &mut impl FnMut(&str),
 ) -> Result<ArmBench, BenchError> {
     let sim_s = plan.steps as f64 * plan.dt();
@@ -357,6 +370,7 @@ fn bench_arm(
         plan.scenario.name, opts.realtime_s
     ));
     let (realtime, floor, _) = realtime_part(plan, opts, None)?;
+    let lockstep_floor_s = plan.steps as f64 * round_trip_us * 1e-6 + inprocess;
     Ok(ArmBench {
         scenario: plan.scenario.name.clone(),
         dof: plan.robot.model.dof(),
@@ -365,6 +379,8 @@ fn bench_arm(
         lockstep_wall_s: lockstep,
         lockstep_realtime_factor: sim_s / lockstep.max(1e-9),
         lockstep_to_inprocess_ratio: lockstep / inprocess.max(1e-9),
+        lockstep_floor_s,
+        lockstep_to_floor_ratio: lockstep / lockstep_floor_s.max(1e-9),
         controller_step_us: costs.controller_us.finish().p50,
         plant_step_us: costs.plant_us.finish().p50,
         realtime,
@@ -417,11 +433,18 @@ fn in_process(
 pub fn run(opts: &BenchOptions, mut progress: impl FnMut(&str)) -> Result<BenchReport, BenchError> {
     let paper = load(None, opts)?;
     let large = load(Some(&opts.large_arm), opts)?;
-    let mut arms = vec![bench_arm(&paper, opts, &mut progress)?];
-    arms.push(bench_arm(&large, opts, &mut progress)?);
+    progress(&format!(
+        "iceoryx2 ping-pong, {} round trips x {}",
+        paper.steps, opts.repeats
+    ));
+    let pingpong = crate::bench_pingpong::measure(paper.steps, opts.repeats, opts.realtime_setup)?;
+    let rtt = pingpong.round_trip_us;
+    let mut arms = vec![bench_arm(&paper, opts, rtt, &mut progress)?];
+    arms.push(bench_arm(&large, opts, rtt, &mut progress)?);
     Ok(BenchReport {
         machine: machine(),
         repeats: opts.repeats,
+        pingpong,
         realtime_setup: opts.realtime_setup,
         paper: arms[0].clone(),
         arms,

@@ -22,6 +22,12 @@ pub fn bench_table(b: &launch::bench::BenchReport) -> String {
             "left to the OS (--no-realtime-setup)"
         }
     );
+    let _ = writeln!(
+        out,
+        "iceoryx2 ping-pong: {:.2} us a round trip (two processes, state out, command back; \
+         {} rounds)",
+        b.pingpong.round_trip_us, b.pingpong.rounds
+    );
     for a in &b.arms {
         let _ = writeln!(
             out,
@@ -33,6 +39,11 @@ pub fn bench_table(b: &launch::bench::BenchReport) -> String {
             out,
             "  lockstep + log  {:8.3} s wall = {:.1}x real time, {:.2}x the in-process wall",
             a.lockstep_wall_s, a.lockstep_realtime_factor, a.lockstep_to_inprocess_ratio
+        );
+        let _ = writeln!(
+            out,
+            "  lockstep floor  {:8.3} s = steps x ping-pong + in process; lockstep is {:.2}x it",
+            a.lockstep_floor_s, a.lockstep_to_floor_ratio
         );
         let _ = writeln!(
             out,

@@ -14,6 +14,7 @@
 pub mod bench;
 pub mod bench_controller;
 pub mod bench_peer;
+pub mod bench_pingpong;
 pub mod compare;
 pub mod compare_findings;
 pub mod compare_plots;

@@ -2,7 +2,8 @@
 //! a reference sample, a command, the controller's diagnostics and a timing
 //! record per step) to an MCAP file, the logger's whole work per step, for
 //! instruction counts that do not move with the machine's load:
-//! `valgrind --tool=callgrind target/release/examples/log_steps 20000 /tmp/steps.mcap`.
+//! `valgrind --tool=callgrind target/release/examples/log_steps 20000 /tmp/steps.mcap`
+//! (a third argument, `zstd`, `lz4` or `none`, picks the compression).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -15,10 +16,18 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().collect();
     let (Some(steps), Some(out)) = (args.get(1).and_then(|s| s.parse::<u64>().ok()), args.get(2))
     else {
-        eprintln!("usage: log_steps STEPS OUT.mcap");
+        eprintln!("usage: log_steps STEPS OUT.mcap [zstd|lz4|none]");
         return ExitCode::from(2);
     };
-    match run(steps, Path::new(out)) {
+    let compression = match args.get(3).map(|s| logger::LogCompression::parse(s)) {
+        None => logger::LogCompression::default(),
+        Some(Ok(c)) => c,
+        Some(Err(e)) => {
+            eprintln!("log_steps: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    match run(steps, Path::new(out), compression) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("log_steps: {e}");
@@ -27,8 +36,12 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(steps: u64, out: &Path) -> Result<(), logger::LogError> {
-    let mut log = LogWriter::create(out, &RunMetadata::default(), "")?;
+fn run(
+    steps: u64,
+    out: &Path,
+    compression: logger::LogCompression,
+) -> Result<(), logger::LogError> {
+    let mut log = LogWriter::create_with(out, &RunMetadata::default(), "", compression)?;
     for k in 0..steps {
         let t = k as f64 * 1e-3;
         let header = Header {

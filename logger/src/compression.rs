@@ -1,7 +1,9 @@
 //! How a log's chunks are compressed: a choice of file size against the
-//! logger's time, which in lockstep paces the run (README, "The plant
-//! engine"): zstd (level 1) is the smallest, LZ4 about 12 % cheaper and
-//! 35 % larger, none about 40 % cheaper and ten times larger.
+//! logger's CPU. On a run's CDR (mostly doubles) zstd's fast level -1 makes
+//! the smallest files of the three, LZ4 files about a third larger, none
+//! files about two and a half times larger; compressing is then about half
+//! of the logger's CPU, and none the cheapest (results.md, "Logs in the
+//! ROS 2 format").
 
 use serde::{Deserialize, Serialize};
 
@@ -9,7 +11,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LogCompression {
-    /// zstd at level 1 (the default).
+    /// zstd at its fast level -1 ([`crate::ZSTD_LEVEL`]; the default).
     #[default]
     Zstd,
     /// LZ4 frames.
@@ -41,14 +43,6 @@ impl LogCompression {
                 "{other:?} is not a log compression (one of: {})",
                 Self::NAMES.join(", ")
             )),
-        }
-    }
-
-    pub(crate) fn mcap(self) -> Option<mcap::Compression> {
-        match self {
-            Self::Zstd => Some(mcap::Compression::Zstd),
-            Self::Lz4 => Some(mcap::Compression::Lz4),
-            Self::None => None,
         }
     }
 }

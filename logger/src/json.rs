@@ -1,4 +1,7 @@
-//! Messages as JSON for the log, and their JSON schemas.
+//! Messages as JSON, as logs of formats 1 and 2 hold them (format 3 is
+//! CDR, [`crate::ros2`]): the reader decodes them with [`LogMessage::parse`];
+//! the writer side (`to_json`, `encode`, `schema`) stays for tools and tests
+//! that want a message as JSON.
 //!
 //! Each message type lists its fields once, where the wire defines it
 //! ([`wire::data_message!`]); the JSON object, the schema and the way back
@@ -39,6 +42,7 @@ pub trait LogMessage: Bound {
         o.insert("t".into(), number(h.t_ns as f64 / 1e9));
         self.visit(&mut |name, f| {
             let v = match f {
+                FieldRef::U32(x) => x.into(),
                 FieldRef::U(x) => x.into(),
                 FieldRef::I(x) => x.into(),
                 FieldRef::F(x) => number(x),
@@ -66,6 +70,7 @@ pub trait LogMessage: Bound {
         self.visit(&mut |name, f| {
             key(out, name, false);
             match f {
+                FieldRef::U32(x) => write_int(out, x),
                 FieldRef::U(x) => write_int(out, x),
                 FieldRef::I(x) => write_int(out, x),
                 FieldRef::F(x) => write_real(out, x),
@@ -99,6 +104,15 @@ pub trait LogMessage: Bound {
             .map_err(DecodeError)
     }
 
+    /// The message back from a log's data in `encoding` (JSON in log
+    /// formats 1 and 2, CDR from format 3).
+    fn decode_as(encoding: crate::Encoding, data: &[u8]) -> Result<Self, DecodeError> {
+        match encoding {
+            crate::Encoding::Json => Self::parse(data),
+            crate::Encoding::Cdr => crate::ros2::decode(data),
+        }
+    }
+
     /// The JSON schema (draft 2020-12, `jsonschema` encoding in MCAP).
     fn schema() -> Value {
         let mut props = Map::new();
@@ -115,7 +129,7 @@ pub trait LogMessage: Bound {
         );
         Self::default().visit(&mut |name, f| {
             let s = match f {
-                FieldRef::U(_) | FieldRef::I(_) => json!({"type": "integer"}),
+                FieldRef::U32(_) | FieldRef::U(_) | FieldRef::I(_) => json!({"type": "integer"}),
                 FieldRef::F(_) => json!({"type": ["number", "null"]}),
                 FieldRef::J(_) => json!({
                     "type": "array",

@@ -6,9 +6,14 @@
 //! receives; `testbed replay` and the launcher's summary read the file
 //! back ([`read_log`]). Nothing here steps the loop.
 //!
-//! Channels carry JSON messages with `jsonschema` schemas (so Foxglove can
-//! plot every field), in zstd-compressed chunks (LZ4 or none on request); each message's log time is
-//! its sim time and its publish time the sample's wall timestamp. A metadata
+//! The file follows MCAP's `ros2` profile, as rosbag2 writes it: channels
+//! carry CDR messages with `ros2msg` schemas ([`ros2`]), so ROS 2 tools,
+//! Foxglove, PlotJuggler and the official `mcap` readers decode every
+//! field; chunks are zstd-compressed (LZ4 or none on request). Each
+//! message's log time is its sim time and its publish time the sample's
+//! wall timestamp. Logs of formats 1 and 2 (JSON messages with JSON
+//! schemas) are still read: the reader hands each message's encoding with
+//! it ([`Encoding`]). A metadata
 //! record `testbed.run` holds the scenario (full TOML), run id, mode, rate,
 //! software version and start time; the robot's URDF is an attachment; a
 //! last metadata record `testbed.log_stats` counts what the logger received
@@ -20,27 +25,44 @@
 //! Log and live view open one channel list ([`channels`]), and
 //! [`foxglove_layout`] lays them out for either.
 
+pub mod cdr;
 mod channels;
 mod compression;
 mod json;
 mod json_object;
 mod layout;
 pub mod live;
+mod mcap_out;
 pub mod node;
 mod outputs;
 mod reader;
 mod records;
+pub mod ros2;
 mod scan;
 pub mod scene;
 mod writer;
 
-pub use channels::{ChannelSpec, channels};
+pub use channels::{
+    ChannelSpec, JOINT_COMMANDS_TOPIC, JOINT_STATES_TOPIC, MESSAGE_ENCODING, PROFILE,
+    SCHEMA_ENCODING, channels,
+};
 pub use compression::LogCompression;
 pub use json::{DecodeError, LogMessage};
 pub use json_object::JsonObject;
 pub use layout::foxglove_layout;
-pub use reader::{LogContents, MessageError, OnMessage, read_log, read_log_bytes, read_log_head};
-pub use writer::{LOG_FORMAT, LogWriter, RunMetadata};
+pub use reader::{
+    Encoding, LogContents, MessageError, OnMessage, read_log, read_log_bytes, read_log_head,
+};
+pub use writer::{LOG_FORMAT, LogWriter, RunMetadata, ZSTD_LEVEL};
+
+/// Checks a message nothing decodes further (the arm's frames and figure,
+/// the standard views): JSON text, or CDR with its header.
+pub fn check_message(encoding: Encoding, data: &[u8]) -> Result<(), DecodeError> {
+    match encoding {
+        Encoding::Json => JsonObject::check(data),
+        Encoding::Cdr => cdr::CdrReader::new(data).map(|_| ()),
+    }
+}
 
 /// Name of the metadata record that describes the run.
 pub const RUN_METADATA: &str = "testbed.run";

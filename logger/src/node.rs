@@ -129,7 +129,7 @@ impl Subs {
         self.timing.drain(|m| out.take(m))?;
         self.state.drain(|m| out.take_state(m))?;
         self.reference.drain(|m| out.take(m))?;
-        self.command.drain(|m| out.take(m))?;
+        self.command.drain(|m| out.take_command(m))?;
         self.diag.drain(|m| out.take(m))
     }
 

@@ -5,16 +5,21 @@
 use std::collections::BTreeMap;
 
 use arm_model::ArmModel;
-use serde_json::Value;
-use wire::JointState;
+use wire::{Command, JointState};
 
 use crate::live::LiveView;
 use crate::scene::{ArmScene, SCENE_TOPIC, TRANSFORMS_TOPIC};
-use crate::{LogError, LogMessage, LogWriter, channels};
+use crate::{JOINT_COMMANDS_TOPIC, JOINT_STATES_TOPIC, LogError, LogMessage, LogWriter, channels};
 
 /// The arm's frames are written at 50 Hz of sim time: smooth to the eye,
 /// 2 % of the messages at 1 kHz.
 const TRANSFORMS_EVERY_NS: u64 = 20_000_000;
+/// The standard views (`/joint_states`, `/joint_commands`) are written at
+/// the frames' rate: they are for tools that draw the arm or plot a
+/// glance (RViz, a robot_state_publisher); every sample, every field, is
+/// in the testbed's own messages, and at 1 kHz the views would add half
+/// the file's index and a sixth of its data.
+const VIEWS_EVERY_NS: u64 = TRANSFORMS_EVERY_NS;
 /// The figure is written again every second, so that a viewer that joins
 /// late or seeks into the log finds it.
 const SCENE_EVERY_NS: u64 = 1_000_000_000;
@@ -25,9 +30,13 @@ pub(crate) struct Outputs {
     live: Option<Box<dyn LiveView>>,
     arm: ArmScene,
     dof: usize,
+    names: Vec<String>,
     next_transforms_ns: u64,
     next_scene_ns: u64,
-    json: Vec<u8>,
+    next_state_view_ns: u64,
+    next_command_view_ns: u64,
+    /// A derived message's CDR, reused.
+    buf: Vec<u8>,
 }
 
 impl Outputs {
@@ -47,53 +56,90 @@ impl Outputs {
             live,
             arm: ArmScene::new(model),
             dof: model.dof(),
+            names: model.joint_names(),
             next_transforms_ns: 0,
             next_scene_ns: 0,
-            json: Vec::with_capacity(4096),
+            next_state_view_ns: 0,
+            next_command_view_ns: 0,
+            buf: Vec::with_capacity(4096),
         })
     }
 
     /// One sample of any topic.
     pub(crate) fn take<M: LogMessage>(&mut self, msg: &M) -> Result<(), LogError> {
-        let json = self.log.write(msg)?;
+        let data = self.log.write(msg)?;
         if let Some(live) = self.live.as_mut() {
-            live.offer(M::LOG_TOPIC, msg.header().t_ns, json);
+            live.offer(M::LOG_TOPIC, msg.header().t_ns, data);
         }
         Ok(())
     }
 
-    /// A joint state: the sample, then the arm's frames and figure when due.
-    /// A state of another arm's size, or not finite (a run blowing up),
-    /// moves no frame: its numbers are in the log all the same.
+    /// A joint state: the sample, then its standard view
+    /// (`/joint_states`), the arm's frames and figure when due. A state of
+    /// another arm's size, or not finite (a run blowing up), moves no
+    /// frame: its numbers are in the log all the same.
     pub(crate) fn take_state(&mut self, s: &JointState) -> Result<(), LogError> {
         self.take(s)?;
         let (t, wall) = (s.header.t_ns, s.header.wall_ns);
+        if t >= self.next_state_view_ns {
+            self.next_state_view_ns = t.saturating_add(VIEWS_EVERY_NS);
+            let n = (s.dof as usize).min(wire::MAX_DOF);
+            self.buf.clear();
+            crate::ros2::joint_state(
+                &mut self.buf,
+                t,
+                self.names.get(..n).unwrap_or_default(),
+                &s.q[..n],
+                &s.qd[..n],
+                &s.tau_applied[..n],
+            );
+            self.emit(JOINT_STATES_TOPIC, t, wall)?;
+        }
         let q = s.q.get(..self.dof).filter(|_| s.dof as usize == self.dof);
         if let Some(q) = q.filter(|q| q.iter().all(|x| x.is_finite()))
             && t >= self.next_transforms_ns
         {
             self.next_transforms_ns = t.saturating_add(TRANSFORMS_EVERY_NS);
-            let v = self.arm.transforms(t, q);
-            self.emit(TRANSFORMS_TOPIC, t, wall, &v)?;
+            self.buf.clear();
+            self.arm.transforms(&mut self.buf, t, q);
+            self.emit(TRANSFORMS_TOPIC, t, wall)?;
         }
         if t >= self.next_scene_ns {
             self.next_scene_ns = t.saturating_add(SCENE_EVERY_NS);
-            let v = self.arm.scene(t);
-            self.emit(SCENE_TOPIC, t, wall, &v)?;
+            self.buf.clear();
+            self.arm.scene(&mut self.buf, t);
+            self.emit(SCENE_TOPIC, t, wall)?;
         }
         Ok(())
     }
 
-    fn emit(&mut self, topic: &'static str, t: u64, wall: u64, v: &Value) -> Result<(), LogError> {
-        self.json.clear();
-        serde_json::to_writer(&mut self.json, v).map_err(|cause| LogError::Encode {
-            path: self.log.path().display().to_string(),
-            topic,
-            cause,
-        })?;
-        self.log.write_json(topic, t, wall, &self.json)?;
+    /// A command: the sample and, when due, its standard view
+    /// (`/joint_commands`).
+    pub(crate) fn take_command(&mut self, c: &Command) -> Result<(), LogError> {
+        self.take(c)?;
+        let t = c.header.t_ns;
+        if t < self.next_command_view_ns {
+            return Ok(());
+        }
+        self.next_command_view_ns = t.saturating_add(VIEWS_EVERY_NS);
+        let n = (c.dof as usize).min(wire::MAX_DOF);
+        self.buf.clear();
+        crate::ros2::joint_state(
+            &mut self.buf,
+            t,
+            self.names.get(..n).unwrap_or_default(),
+            &[],
+            &[],
+            &c.tau[..n],
+        );
+        self.emit(JOINT_COMMANDS_TOPIC, t, c.header.wall_ns)
+    }
+
+    /// Writes the derived message in `buf` and offers it live.
+    fn emit(&mut self, topic: &'static str, t: u64, wall: u64) -> Result<(), LogError> {
+        self.log.write_raw(topic, t, wall, &self.buf)?;
         if let Some(live) = self.live.as_mut() {
-            live.offer(topic, t, &self.json);
+            live.offer(topic, t, &self.buf);
         }
         Ok(())
     }

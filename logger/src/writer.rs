@@ -1,24 +1,23 @@
 //! Writing a run log.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use mcap::records::MessageHeader;
-use mcap::{Attachment, WriteOptions, Writer};
-
-use super::channels::ChannelSpec;
+use super::channels::{ChannelSpec, MESSAGE_ENCODING, PROFILE, SCHEMA_ENCODING};
 use super::compression::LogCompression;
 use super::json::LogMessage;
+use super::mcap_out::McapOut;
 use super::{LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
 
 /// A chunk is closed at least this often, so a crash loses at most this
 /// much wall time of data (an unfinished MCAP file loses only its open chunk).
 const FLUSH_EVERY: Duration = Duration::from_millis(500);
-/// Chunks are also closed when they reach this size (compressed input).
-const CHUNK_BYTES: u64 = 1 << 20;
+/// The zstd level of the chunks (negative: zstd's fast levels).
+pub const ZSTD_LEVEL: i32 = -1;
+/// Chunks are also closed when they reach this size (uncompressed).
+const CHUNK_BYTES: usize = 1 << 20;
 
 /// What the `testbed.run` metadata record says.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -77,7 +76,9 @@ pub struct RunMetadata {
 /// `testbed.run` metadata (a log without it is format 1). Format 2 adds the
 /// data path's stamps: `JointState.command_seq` and `applied_wall_ns`,
 /// `Command.started_wall_ns`, `reference_t_ns` and `stale_references`.
-pub const LOG_FORMAT: u32 = 2;
+/// Format 3 is the ROS 2 one: the `ros2` profile, CDR messages and
+/// `ros2msg` schemas ([`crate::ros2`]) instead of JSON with JSON schemas.
+pub const LOG_FORMAT: u32 = 3;
 
 impl RunMetadata {
     /// The `testbed.run` record: every field as text (lists joined by
@@ -109,11 +110,14 @@ impl RunMetadata {
 
 /// An open log.
 pub struct LogWriter {
-    writer: Writer<BufWriter<File>>,
+    writer: McapOut,
     path: PathBuf,
-    channels: HashMap<&'static str, (u16, u32)>,
+    /// Topic, channel id and last sequence number of each open channel: a
+    /// handful, searched by the topic's address first (every caller passes
+    /// the same constants), which costs less than hashing it per message.
+    channels: Vec<(&'static str, u16, u32)>,
     last_flush: Instant,
-    /// One message's JSON, reused from message to message.
+    /// One message's CDR, reused from message to message.
     scratch: Vec<u8>,
 }
 
@@ -135,43 +139,41 @@ impl LogWriter {
             path: p.clone(),
             cause,
         })?;
-        let mcap_err = |cause| LogError::mcap(&p, cause);
-        let mut writer = WriteOptions::new()
-            .compression(compression.mcap())
-            // Level 1, not zstd's default 3: in lockstep the logger paces
-            // the run, and this is its largest cost (the files grow 4 %).
-            .compression_level(1)
-            // In this process: zstd's worker threads (one per physical
-            // CPU by default) compete with the plant and the controller.
-            .compression_threads(0)
-            .chunk_size(Some(CHUNK_BYTES))
-            .profile("")
-            .library(format!("testbed {}", env!("CARGO_PKG_VERSION")))
-            .create(BufWriter::new(file))
-            .map_err(mcap_err)?;
+        let io = |cause| LogError::Io {
+            path: p.clone(),
+            cause,
+        };
+        // zstd's first fast level (`zstd --fast=1`), not its default 3:
+        // compressing is the logger's largest cost, and on the doubles of a
+        // run (which no level squeezes much) level -1 is twice as fast as
+        // level 1 for a file 3 % larger (results.md).
+        let mut writer = McapOut::create(
+            file,
+            PROFILE,
+            &format!("testbed {}", env!("CARGO_PKG_VERSION")),
+            compression,
+            ZSTD_LEVEL,
+        )
+        .map_err(io)?;
+        let map = meta.to_map().map_err(|cause| LogError::Encode {
+            path: p.clone(),
+            topic: RUN_METADATA,
+            cause,
+        })?;
+        writer.metadata(RUN_METADATA, &map).map_err(io)?;
         writer
-            .write_metadata(&mcap::records::Metadata {
-                name: RUN_METADATA.into(),
-                metadata: meta.to_map().map_err(|cause| LogError::Encode {
-                    path: path.display().to_string(),
-                    topic: RUN_METADATA,
-                    cause,
-                })?,
-            })
-            .map_err(mcap_err)?;
-        writer
-            .attach(&Attachment {
-                log_time: 0,
-                create_time: meta.start_time_unix_ns,
-                name: URDF_ATTACHMENT.into(),
-                media_type: "application/xml".into(),
-                data: std::borrow::Cow::Borrowed(urdf.as_bytes()),
-            })
-            .map_err(mcap_err)?;
+            .attach(
+                0,
+                meta.start_time_unix_ns,
+                URDF_ATTACHMENT,
+                "application/xml",
+                urdf.as_bytes(),
+            )
+            .map_err(io)?;
         Ok(Self {
             writer,
             path: path.to_path_buf(),
-            channels: HashMap::new(),
+            channels: Vec::new(),
             last_flush: Instant::now(),
             scratch: Vec::with_capacity(4096),
         })
@@ -182,75 +184,78 @@ impl LogWriter {
         &self.path
     }
 
-    fn err(&self) -> impl Fn(mcap::McapError) -> LogError + '_ {
-        |cause| LogError::mcap(&self.path.display().to_string(), cause)
+    fn err(&self) -> impl Fn(std::io::Error) -> LogError + '_ {
+        |cause| LogError::Io {
+            path: self.path.display().to_string(),
+            cause,
+        }
     }
 
     /// Registers the channel of `M` (done on first write otherwise).
     pub fn add_channel<M: LogMessage>(&mut self) -> Result<u16, LogError> {
-        match self.channels.get(M::LOG_TOPIC) {
-            Some((id, _)) => Ok(*id),
+        match self.find(M::LOG_TOPIC) {
+            Some(i) => Ok(self.channels[i].1),
             None => self.add_channel_spec(&ChannelSpec::of::<M>()),
         }
     }
 
     /// Registers a channel (once: a topic registered before keeps its id).
     pub fn add_channel_spec(&mut self, spec: &ChannelSpec) -> Result<u16, LogError> {
-        if let Some((id, _)) = self.channels.get(spec.topic) {
-            return Ok(*id);
+        if let Some(i) = self.find(spec.topic) {
+            return Ok(self.channels[i].1);
         }
-        let schema = serde_json::to_vec(&spec.schema).map_err(|cause| LogError::Encode {
-            path: self.path.display().to_string(),
-            topic: spec.topic,
-            cause,
-        })?;
         let schema_id = self
             .writer
-            .add_schema(spec.schema_name, "jsonschema", &schema)
+            .add_schema(&spec.schema_name, SCHEMA_ENCODING, spec.schema.as_bytes())
             .map_err(self.err())?;
         let id = self
             .writer
-            .add_channel(schema_id, spec.topic, "json", &BTreeMap::new())
+            .add_channel(schema_id, spec.topic, MESSAGE_ENCODING)
             .map_err(self.err())?;
-        self.channels.insert(spec.topic, (id, 0));
+        self.channels.push((spec.topic, id, 0));
         Ok(id)
     }
 
-    /// Appends one message; gives back its JSON (for the live view).
+    fn find(&self, topic: &str) -> Option<usize> {
+        let same = |t: &&str| std::ptr::eq(*t, topic);
+        (self.channels.iter().position(|c| same(&c.0)))
+            .or_else(|| self.channels.iter().position(|c| c.0 == topic))
+    }
+
+    /// Appends one message; gives back its CDR (for the live view).
     pub fn write<M: LogMessage>(&mut self, msg: &M) -> Result<&[u8], LogError> {
         self.add_channel::<M>()?;
         let h = msg.header();
         let mut data = std::mem::take(&mut self.scratch);
         data.clear();
-        msg.encode(&mut data);
-        let res = self.write_json(M::LOG_TOPIC, h.t_ns, h.wall_ns, &data);
+        crate::ros2::encode(msg, &mut data);
+        let res = self.write_raw(M::LOG_TOPIC, h.t_ns, h.wall_ns, &data);
         self.scratch = data;
         res.map(|()| self.scratch.as_slice())
     }
 
-    /// Appends one message already in JSON to a registered channel.
-    pub fn write_json(
+    /// Appends one message already encoded (CDR) to a registered channel.
+    pub fn write_raw(
         &mut self,
         topic: &'static str,
         log_time: u64,
         publish_time: u64,
-        json: &[u8],
+        data: &[u8],
     ) -> Result<(), LogError> {
-        let Some((id, seq)) = self.channels.get_mut(topic) else {
+        let Some(i) = self.find(topic) else {
             return Err(LogError::UnknownChannel {
                 path: self.path.display().to_string(),
                 topic,
             });
         };
+        let (_, id, seq) = &mut self.channels[i];
         *seq = seq.wrapping_add(1);
-        let header = MessageHeader {
-            channel_id: *id,
-            sequence: *seq,
-            log_time,
-            publish_time,
-        };
-        let res = self.writer.write_to_known_channel(&header, json);
-        res.map_err(self.err())
+        self.writer.message(*id, *seq, log_time, publish_time, data);
+        if self.writer.chunk_len() >= CHUNK_BYTES {
+            let res = self.writer.close_chunk();
+            res.map_err(self.err())?;
+        }
+        Ok(())
     }
 
     /// Closes the open chunk if it is older than the flush period.
@@ -264,21 +269,21 @@ impl LogWriter {
     /// Closes the open chunk and pushes it to the file.
     pub fn flush(&mut self) -> Result<(), LogError> {
         self.last_flush = Instant::now();
-        let res = self.writer.flush();
+        let res = self.writer.close_chunk().and_then(|()| self.writer.flush());
         res.map_err(self.err())
     }
 
     /// Writes the `testbed.log_stats` record, the summary and the footer.
-    /// Checked: mcap's own `Drop` would throw a failure away.
     pub fn finish(mut self, stats: BTreeMap<String, String>) -> Result<(), LogError> {
-        let res = self.writer.write_metadata(&mcap::records::Metadata {
-            name: STATS_METADATA.into(),
-            metadata: stats,
-        });
+        let res = self
+            .writer
+            .close_chunk()
+            .and_then(|()| self.writer.metadata(STATS_METADATA, &stats));
         res.map_err(self.err())?;
-        let res = self.writer.finish();
-        res.map_err(self.err())?;
-        Ok(())
+        let path = self.path.display().to_string();
+        self.writer
+            .finish()
+            .map_err(|cause| LogError::Io { path, cause })
     }
 }
 

@@ -58,7 +58,7 @@ fn handshake(port: u16, protocol: &str) -> Result<WebSocket<TcpStream>, String> 
 struct Advertised {
     topic: String,
     schema_name: String,
-    schema: Value,
+    schema: String,
 }
 
 struct Viewer {
@@ -109,9 +109,9 @@ impl Viewer {
             return;
         }
         for c in v["channels"].as_array().unwrap() {
-            assert_eq!(c["encoding"], "json", "{c}");
-            assert_eq!(c["schemaEncoding"], "jsonschema", "{c}");
-            let schema = serde_json::from_str(c["schema"].as_str().unwrap()).unwrap();
+            assert_eq!(c["encoding"], "cdr", "{c}");
+            assert_eq!(c["schemaEncoding"], "ros2msg", "{c}");
+            let schema = c["schema"].as_str().unwrap().to_string();
             self.channels.insert(
                 c["id"].as_u64().unwrap(),
                 Advertised {
@@ -136,8 +136,8 @@ impl Viewer {
         self.ws.send(Message::text(msg)).unwrap();
     }
 
-    /// Reads until the server closes: (topic, log time, JSON) in order.
-    fn read_to_end(&mut self) -> Vec<(String, u64, Value)> {
+    /// Reads until the server closes: (topic, log time, CDR) in order.
+    fn read_to_end(&mut self) -> Vec<(String, u64, Vec<u8>)> {
         let mut out = Vec::new();
         loop {
             let m = match self.ws.read() {
@@ -166,16 +166,15 @@ impl Viewer {
             }
             let sub = u32::from_le_bytes(b[1..5].try_into().unwrap());
             let t = u64::from_le_bytes(b[5..13].try_into().unwrap());
-            let value: Value = serde_json::from_slice(&b[13..]).unwrap();
             let topic = self.channels[&self.subs[&sub]].topic.clone();
-            out.push((topic, t, value));
+            out.push((topic, t, b[13..].to_vec()));
         }
         out
     }
 }
 
 /// The channels of the run's log: topic → (schema name, schema).
-fn log_channels(log: &Path) -> BTreeMap<String, (String, Value)> {
+fn log_channels(log: &Path) -> BTreeMap<String, (String, String)> {
     let buf = std::fs::read(log).unwrap();
     let summary = mcap::Summary::read(&buf).unwrap().unwrap();
     summary
@@ -183,7 +182,7 @@ fn log_channels(log: &Path) -> BTreeMap<String, (String, Value)> {
         .values()
         .map(|c| {
             let s = c.schema.as_ref().unwrap();
-            let schema = serde_json::from_slice(&s.data).unwrap();
+            let schema = String::from_utf8(s.data.to_vec()).unwrap();
             (c.topic.clone(), (s.name.clone(), schema))
         })
         .collect()
@@ -203,35 +202,25 @@ fn live_run(port: u16, mode: &str, extra: &[&str], dir: &Path) -> Child {
 }
 
 /// A lockstep run seen live: the joint states and the arm's frames arrive
-/// in order, every k-th sample, valid against the advertised schemas; the
-/// live channels are the log's; the log counts the client.
+/// in order, every k-th sample, CDR that decodes; the live channels are
+/// the log's, with the same schemas; the log counts the client.
 #[test]
 fn a_lockstep_run_streams_live_what_its_log_keeps() {
     let dir = tempfile::tempdir().unwrap();
     let port = free_port();
     let mut run = live_run(port, "lockstep", &["--duration", "60"], dir.path());
     let mut viewer = Viewer::connect(port, &mut run, SDK);
-    viewer.subscribe(&["/joint_state", "/arm/transforms"]);
+    viewer.subscribe(&["/joint_state", "/tf"]);
     let got = viewer.read_to_end();
     let (status, out, err) = ended(&mut run, 300);
     assert!(status.success(), "{err}");
     let report = parse_json_str(&out);
 
-    let validators: HashMap<String, jsonschema::Validator> = viewer
-        .channels
-        .values()
-        .map(|c| {
-            (
-                c.topic.clone(),
-                jsonschema::validator_for(&c.schema).unwrap(),
-            )
-        })
-        .collect();
     let mut last: HashMap<&str, u64> = HashMap::new();
     let mut counts: BTreeMap<&str, u64> = BTreeMap::new();
     for (topic, t, v) in &got {
-        if let Err(e) = validators[topic].validate(v) {
-            panic!("{topic} at {t}: {e}\n{v}");
+        if let Err(e) = logger::check_message(logger::Encoding::Cdr, v) {
+            panic!("{topic} at {t}: {e}");
         }
         if let Some(prev) = last.insert(topic, *t) {
             assert!(*t > prev, "{topic}: {t} after {prev}");
@@ -239,7 +228,9 @@ fn a_lockstep_run_streams_live_what_its_log_keeps() {
         // 50 Hz of a 1 kHz run: every 20th sample, the same ones each run.
         assert_eq!(t % 20_000_000, 0, "{topic} at {t}");
         if topic == "/joint_state" {
-            assert_eq!(v["t_ns"].as_u64(), Some(*t));
+            use logger::LogMessage;
+            let s = wire::JointState::decode_as(logger::Encoding::Cdr, v).unwrap();
+            assert_eq!(s.header.t_ns, *t);
         }
         *counts.entry(topic).or_default() += 1;
     }
@@ -247,14 +238,11 @@ fn a_lockstep_run_streams_live_what_its_log_keeps() {
         counts.get("/joint_state").copied().unwrap_or(0) >= 10,
         "{counts:?}"
     );
-    assert!(
-        counts.get("/arm/transforms").copied().unwrap_or(0) >= 10,
-        "{counts:?}"
-    );
+    assert!(counts.get("/tf").copied().unwrap_or(0) >= 10, "{counts:?}");
 
     // The same channels live and in the log, with the same schemas.
     let log = Path::new(report["log"].as_str().unwrap());
-    let live: BTreeMap<String, (String, Value)> = viewer
+    let live: BTreeMap<String, (String, String)> = viewer
         .channels
         .values()
         .map(|c| (c.topic.clone(), (c.schema_name.clone(), c.schema.clone())))

@@ -23,11 +23,15 @@ fn lockstep_run(dir: &Path, duration: &str) -> (serde_json::Value, PathBuf) {
     (s, log)
 }
 
-/// The log, read with the official MCAP library: header, footer, summary
-/// with statistics; every message valid against its channel's JSON schema;
-/// one message per step on each step topic.
+/// The log, read with the official MCAP library: header (the `ros2`
+/// profile), footer, summary with statistics; every channel CDR with a
+/// `ros2msg` schema; every testbed message decodes, its log time its sim
+/// time (the header's stamp) and its publish time its wall stamp; one
+/// message per step on each step topic.
 #[test]
-fn log_is_complete_mcap_with_valid_json_messages() {
+fn log_is_complete_ros2_mcap_whose_messages_decode() {
+    use logger::LogMessage;
+    use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
     let dir = tempfile::tempdir().unwrap();
     let (run, log) = lockstep_run(dir.path(), "0.5");
     let buf = std::fs::read(&log).unwrap();
@@ -40,8 +44,9 @@ fn log_is_complete_mcap_with_valid_json_messages() {
         let n = stats.channel_message_counts.get(id).copied().unwrap_or(0);
         counts.insert(ch.topic.clone(), n);
         let schema = ch.schema.as_ref().expect("every channel has a schema");
-        assert_eq!(schema.encoding, "jsonschema");
-        assert_eq!(ch.message_encoding, "json");
+        assert_eq!(schema.encoding, "ros2msg");
+        assert_eq!(ch.message_encoding, "cdr");
+        assert!(schema.name.contains("/msg/"), "{}", schema.name);
     }
     let steps = run["steps"].as_u64().unwrap();
     assert_eq!(steps, 500);
@@ -50,46 +55,39 @@ fn log_is_complete_mcap_with_valid_json_messages() {
     assert_eq!(counts["/controller/diagnostics"], steps, "{counts:?}");
     assert_eq!(counts["/timing"], steps, "{counts:?}");
     assert_eq!(counts["/reference"], steps + 1, "{counts:?}");
-    // The arm's frames at 50 Hz of sim time (states at 0, 20, …, 500 ms),
-    // its figure once a second.
-    assert_eq!(counts["/arm/transforms"], 26, "{counts:?}");
+    // The standard views and the arm's frames at 50 Hz of sim time
+    // (states at 0, 20, …, 500 ms), its figure once a second.
+    assert_eq!(counts["/joint_states"], 26, "{counts:?}");
+    assert_eq!(counts["/joint_commands"], 25, "{counts:?}");
+    assert_eq!(counts["/tf"], 26, "{counts:?}");
     assert_eq!(counts["/arm/scene"], 1, "{counts:?}");
 
-    let mut validators = BTreeMap::new();
-    for ch in summary.channels.values() {
-        let schema: serde_json::Value =
-            serde_json::from_slice(&ch.schema.as_ref().unwrap().data).unwrap();
-        validators.insert(
-            ch.topic.clone(),
-            jsonschema::validator_for(&schema).unwrap(),
-        );
-    }
     let mut seen = 0;
     for msg in mcap::MessageStream::new(&buf).unwrap() {
         let msg = msg.unwrap();
-        let value: serde_json::Value = serde_json::from_slice(&msg.data).unwrap();
-        let v = &validators[&msg.channel.topic];
-        if let Err(e) = v.validate(&value) {
-            panic!(
-                "{} message {} does not match its schema: {e}",
-                msg.channel.topic, msg.sequence
-            );
-        }
-        // log_time is sim time, publish_time the sample's wall timestamp
-        // (the arm's messages carry sim time in Foxglove's stamp).
-        let arm = value["transforms"][0]["timestamp"]
-            .as_object()
-            .or(value["entities"][0]["timestamp"].as_object());
-        match arm {
-            Some(t) => {
-                let ns = t["sec"].as_u64().unwrap() * 1_000_000_000 + t["nsec"].as_u64().unwrap();
-                assert_eq!(msg.log_time, ns, "{}", msg.channel.topic);
+        let enc = logger::Encoding::Cdr;
+        let header = match msg.channel.topic.as_str() {
+            t if t == JointState::LOG_TOPIC => {
+                JointState::decode_as(enc, &msg.data).map(|m| m.header)
             }
-            None => {
-                assert_eq!(msg.log_time, value["t_ns"].as_u64().unwrap());
-                assert_eq!(msg.publish_time, value["wall_ns"].as_u64().unwrap());
+            t if t == ReferenceSample::LOG_TOPIC => {
+                ReferenceSample::decode_as(enc, &msg.data).map(|m| m.header)
             }
-        }
+            t if t == Command::LOG_TOPIC => Command::decode_as(enc, &msg.data).map(|m| m.header),
+            t if t == ControllerDiagnostics::LOG_TOPIC => {
+                ControllerDiagnostics::decode_as(enc, &msg.data).map(|m| m.header)
+            }
+            t if t == Timing::LOG_TOPIC => Timing::decode_as(enc, &msg.data).map(|m| m.header),
+            _ => {
+                logger::check_message(enc, &msg.data).unwrap();
+                seen += 1;
+                continue;
+            }
+        };
+        let header =
+            header.unwrap_or_else(|e| panic!("{} {}: {e}", msg.channel.topic, msg.sequence));
+        assert_eq!(msg.log_time, header.t_ns);
+        assert_eq!(msg.publish_time, header.wall_ns);
         seen += 1;
     }
     assert_eq!(seen, counts.values().sum::<u64>());
@@ -135,6 +133,8 @@ fn log_is_complete_mcap_with_valid_json_messages() {
 /// the default zstd log of the same (deterministic) run.
 #[test]
 fn logs_of_every_compression_hold_the_same_messages() {
+    use logger::LogMessage;
+    let enc = logger::Encoding::Cdr;
     let dir = tempfile::tempdir().unwrap();
     let messages = |compression: &str| {
         let out = ok(testbed()
@@ -152,22 +152,33 @@ fn logs_of_every_compression_hold_the_same_messages() {
         let mut all = Vec::new();
         for m in mcap::MessageStream::new(&buf).unwrap() {
             let m = m.unwrap();
-            let mut v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
             // Wall stamps and measured times differ from run to run; the
             // rest may not.
-            let o = v.as_object_mut().unwrap();
-            if m.channel.topic == "/timing" {
-                o.clear();
-            }
-            for k in [
-                "wall_ns",
-                "state_wall_ns",
-                "compute_ns",
-                "started_wall_ns",
-                "applied_wall_ns",
-            ] {
-                o.remove(k);
-            }
+            let v = match m.channel.topic.as_str() {
+                "/timing" => Vec::new(),
+                "/joint_state" => {
+                    let mut s = wire::JointState::decode_as(enc, &m.data).unwrap();
+                    (s.header.wall_ns, s.applied_wall_ns) = (0, 0);
+                    format!("{s:?}").into_bytes()
+                }
+                "/command" => {
+                    let mut c = wire::Command::decode_as(enc, &m.data).unwrap();
+                    c.header.wall_ns = 0;
+                    (c.state_wall_ns, c.compute_ns, c.started_wall_ns) = (0, 0, 0);
+                    format!("{c:?}").into_bytes()
+                }
+                "/controller/diagnostics" => {
+                    let mut d = wire::ControllerDiagnostics::decode_as(enc, &m.data).unwrap();
+                    (d.header.wall_ns, d.compute_ns) = (0, 0);
+                    format!("{d:?}").into_bytes()
+                }
+                "/reference" => {
+                    let mut r = wire::ReferenceSample::decode_as(enc, &m.data).unwrap();
+                    r.header.wall_ns = 0;
+                    format!("{r:?}").into_bytes()
+                }
+                _ => m.data.to_vec(),
+            };
             all.push((m.channel.topic.clone(), m.log_time, v));
         }
         // The order across topics depends on when the logger drained.

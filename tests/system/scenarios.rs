@@ -203,9 +203,10 @@ fn the_log_records_the_seed_and_the_effects() {
         .map(|m| m.unwrap())
         .find(|m| m.channel.topic == "/joint_state")
         .unwrap();
-    let v: serde_json::Value = serde_json::from_slice(&state.data).unwrap();
-    assert_eq!(v["effects"], 0b11_0001);
-    assert_ne!(v["q"], v["q_measured"]);
+    let s = <wire::JointState as logger::LogMessage>::decode_as(logger::Encoding::Cdr, &state.data)
+        .unwrap();
+    assert_eq!(s.effects, 0b11_0001);
+    assert_ne!(s.q, s.q_measured);
 }
 
 #[test]

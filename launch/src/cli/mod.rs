@@ -76,6 +76,16 @@ enum Command {
     /// Prints a table (or JSON) on standard output; its runs' folders go
     /// under --runs-dir.
     Bench(BenchArgs),
+    /// The other side of `bench`'s iceoryx2 ping-pong (started by `bench`).
+    #[command(name = "bench-pong", hide = true)]
+    BenchPong {
+        /// The ping's run prefix.
+        #[arg(long)]
+        prefix: String,
+        /// Where to run (as lockstep's controller).
+        #[command(flatten)]
+        placement: launch::node::placement::Placement,
+    },
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
     ///
     /// Prints the summary on standard output; --csv FILE and --plots DIR
@@ -171,6 +181,10 @@ pub fn run() -> Result<ExitCode> {
         Command::Run(args) => run::run_stack(args, cli.verbose),
         Command::Replay(args) => replay::replay(args),
         Command::Bench(args) => bench::bench(args),
+        Command::BenchPong { prefix, placement } => {
+            launch::bench_pingpong::pong(&prefix, &placement)?;
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Compare(args) => compare::compare(args),
         Command::Sweep(cmd) => sweep::sweep(cmd),
         Command::Bindings { lang, out } => {

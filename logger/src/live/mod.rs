@@ -76,9 +76,9 @@ pub enum LiveError {
 
 /// A running live view, as the logger drives it.
 pub trait LiveView {
-    /// Offers one message of `topic` (its JSON) stamped `t_ns`: sent if its
-    /// topic is due and someone subscribed, skipped otherwise.
-    fn offer(&mut self, topic: &str, t_ns: u64, json: &[u8]);
+    /// Offers one message of `topic` (its CDR, as logged) stamped `t_ns`:
+    /// sent if its topic is due and someone subscribed, skipped otherwise.
+    fn offer(&mut self, topic: &str, t_ns: u64, data: &[u8]);
     /// The address the server listens on (the port chosen when asked for 0).
     fn address(&self) -> std::net::SocketAddr;
     /// Stops the server; what was sent, for the log's stats record.

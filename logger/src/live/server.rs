@@ -193,7 +193,7 @@ impl LiveView for Live {
         self.config.addr
     }
 
-    fn offer(&mut self, topic: &str, t_ns: u64, json: &[u8]) {
+    fn offer(&mut self, topic: &str, t_ns: u64, data: &[u8]) {
         let Some(t) = self.topics.iter_mut().find(|t| t.name == topic) else {
             return;
         };
@@ -210,7 +210,7 @@ impl LiveView for Live {
             return;
         }
         t.channel
-            .log_with_meta(json, PartialMetadata::with_log_time(t_ns));
+            .log_with_meta(data, PartialMetadata::with_log_time(t_ns));
         t.sent += 1;
         self.book.count(t.channel.id());
     }
@@ -242,11 +242,14 @@ fn open(ctx: &Arc<Context>, spec: &ChannelSpec) -> Result<LiveTopic, LiveError> 
         topic: spec.topic,
         cause,
     };
-    let schema = serde_json::to_vec(&spec.schema).map_err(|e| err(e.to_string()))?;
     let channel = ctx
         .channel_builder(spec.topic)
-        .message_encoding("json")
-        .schema(Schema::new(spec.schema_name, "jsonschema", schema))
+        .message_encoding(crate::MESSAGE_ENCODING)
+        .schema(Schema::new(
+            spec.schema_name.as_str(),
+            crate::SCHEMA_ENCODING,
+            spec.schema.as_bytes().to_vec(),
+        ))
         .build_raw()
         .map_err(|e| err(e.to_string()))?;
     Ok(LiveTopic {

@@ -1,0 +1,491 @@
+//! The log's messages as ROS 2 sees them: CDR data ([`crate::cdr`]) with
+//! `ros2msg` schema texts, as rosbag2 writes MCAP (the `ros2` profile).
+//!
+//! Each wire message is a message of the testbed's own package,
+//! `testbed_msgs/msg/<Name>`, made from its field list
+//! ([`wire::data_message!`]) like the JSON codec before it: the `.msg`
+//! text, the encoder and the decoder all walk that list, so they cannot
+//! drift apart. The fields follow a `std_msgs/Header` (stamp: the sample's
+//! sim time) and the wire header's `seq` and `wall_ns`, in the wire's
+//! order, with these types: `U32` → `uint32`, `U64` → `uint64`, `I64` →
+//! `int64`, `F64` → `float64`, `J` → `float64[]` (one entry per joint in
+//! use). The package is shipped in `logger/msg/testbed_msgs/`, generated
+//! from here (a test keeps it equal).
+//!
+//! Beside them the log carries standard messages for the tools that know
+//! only those: `sensor_msgs/msg/JointState` for the states and the
+//! commands, `tf2_msgs/msg/TFMessage` for the arm's frames and
+//! `visualization_msgs/msg/MarkerArray` for its stick figure.
+
+use wire::{FieldRef, FieldSource, Header, Joints, MAX_DOF, joints};
+
+use crate::LogMessage;
+use crate::cdr::{CdrReader, CdrWriter};
+use crate::json::DecodeError;
+
+/// The testbed's message package.
+pub const PACKAGE: &str = "testbed_msgs";
+
+/// What separates a schema text's message from the messages it uses.
+const SEPARATOR: &str =
+    "================================================================================";
+
+/// `builtin_interfaces/msg/Time`.
+const TIME: &str = "int32 sec\nuint32 nanosec\n";
+/// `std_msgs/msg/Header`.
+const HEADER: &str = "builtin_interfaces/Time stamp\nstring frame_id\n";
+
+/// A schema text: `main`, then each used message as `MSG: name` after a
+/// separator line (the `ros2msg` encoding rosbag2 writes).
+fn with_deps(main: &str, deps: &[(&str, &str)]) -> String {
+    let mut s = main.to_string();
+    for (name, text) in deps {
+        s.push_str(SEPARATOR);
+        s.push_str("\nMSG: ");
+        s.push_str(name);
+        s.push('\n');
+        s.push_str(text);
+    }
+    s
+}
+
+const HEADER_DEPS: [(&str, &str); 2] = [
+    ("std_msgs/Header", HEADER),
+    ("builtin_interfaces/Time", TIME),
+];
+
+/// The `testbed_msgs/msg/<Name>` name of a wire message.
+pub fn type_name<M: LogMessage>() -> String {
+    format!("{PACKAGE}/msg/{}", msg_name::<M>())
+}
+
+/// The message's name in its package (`JointState`, `Reference`, …).
+pub fn msg_name<M: LogMessage>() -> &'static str {
+    let s = M::LOG_SCHEMA;
+    s.rsplit('.').next().unwrap_or(s)
+}
+
+/// The `.msg` definition of a wire message, made from its field list.
+pub fn msg_text<M: LogMessage>() -> String {
+    let mut s = String::new();
+    for line in wrap(M::ABOUT, 76) {
+        s.push_str("# ");
+        s.push_str(&line);
+        s.push('\n');
+    }
+    s.push_str(
+        "# Generated from the wire's field list (crate wire, data_message!): do not edit.\n\n",
+    );
+    s.push_str("std_msgs/Header header  # stamp: the sample's sim time; frame_id empty\n");
+    s.push_str("uint64 seq  # sequence number (the control step for step-aligned topics)\n");
+    s.push_str("uint64 wall_ns  # CLOCK_MONOTONIC when published, ns\n");
+    M::default().visit(&mut |name, f| {
+        let ty = match f {
+            FieldRef::U32(_) => "uint32",
+            FieldRef::U(_) => "uint64",
+            FieldRef::I(_) => "int64",
+            FieldRef::F(_) => "float64",
+            FieldRef::J(_) => "float64[]",
+        };
+        s.push_str(ty);
+        s.push(' ');
+        s.push_str(name);
+        if matches!(f, FieldRef::J(_)) {
+            s.push_str("  # one entry per joint, in joint order");
+        }
+        s.push('\n');
+    });
+    s
+}
+
+/// The `ros2msg` schema of a wire message: its definition and the
+/// standard messages it uses.
+pub fn schema_text<M: LogMessage>() -> String {
+    with_deps(&msg_text::<M>(), &HEADER_DEPS)
+}
+
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for word in text.split_whitespace() {
+        let line = lines.last_mut().filter(|l| l.len() + word.len() < width);
+        match line {
+            Some(l) => {
+                if !l.is_empty() {
+                    l.push(' ');
+                }
+                l.push_str(word);
+            }
+            None => lines.push(word.to_string()),
+        }
+    }
+    lines
+}
+
+/// Appends the message's CDR to `out`.
+pub fn encode<M: LogMessage>(m: &M, out: &mut Vec<u8>) {
+    let h = m.header();
+    let mut w = CdrWriter::new(out);
+    w.header(h.t_ns, "");
+    w.u64(h.seq);
+    w.u64(h.wall_ns);
+    m.each_field(|_, f| match f {
+        FieldRef::U32(x) => w.u32(x),
+        FieldRef::U(x) => w.u64(x),
+        FieldRef::I(x) => w.i64(x),
+        FieldRef::F(x) => w.f64(x),
+        FieldRef::J(xs) => w.f64s(xs),
+    });
+}
+
+/// One field read from CDR.
+enum Val {
+    U(u64),
+    I(i64),
+    F(f64),
+    J(Box<Joints>),
+}
+
+/// A message's fields read from its CDR, in the order its field list
+/// gives, for [`wire::MessageFields::decode`].
+struct CdrFields(Vec<(&'static str, Val)>);
+
+impl CdrFields {
+    fn get(&self, k: &str) -> Result<&Val, String> {
+        self.0
+            .iter()
+            .find(|(n, _)| *n == k)
+            .map(|(_, v)| v)
+            .ok_or_else(|| format!("field '{k}' is missing"))
+    }
+}
+
+impl FieldSource for CdrFields {
+    fn u(&self, k: &str) -> Result<u64, String> {
+        match self.get(k)? {
+            Val::U(x) => Ok(*x),
+            _ => Err(format!("field '{k}' is not an unsigned integer")),
+        }
+    }
+    fn u32(&self, k: &str) -> Result<u32, String> {
+        u32::try_from(self.u(k)?).map_err(|_| format!("field '{k}' is out of range"))
+    }
+    fn i(&self, k: &str) -> Result<i64, String> {
+        match self.get(k)? {
+            Val::I(x) => Ok(*x),
+            _ => Err(format!("field '{k}' is not an integer")),
+        }
+    }
+    fn f(&self, k: &str) -> Result<f64, String> {
+        match self.get(k)? {
+            Val::F(x) => Ok(*x),
+            _ => Err(format!("field '{k}' is not a number")),
+        }
+    }
+    fn j(&self, k: &str) -> Result<Joints, String> {
+        match self.get(k)? {
+            Val::J(x) => Ok(**x),
+            _ => Err(format!("field '{k}' is not an array")),
+        }
+    }
+    fn has(&self, k: &str) -> bool {
+        self.get(k).is_ok()
+    }
+}
+
+/// The message back from its CDR.
+pub fn decode<M: LogMessage>(data: &[u8]) -> Result<M, DecodeError> {
+    let mut r = CdrReader::new(data)?;
+    let t_ns = r.time("header.stamp")?;
+    r.string("header.frame_id")?;
+    let header = Header {
+        seq: r.u64("seq")?,
+        t_ns,
+        wall_ns: r.u64("wall_ns")?,
+    };
+    let mut fields = Vec::with_capacity(32);
+    let mut err = None;
+    let mut xs = Vec::with_capacity(MAX_DOF);
+    M::default().visit(&mut |name, f| {
+        if err.is_some() {
+            return;
+        }
+        let v = match f {
+            FieldRef::U32(_) => r.u32(name).map(|x| Val::U(x.into())),
+            FieldRef::U(_) => r.u64(name).map(Val::U),
+            FieldRef::I(_) => r.i64(name).map(Val::I),
+            FieldRef::F(_) => r.f64(name).map(Val::F),
+            FieldRef::J(_) => r.f64s(name, &mut xs).and_then(|()| {
+                if xs.len() > MAX_DOF {
+                    Err(DecodeError(format!(
+                        "field '{name}' has {} entries (at most {MAX_DOF})",
+                        xs.len()
+                    )))
+                } else {
+                    Ok(Val::J(Box::new(joints(&xs))))
+                }
+            }),
+        };
+        match v {
+            Ok(v) => fields.push((name, v)),
+            Err(e) => err = Some(e),
+        }
+    });
+    if let Some(e) = err {
+        return Err(e);
+    }
+    if !r.at_end() {
+        return Err(DecodeError(format!(
+            "the CDR message is longer than a {}",
+            type_name::<M>()
+        )));
+    }
+    M::decode(header, &CdrFields(fields)).map_err(DecodeError)
+}
+
+/// `sensor_msgs/msg/JointState`.
+pub const JOINT_STATE: &str = "sensor_msgs/msg/JointState";
+
+/// The schema of [`JOINT_STATE`].
+pub fn joint_state_schema() -> String {
+    with_deps(
+        "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n",
+        &HEADER_DEPS,
+    )
+}
+
+/// A `sensor_msgs/msg/JointState` stamped `t_ns`.
+pub fn joint_state(
+    out: &mut Vec<u8>,
+    t_ns: u64,
+    names: &[String],
+    position: &[f64],
+    velocity: &[f64],
+    effort: &[f64],
+) {
+    let mut w = CdrWriter::new(out);
+    w.header(t_ns, "");
+    w.len(names.len());
+    for n in names {
+        w.string(n);
+    }
+    w.f64s(position);
+    w.f64s(velocity);
+    w.f64s(effort);
+}
+
+/// `tf2_msgs/msg/TFMessage`.
+pub const TF_MESSAGE: &str = "tf2_msgs/msg/TFMessage";
+
+const VECTOR3: &str = "float64 x\nfloat64 y\nfloat64 z\n";
+const QUATERNION: &str = "float64 x\nfloat64 y\nfloat64 z\nfloat64 w\n";
+
+/// The schema of [`TF_MESSAGE`].
+pub fn tf_schema() -> String {
+    with_deps(
+        "geometry_msgs/TransformStamped[] transforms\n",
+        &[
+            (
+                "geometry_msgs/TransformStamped",
+                "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/Transform transform\n",
+            ),
+            (
+                "geometry_msgs/Transform",
+                "geometry_msgs/Vector3 translation\ngeometry_msgs/Quaternion rotation\n",
+            ),
+            ("geometry_msgs/Vector3", VECTOR3),
+            ("geometry_msgs/Quaternion", QUATERNION),
+            HEADER_DEPS[0],
+            HEADER_DEPS[1],
+        ],
+    )
+}
+
+/// A rigid transform: translation x, y, z and rotation x, y, z, w.
+pub type Pose = ([f64; 3], [f64; 4]);
+
+/// A `tf2_msgs/msg/TFMessage`: each `(child, pose)` in `parent`, stamped `t_ns`.
+pub fn tf_message<'a>(
+    out: &mut Vec<u8>,
+    t_ns: u64,
+    parent: &str,
+    frames: impl ExactSizeIterator<Item = (&'a str, Pose)>,
+) {
+    let mut w = CdrWriter::new(out);
+    w.len(frames.len());
+    for (child, (t, r)) in frames {
+        w.header(t_ns, parent);
+        w.string(child);
+        for x in t.into_iter().chain(r) {
+            w.f64(x);
+        }
+    }
+}
+
+/// `visualization_msgs/msg/MarkerArray`.
+pub const MARKER_ARRAY: &str = "visualization_msgs/msg/MarkerArray";
+
+/// The schema of [`MARKER_ARRAY`] (the marker of ROS 2 Foxy and Galactic:
+/// no texture fields).
+pub fn marker_array_schema() -> String {
+    with_deps(
+        "visualization_msgs/Marker[] markers\n",
+        &[
+            (
+                "visualization_msgs/Marker",
+                "int32 ARROW=0\nint32 CUBE=1\nint32 SPHERE=2\nint32 CYLINDER=3\n\
+                 int32 ADD=0\nint32 DELETE=2\n\
+                 std_msgs/Header header\nstring ns\nint32 id\nint32 type\nint32 action\n\
+                 geometry_msgs/Pose pose\ngeometry_msgs/Vector3 scale\nstd_msgs/ColorRGBA color\n\
+                 builtin_interfaces/Duration lifetime\nbool frame_locked\n\
+                 geometry_msgs/Point[] points\nstd_msgs/ColorRGBA[] colors\n\
+                 string text\nstring mesh_resource\nbool mesh_use_embedded_materials\n",
+            ),
+            (
+                "geometry_msgs/Pose",
+                "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n",
+            ),
+            ("geometry_msgs/Point", VECTOR3),
+            ("geometry_msgs/Vector3", VECTOR3),
+            ("geometry_msgs/Quaternion", QUATERNION),
+            (
+                "std_msgs/ColorRGBA",
+                "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n",
+            ),
+            ("builtin_interfaces/Duration", TIME),
+            HEADER_DEPS[0],
+            HEADER_DEPS[1],
+        ],
+    )
+}
+
+/// One shape of the stick figure, locked to its frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Marker {
+    /// The frame it rides on (also its namespace).
+    pub frame: String,
+    /// Unique within the frame.
+    pub id: i32,
+    /// `Marker.SPHERE` (2) or `Marker.CYLINDER` (3).
+    pub kind: i32,
+    /// Its pose in the frame.
+    pub pose: Pose,
+    /// Its size along x, y, z.
+    pub scale: [f64; 3],
+    /// r, g, b, a.
+    pub color: [f32; 4],
+}
+
+/// A `visualization_msgs/msg/MarkerArray` of `markers`, stamped `t_ns`.
+pub fn marker_array(out: &mut Vec<u8>, t_ns: u64, markers: &[Marker]) {
+    let mut w = CdrWriter::new(out);
+    w.len(markers.len());
+    for m in markers {
+        w.header(t_ns, &m.frame);
+        w.string(&m.frame);
+        w.i32(m.id);
+        w.i32(m.kind);
+        w.i32(0);
+        for x in m.pose.0.into_iter().chain(m.pose.1).chain(m.scale) {
+            w.f64(x);
+        }
+        for c in m.color {
+            w.f32(c);
+        }
+        w.time(0);
+        w.u8(1);
+        w.len(0);
+        w.len(0);
+        w.string("");
+        w.string("");
+        w.u8(0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use wire::{Command, ControllerDiagnostics, JointState, Timing};
+
+    #[test]
+    fn every_field_round_trips_bit_for_bit() {
+        let mut s = JointState {
+            header: Header {
+                seq: 7,
+                t_ns: 7_000_000_123,
+                wall_ns: u64::MAX - 3,
+            },
+            dof: 3,
+            flags: 1,
+            effects: 0x1ff,
+            deadline_misses: 4,
+            command_seq: wire::NONE_U64,
+            applied_wall_ns: 99,
+            ..JointState::default()
+        };
+        s.q[0] = 0.1 + 0.2;
+        s.q[1] = -1e-300;
+        s.qd[0] = f64::NAN;
+        s.disturbance[2] = f64::INFINITY;
+        let mut out = Vec::new();
+        encode(&s, &mut out);
+        let back: JointState = decode(&out).unwrap();
+        assert_eq!(back.header, s.header);
+        for (a, b) in back.q.iter().zip(&s.q).chain(back.qd.iter().zip(&s.qd)) {
+            assert_eq!(a.to_bits(), b.to_bits());
+        }
+        assert_eq!(back.disturbance, s.disturbance);
+        assert_eq!(
+            (back.command_seq, back.effects, back.flags),
+            (s.command_seq, s.effects, s.flags)
+        );
+        let t = Timing {
+            round_trip_ns: -1,
+            deadline_missed: 1,
+            ..Timing::default()
+        };
+        out.clear();
+        encode(&t, &mut out);
+        assert_eq!(decode::<Timing>(&out).unwrap(), t);
+        let d = ControllerDiagnostics {
+            dof: MAX_DOF as u32,
+            gamma: 0.25,
+            tau: [1.5; MAX_DOF],
+            ..ControllerDiagnostics::default()
+        };
+        out.clear();
+        encode(&d, &mut out);
+        assert_eq!(decode::<ControllerDiagnostics>(&out).unwrap(), d);
+    }
+
+    #[test]
+    fn a_short_or_long_message_is_an_error() {
+        let mut out = Vec::new();
+        encode(&Command::default(), &mut out);
+        for cut in [0, 3, 10, out.len() - 1] {
+            assert!(decode::<Command>(&out[..cut]).is_err(), "{cut}");
+        }
+        out.extend([1; 8]);
+        assert!(decode::<Command>(&out).unwrap_err().0.contains("longer"));
+        // A JointState's bytes are not a Timing.
+        out.clear();
+        encode(&JointState::default(), &mut out);
+        assert!(decode::<Timing>(&out).is_err());
+    }
+
+    #[test]
+    fn msg_texts_list_every_field_with_its_type() {
+        let text = msg_text::<JointState>();
+        assert!(text.contains("\nfloat64[] q_measured  #"), "{text}");
+        assert!(text.contains("\nuint32 dof\n"), "{text}");
+        assert!(text.contains("\nuint64 command_seq\n"), "{text}");
+        assert!(!text.contains("reserved"));
+        assert!(msg_text::<Timing>().contains("\nint64 round_trip_ns\n"));
+        assert_eq!(
+            type_name::<wire::ReferenceSample>(),
+            "testbed_msgs/msg/Reference"
+        );
+        let schema = schema_text::<Command>();
+        assert!(schema.contains(&format!("{SEPARATOR}\nMSG: std_msgs/Header\n")));
+    }
+}

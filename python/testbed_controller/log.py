@@ -1,0 +1,147 @@
+"""Read a run's log (`runs/<id>/run.mcap`) into numpy tables, one per topic.
+
+    import testbed_controller.log as tlog
+    log = tlog.read_log("runs/<id>/run.mcap")
+    state = log["/joint_state"]           # dict of numpy arrays
+    state["t"], state["q"][:, 0]          # sim time (s), joint 1's position
+    diag = log["/controller/diagnostics"]
+    log.run["joint_names"], log.stats     # the run's metadata and the logger's counts
+
+Built on the official readers: `mcap` for the file and `mcap-ros2-support`
+for the messages (CDR with `ros2msg` schemas, log format 3), so every field
+is decoded by the same code ROS 2 tools use; nothing here knows the
+testbed's message layouts.
+
+Each table has a row per message, in log order: `log_time_ns`; `t_ns` and
+`t` (seconds) from `header.stamp` when the message has one; every numeric
+field (nested fields as `a.b`); per-joint `float64[]` fields as 2-D arrays
+(rows × joints). A field whose rows differ in length (or that holds
+strings or messages) is an object array. `to_dataframe` turns a table into
+a pandas DataFrame (`q[0]`, `q[1]`, … for per-joint fields), if pandas is
+installed.
+"""
+
+from __future__ import annotations
+
+from typing import Dict, Iterable, List, Optional
+
+import numpy as np
+
+__all__ = ["Log", "read_log", "to_dataframe"]
+
+
+class Log(dict):
+    """Topic → table (a dict of numpy arrays), with the run's metadata."""
+
+    def __init__(self, path: str):
+        super().__init__()
+        self.path = path
+        #: The `testbed.run` metadata (scenario TOML, mode, joint names, ...).
+        self.run: Dict[str, str] = {}
+        #: The logger's counts (`testbed.log_stats`), empty if it never finished.
+        self.stats: Dict[str, str] = {}
+        #: ROS 2 type of each topic (`testbed_msgs/msg/JointState`, ...).
+        self.types: Dict[str, str] = {}
+
+    @property
+    def log_format(self) -> int:
+        return int(self.run.get("log_format", "1"))
+
+
+def _is_message(x) -> bool:
+    return hasattr(x, "__slots__") and not isinstance(x, (str, bytes))
+
+
+def _flatten(msg, prefix: str, row: Dict[str, object]) -> None:
+    for name in msg.__slots__:
+        value = getattr(msg, name)
+        key = prefix + name
+        if _is_message(value):
+            _flatten(value, key + ".", row)
+        else:
+            row[key] = value
+
+
+def _column(values: List[object]) -> np.ndarray:
+    first = values[0]
+    if isinstance(first, bool):
+        return np.array(values, dtype=bool)
+    if isinstance(first, int):
+        try:
+            return np.array(values, dtype=np.int64)
+        except OverflowError:
+            return np.array(values, dtype=np.uint64)
+    if isinstance(first, float):
+        return np.array(values, dtype=np.float64)
+    if isinstance(first, (list, tuple)) and all(
+        isinstance(v, (list, tuple)) and len(v) == len(first) for v in values
+    ):
+        if all(isinstance(x, (int, float)) for v in values[:1] for x in v):
+            return np.array(values, dtype=np.float64).reshape(len(values), len(first))
+    out = np.empty(len(values), dtype=object)
+    out[:] = values
+    return out
+
+
+def _table(rows: List[Dict[str, object]], log_times: List[int]) -> Dict[str, np.ndarray]:
+    table: Dict[str, np.ndarray] = {"log_time_ns": np.array(log_times, dtype=np.int64)}
+    if "header.stamp.sec" in rows[0]:
+        t_ns = np.array(
+            [r["header.stamp.sec"] * 1_000_000_000 + r["header.stamp.nanosec"] for r in rows],
+            dtype=np.int64,
+        )
+        table["t_ns"] = t_ns
+        table["t"] = t_ns / 1e9
+    for key in rows[0]:
+        table[key] = _column([r[key] for r in rows])
+    return table
+
+
+def read_log(path: str, topics: Optional[Iterable[str]] = None) -> Log:
+    """Every message of the log at `path` (or of `topics` only), decoded by
+    the official ROS 2 decoder, as one table per topic. A log of format 1 or
+    2 (JSON messages) is refused: `testbed replay --csv` reads those."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    log = Log(path)
+    rows: Dict[str, List[Dict[str, object]]] = {}
+    times: Dict[str, List[int]] = {}
+    with open(path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for record in reader.iter_metadata():
+            if record.name == "testbed.run":
+                log.run = dict(record.metadata)
+            elif record.name == "testbed.log_stats":
+                log.stats = dict(record.metadata)
+        if log.log_format < 3:
+            raise ValueError(
+                f"{path} is a log of format {log.log_format} (JSON messages); "
+                "read it with `testbed replay --csv`"
+            )
+        wanted = list(topics) if topics is not None else None
+        for schema, channel, message, decoded in reader.iter_decoded_messages(
+            topics=wanted, log_time_order=False
+        ):
+            log.types.setdefault(channel.topic, schema.name if schema else "")
+            row: Dict[str, object] = {}
+            _flatten(decoded, "", row)
+            rows.setdefault(channel.topic, []).append(row)
+            times.setdefault(channel.topic, []).append(message.log_time)
+    for topic, r in rows.items():
+        log[topic] = _table(r, times[topic])
+    return log
+
+
+def to_dataframe(table: Dict[str, np.ndarray]):
+    """A table as a pandas DataFrame: per-joint arrays become `name[i]` columns."""
+    import pandas as pd
+
+    cols: Dict[str, np.ndarray] = {}
+    for key, v in table.items():
+        if v.ndim == 2:
+            for i in range(v.shape[1]):
+                cols[f"{key}[{i}]"] = v[:, i]
+        else:
+            cols[key] = v
+    return pd.DataFrame(cols)
