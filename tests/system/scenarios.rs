@@ -1,8 +1,5 @@
 //! The shipped scenarios and the plant effects they turn on, end to end.
-
-use std::path::Path;
-
-use crate::util::{assert_same_csv, fails, json, ok, repo_root, testbed};
+use crate::util::{assert_same_csv, csv_of, fails, json, ok, repo_root, testbed};
 
 /// Every shipped scenario, as listed by `testbed scenarios`.
 fn shipped() -> Vec<String> {
@@ -60,12 +57,6 @@ fn every_shipped_scenario_keeps_its_envelope() {
             assert!(active.contains(w), "{name}: {w} not in {active:?}");
         }
     }
-}
-
-fn csv_of(args: &[&str], dir: &Path, name: &str) -> Vec<u8> {
-    let path = dir.join(name);
-    ok(testbed().args(args).arg("--csv").arg(&path));
-    std::fs::read(&path).unwrap()
 }
 
 /// Every random effect at once (sensor noise, quantisation, disturbance

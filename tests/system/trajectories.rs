@@ -5,13 +5,7 @@
 
 use std::path::Path;
 
-use crate::util::{assert_same_csv, fails, json, ok, ran, repo_root, testbed};
-
-fn csv_of(args: &[&str], dir: &Path, name: &str) -> Vec<u8> {
-    let path = dir.join(name);
-    ok(testbed().args(args).arg("--csv").arg(&path));
-    std::fs::read(&path).unwrap()
-}
+use crate::util::{assert_same_csv, csv_of, fails, json, ok, ran, repo_root, testbed};
 
 #[test]
 fn waypoints_and_a_trajectory_file_run_bit_identical_in_sim_and_lockstep() {

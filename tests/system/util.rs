@@ -179,3 +179,10 @@ pub fn shm_files(prefix: &str) -> Vec<String> {
         })
         .unwrap_or_default()
 }
+
+/// Runs `testbed ARGS --csv DIR/NAME` and returns the CSV's bytes.
+pub fn csv_of(args: &[&str], dir: &Path, name: &str) -> Vec<u8> {
+    let path = dir.join(name);
+    ok(testbed().args(args).arg("--csv").arg(&path));
+    std::fs::read(&path).unwrap()
+}

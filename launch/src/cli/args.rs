@@ -116,12 +116,7 @@ fn parse_external_law(s: &str) -> Result<(String, String), String> {
     let (name, cmd) = s
         .split_once('=')
         .ok_or_else(|| format!("{s:?} is not NAME=CMD (e.g. pid=\"python3 my.py\")"))?;
-    let ok = !name.is_empty()
-        && name.len() <= 40
-        && name
-            .chars()
-            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_');
-    if !ok {
+    if !launch::run::external::is_law_name(name) {
         return Err(format!(
             "{name:?} is not a row name (1 to 40 of a-z, 0-9, '-', '_')"
         ));

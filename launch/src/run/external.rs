@@ -110,18 +110,23 @@ fn same_kind(a: &Value, b: &Value) -> bool {
     }
 }
 
+/// Whether `name` may name a law: 1 to 40 of a-z, 0-9, `-`, `_` (it
+/// labels rows, files and log records).
+pub fn is_law_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.len() <= 40
+        && name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_')
+}
+
 /// Reads a description: a name of lowercase letters, digits, `-` and `_`,
 /// and parameters that are numbers, booleans, strings or lists.
 fn parse(text: &str) -> Result<Declared, String> {
     let v: Value = serde_json::from_str(text.trim())
         .map_err(|e| format!("`--describe` printed no JSON object: {e}"))?;
     let name = v["name"].as_str().unwrap_or_default().to_string();
-    let ok_name = !name.is_empty()
-        && name.len() <= 40
-        && name
-            .chars()
-            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-' || c == '_');
-    if !ok_name {
+    if !is_law_name(&name) {
         return Err(format!(
             "`--describe` gave the name {:?}: 1 to 40 of a-z, 0-9, '-', '_'",
             v["name"]
