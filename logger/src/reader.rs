@@ -96,22 +96,91 @@ pub type OnMessage<'a> = &'a mut dyn FnMut(&str, Encoding, &[u8]) -> Result<(), 
 /// Reads `path` record by record, calling `on_message(topic, data)` (if
 /// given) for every message in file order. A truncated or unfinished file is
 /// read up to its last whole record; `cut_short` then says why it ended.
+///
+/// The file is read one top-level record at a time (a chunk is about a
+/// megabyte), so memory stays the same whatever the log's length.
 pub fn read_log(path: &Path, on_message: Option<OnMessage<'_>>) -> Result<LogContents, LogError> {
-    read_log_bytes(&read_file(path)?, path, on_message)
-}
-
-fn read_file(path: &Path) -> Result<Vec<u8>, LogError> {
-    wire::read_regular_file(path, None).map_err(|cause| LogError::Io {
-        path: path.display().to_string(),
-        cause,
-    })
+    stream(path, on_message, false)
 }
 
 /// The run's metadata and URDF of the log at `path`: the records before its
 /// first message (where the logger writes them), without unpacking the
 /// rest. Only `run` and `urdf` are read.
 pub fn read_log_head(path: &Path) -> Result<LogContents, LogError> {
-    read(&read_file(path)?, path, None, true)
+    stream(path, None, true)
+}
+
+/// [`read`] over the file at `path`, record by record: each top-level
+/// record's framing is checked (as [`crate::scan::sound_prefix`] does for a
+/// whole buffer) before its bytes are handed on.
+fn stream(
+    path: &Path,
+    mut on_message: Option<OnMessage<'_>>,
+    head_only: bool,
+) -> Result<LogContents, LogError> {
+    use std::io::Read;
+    let p = path.display().to_string();
+    let io = |cause| LogError::Io {
+        path: p.clone(),
+        cause,
+    };
+    let file = wire::open_regular_file(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    let mut file = std::io::BufReader::with_capacity(1 << 20, file);
+    let mut magic = [0u8; 8];
+    if file.read_exact(&mut magic).is_err() || magic != *mcap::MAGIC {
+        return Err(LogError::NotATestbedLog {
+            path: p,
+            reason: "not an MCAP file (no MCAP magic at the start)".into(),
+        });
+    }
+    let mut walk = Walk::new(path);
+    let mut at = magic.len() as u64;
+    let mut part = Vec::new();
+    while at < len {
+        let rest = len - at;
+        let mut header = [0u8; 9];
+        if rest < 9 || file.read_exact(&mut header).is_err() {
+            walk.damaged = Some(format!("the file ends inside a record header at byte {at}"));
+            break;
+        }
+        let op = header[0];
+        let mut l8 = [0u8; 8];
+        l8.copy_from_slice(&header[1..]);
+        let body_len = u64::from_le_bytes(l8);
+        if body_len > rest - 9 || body_len > crate::scan::MAX_CHUNK_BYTES {
+            walk.damaged = Some(format!(
+                "the record at byte {at} (opcode {op:#04x}) claims {body_len} bytes but {} remain: \
+                 the file is cut short or damaged",
+                rest - 9
+            ));
+            break;
+        }
+        part.clear();
+        part.extend_from_slice(mcap::MAGIC);
+        part.extend_from_slice(&header);
+        let start = part.len();
+        part.resize(start + body_len as usize, 0);
+        file.read_exact(&mut part[start..]).map_err(io)?;
+        if op == crate::scan::OP_CHUNK
+            && let Some(why) = crate::scan::check_chunk(&part[start..])
+        {
+            walk.damaged = Some(format!("the chunk at byte {at} is damaged: {why}"));
+            break;
+        }
+        if walk.feed(
+            crate::records::Records::part(&part),
+            &mut on_message,
+            head_only,
+        )? {
+            break;
+        }
+        at += 9 + body_len;
+        if op == crate::scan::OP_FOOTER {
+            break;
+        }
+    }
+    walk.finish(head_only)
 }
 
 /// [`read_log`] of a log already in memory (`path` names it in messages).
@@ -129,75 +198,114 @@ fn read(
     mut on_message: Option<OnMessage<'_>>,
     head_only: bool,
 ) -> Result<LogContents, LogError> {
-    let p = path.display().to_string();
     if !buf.starts_with(mcap::MAGIC) {
         return Err(LogError::NotATestbedLog {
-            path: p,
+            path: path.display().to_string(),
             reason: "not an MCAP file (no MCAP magic at the start)".into(),
         });
     }
-    let mut out = LogContents {
-        path: path.to_path_buf(),
-        ..LogContents::default()
-    };
-    let mut topics: HashMap<u16, (String, Result<Encoding, String>)> = HashMap::new();
+    let mut walk = Walk::new(path);
     // Only the soundly framed part goes to the reader (see `scan`).
     let (end, damaged) = crate::scan::sound_prefix(buf);
-    let records = crate::records::Records::new(&buf[..end]);
-    for record in records {
-        let record = match record {
-            Ok(r) => r,
-            Err(e) => {
-                out.cut_short = Some(if e.to_lowercase().contains("crc") {
-                    format!(
-                        "a chunk is damaged (its checksum does not match: {e}); it and what follows are left out"
-                    )
-                } else {
-                    format!("the file ends inside a record ({e})")
-                });
-                break;
-            }
-        };
-        match record {
-            Record::Channel(c) => {
-                let enc = Encoding::of(&c.message_encoding).ok_or(c.message_encoding);
-                topics.insert(c.id, (c.topic, enc));
-            }
-            Record::Message { .. } if head_only => break,
-            Record::Message { header, data } => {
-                let topic = topics.get(&header.channel_id);
-                if let (Some((topic, enc)), Some(handler)) = (topic, on_message.as_mut())
-                    && let Some(why) = deliver(handler, topic, enc, &data, &p)?
-                {
-                    out.cut_short = Some(why);
-                    break;
-                }
-                out.messages += 1;
-            }
-            Record::Metadata(m) if m.name == RUN_METADATA => out.run = m.metadata,
-            Record::Metadata(m) if m.name == STATS_METADATA => out.stats = Some(m.metadata),
-            Record::Attachment { header, data, .. } if header.name == URDF_ATTACHMENT => {
-                out.urdf = Some(String::from_utf8_lossy(&data).to_string());
-            }
-            Record::Footer(_) => out.complete = true,
-            _ => {}
+    walk.damaged = damaged;
+    walk.feed(
+        crate::records::Records::new(&buf[..end]),
+        &mut on_message,
+        head_only,
+    )?;
+    walk.finish(head_only)
+}
+
+/// What a log has said so far, record by record.
+struct Walk {
+    out: LogContents,
+    p: String,
+    topics: HashMap<u16, (String, Result<Encoding, String>)>,
+    /// Where the framing stopped being sound, if it did.
+    damaged: Option<String>,
+}
+
+impl Walk {
+    fn new(path: &Path) -> Self {
+        Self {
+            out: LogContents {
+                path: path.to_path_buf(),
+                ..LogContents::default()
+            },
+            p: path.display().to_string(),
+            topics: HashMap::new(),
+            damaged: None,
         }
     }
-    if let Some(why) = damaged
-        && out.cut_short.is_none()
-    {
-        out.cut_short = Some(why);
+
+    /// Takes `records`; true when reading is to stop.
+    fn feed(
+        &mut self,
+        records: crate::records::Records<'_>,
+        on_message: &mut Option<OnMessage<'_>>,
+        head_only: bool,
+    ) -> Result<bool, LogError> {
+        let out = &mut self.out;
+        for record in records {
+            let record = match record {
+                Ok(r) => r,
+                Err(e) => {
+                    out.cut_short = Some(if e.to_lowercase().contains("crc") {
+                        format!(
+                            "a chunk is damaged (its checksum does not match: {e}); it and what follows are left out"
+                        )
+                    } else {
+                        format!("the file ends inside a record ({e})")
+                    });
+                    return Ok(true);
+                }
+            };
+            match record {
+                Record::Channel(c) => {
+                    let enc = Encoding::of(&c.message_encoding).ok_or(c.message_encoding);
+                    self.topics.insert(c.id, (c.topic, enc));
+                }
+                Record::Message { .. } if head_only => return Ok(true),
+                Record::Message { header, data } => {
+                    let topic = self.topics.get(&header.channel_id);
+                    if let (Some((topic, enc)), Some(handler)) = (topic, on_message.as_mut())
+                        && let Some(why) = deliver(handler, topic, enc, &data, &self.p)?
+                    {
+                        out.cut_short = Some(why);
+                        return Ok(true);
+                    }
+                    out.messages += 1;
+                }
+                Record::Metadata(m) if m.name == RUN_METADATA => out.run = m.metadata,
+                Record::Metadata(m) if m.name == STATS_METADATA => out.stats = Some(m.metadata),
+                Record::Attachment { header, data, .. } if header.name == URDF_ATTACHMENT => {
+                    out.urdf = Some(String::from_utf8_lossy(&data).to_string());
+                }
+                Record::Footer(_) => out.complete = true,
+                _ => {}
+            }
+        }
+        Ok(false)
     }
-    if out.run.is_empty() {
-        return Err(LogError::NotATestbedLog {
-            path: p,
-            reason: "no testbed.run metadata: not a log written by testbed".into(),
-        });
+
+    fn finish(mut self, head_only: bool) -> Result<LogContents, LogError> {
+        let out = &mut self.out;
+        if let Some(why) = self.damaged
+            && out.cut_short.is_none()
+        {
+            out.cut_short = Some(why);
+        }
+        if out.run.is_empty() {
+            return Err(LogError::NotATestbedLog {
+                path: self.p,
+                reason: "no testbed.run metadata: not a log written by testbed".into(),
+            });
+        }
+        if !out.complete && out.cut_short.is_none() && !head_only {
+            out.cut_short = Some("the logger never finished the file (no footer)".into());
+        }
+        Ok(self.out)
     }
-    if !out.complete && out.cut_short.is_none() && !head_only {
-        out.cut_short = Some("the logger never finished the file (no footer)".into());
-    }
-    Ok(out)
 }
 
 /// Hands one message to the handler: None when it took it, Some(why) when

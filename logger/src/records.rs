@@ -23,6 +23,17 @@ pub struct Records<'a> {
 impl<'a> Records<'a> {
     /// The records of `buf`.
     pub fn new(buf: &'a [u8]) -> Self {
+        Self::with_data_crc(buf, true)
+    }
+
+    /// The records of `buf`, one top-level record of a file after the
+    /// magic: the data section's checksum covers the whole file, so it is
+    /// not checked here (each chunk's is).
+    pub fn part(buf: &'a [u8]) -> Self {
+        Self::with_data_crc(buf, false)
+    }
+
+    fn with_data_crc(buf: &'a [u8], data_crc: bool) -> Self {
         Self {
             buf,
             reader: LinearReader::new_with_options(
@@ -31,7 +42,7 @@ impl<'a> Records<'a> {
                     // A chunk is checked before any of its records is used:
                     // a flipped byte once changed a summary without a word.
                     .with_prevalidate_chunk_crcs(true)
-                    .with_validate_data_section_crc(true)
+                    .with_validate_data_section_crc(data_crc)
                     .with_record_length_limit(MAX_RECORD_BYTES),
             ),
         }

@@ -8,8 +8,8 @@
 /// are a few MB at most): a damaged size field.
 pub const MAX_CHUNK_BYTES: u64 = 256 << 20;
 
-const OP_FOOTER: u8 = 0x02;
-const OP_CHUNK: u8 = 0x06;
+pub(crate) const OP_FOOTER: u8 = 0x02;
+pub(crate) const OP_CHUNK: u8 = 0x06;
 
 /// How far the records of `buf` (a whole MCAP file) are sound: the byte
 /// offset where reading must stop, and why when that is before the end.
@@ -53,7 +53,7 @@ pub fn sound_prefix(buf: &[u8]) -> (usize, Option<String>) {
 }
 
 /// A chunk's sizes agree with its body and are plausible.
-fn check_chunk(body: &[u8]) -> Option<String> {
+pub(crate) fn check_chunk(body: &[u8]) -> Option<String> {
     // start, end, uncompressed size (u64 each), crc (u32), compression (u32 length + text).
     if body.len() < 32 {
         return Some("shorter than its fixed fields".into());

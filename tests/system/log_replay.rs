@@ -367,3 +367,41 @@ fn golden_logs_of_every_format_still_replay() {
     assert_eq!(v2["timing"]["stale_references"], 0);
     assert_eq!(v2["timing"]["recount"]["deadline_misses"], 0);
 }
+
+/// #31 row 6: a log file is read record by record (memory does not grow
+/// with its length), and what that gives equals reading it whole, for the
+/// whole file and for the file cut at points inside records.
+#[test]
+fn a_log_read_from_its_file_equals_the_log_read_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, log) = lockstep_run(dir.path(), "3");
+    let bytes = std::fs::read(&log).unwrap();
+    for cut in [bytes.len(), bytes.len() - 7, bytes.len() * 2 / 3, 4096, 300] {
+        let path = dir.path().join(format!("cut{cut}.mcap"));
+        std::fs::write(&path, &bytes[..cut]).unwrap();
+        let (mut a, mut b) = (Vec::<String>::new(), Vec::<String>::new());
+        let mut on_a = |topic: &str, _: logger::Encoding, data: &[u8]| {
+            a.push(format!("{topic}:{}", data.len()));
+            Ok(())
+        };
+        let streamed = logger::read_log(&path, Some(&mut on_a));
+        let mut on_b = |topic: &str, _: logger::Encoding, data: &[u8]| {
+            b.push(format!("{topic}:{}", data.len()));
+            Ok(())
+        };
+        let whole = logger::read_log_bytes(&bytes[..cut], &path, Some(&mut on_b));
+        match (streamed, whole) {
+            (Ok(s), Ok(w)) => {
+                assert_eq!(a, b, "cut at {cut}");
+                assert_eq!(
+                    (s.messages, s.complete, s.run, s.stats, s.urdf),
+                    (w.messages, w.complete, w.run, w.stats, w.urdf),
+                    "cut at {cut}"
+                );
+                assert_eq!(s.cut_short.is_some(), w.cut_short.is_some(), "cut at {cut}");
+            }
+            (Err(s), Err(w)) => assert_eq!(s.to_string(), w.to_string()),
+            (s, w) => panic!("cut at {cut}: streamed {s:?}, whole {w:?}"),
+        }
+    }
+}

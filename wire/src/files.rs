@@ -11,6 +11,18 @@ pub const MAX_TEXT_FILE_BYTES: u64 = 16 << 20;
 /// under 1 MB).
 pub const MAX_URDF_BYTES: u64 = 16 << 20;
 
+/// Opens `path` for reading if it is a regular file (a device, FIFO or
+/// folder is refused before it is opened: opening a FIFO would block).
+pub fn open_regular_file(path: &Path) -> std::io::Result<std::fs::File> {
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a device, FIFO or folder is not read)",
+        ));
+    }
+    std::fs::File::open(path)
+}
+
 /// The bytes of the regular file at `path`, at most `max_bytes` of them
 /// (`None`: no limit).
 pub fn read_regular_file(path: &Path, max_bytes: Option<u64>) -> std::io::Result<Vec<u8>> {

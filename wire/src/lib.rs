@@ -42,7 +42,9 @@ pub use binding::{Bound, struct_of};
 pub use effects::Effects;
 pub use faults::Fault;
 pub use fields::{FieldRef, FieldSource, MessageFields};
-pub use files::{MAX_TEXT_FILE_BYTES, MAX_URDF_BYTES, read_regular_file, read_text_file};
+pub use files::{
+    MAX_TEXT_FILE_BYTES, MAX_URDF_BYTES, open_regular_file, read_regular_file, read_text_file,
+};
 pub use iceoryx2::prelude::ZeroCopySend;
 pub use layout::{
     FieldLayout, FieldType, TypeLayout, WireField, WireLayout, all_layouts, field_size,
