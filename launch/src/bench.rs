@@ -237,16 +237,21 @@ impl FloorProbe {
         }
     }
 
-    /// Stops the loop; the figures of the deadlines inside `window` (ns).
-    fn finish(self, window: (u64, u64), rate_hz: f64) -> TimerFloor {
+    /// Stops the loop; the figures of `cycles` deadlines from the one the
+    /// run's first wake-up (`first_wake_ns`) belongs to. Counting deadlines,
+    /// not a wall-clock window, keeps a late last wake-up of the run from
+    /// adding periods to the floor.
+    fn finish(self, first_wake_ns: u64, cycles: u64, rate_hz: f64) -> TimerFloor {
         self.stop.store(true, Ordering::Relaxed);
         let (wakes, refused) = self.handle.join().unwrap_or_default();
         let period = self.period_ns;
+        let first_deadline = first_wake_ns / period * period;
         let mut stats = TimingStats::new(period);
         let mut last: Option<u64> = None;
         for &(deadline, wake) in wakes
             .iter()
-            .filter(|(d, _)| (window.0..=window.1).contains(d))
+            .filter(|(d, _)| *d >= first_deadline)
+            .take(usize::try_from(cycles).unwrap_or(usize::MAX))
         {
             stats.add(&wire::Timing {
                 wake_late_ns: wake as i64 - deadline as i64,
@@ -318,10 +323,10 @@ pub(crate) fn realtime_part(
     // running until the run is over, and only the run's window counts.
     let probe = FloorProbe::start(plan.scenario.rate_hz, opts.realtime_s + 60.0, &placement);
     let rt = stack(&rt_plan, Mode::Realtime, opts, controller_cmd);
-    let floor = probe.finish(
-        rt.as_ref().map_or((0, 0), |r| r.analysis.wall_window_ns),
-        plan.scenario.rate_hz,
-    );
+    let (first_wake, cycles) = rt.as_ref().map_or((0, 0), |r| {
+        (r.analysis.wall_window_ns.0, r.analysis.timing.cycles)
+    });
+    let floor = probe.finish(first_wake, cycles, plan.scenario.rate_hz);
     let rt = rt?;
     let t = &rt.analysis.timing;
     let figures = RealtimeFigures {
