@@ -15,9 +15,11 @@
 //! placement) are ignored.
 //!
 //! It is also a law of its own for `testbed run --controller-cmd`: asked
-//! `--describe`, it declares its name and parameters (`kp`, `kd`), which
-//! the scenario's `[external]` table may set (docs/python.md explains
-//! the declaration; it is the same for any language). As a member of the
+//! `--describe`, it declares its name, its parameters (`kp`, `kd`), which
+//! the scenario's `[external]` table may set, and a diagnostic of its own,
+//! `error_norm` = ‖q − q_d‖, published on the own-diagnostics topic when
+//! the launcher asks for it (docs/python.md explains the declaration; it
+//! is the same for any language). As a member of the
 //! workspace it builds with the testbed, reusing its build:
 //! `cargo build --release --bin example-pd-controller`.
 
@@ -26,7 +28,9 @@ use std::time::Duration;
 
 use bus::{NodeLink, ReferenceWindow, RunPrefix, monotonic_ns, read_config};
 use controller::node::ControllerNodeConfig;
-use wire::{Command, ControllerDiagnostics, JointState, Mode, NodeKind, STATE_FINAL, Topic};
+use wire::{
+    Command, ControllerDiagnostics, JointState, Mode, NodeKind, OwnDiagnostics, STATE_FINAL, Topic,
+};
 
 /// The declared defaults of the law's own parameters.
 const KP: f64 = 400.0;
@@ -34,7 +38,10 @@ const KD: f64 = 40.0;
 
 fn main() -> ExitCode {
     if std::env::args().skip(1).eq(["--describe"]) {
-        println!(r#"{{"name": "pd-example", "params": {{"kp": {KP:?}, "kd": {KD:?}}}}}"#);
+        println!(
+            r#"{{"name": "pd-example", "params": {{"kp": {KP:?}, "kd": {KD:?}}},
+                "diagnostics": {{"error_norm": "scalar"}}}}"#
+        );
         return ExitCode::SUCCESS;
     }
     match run() {
@@ -83,6 +90,16 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let diagnostics = link
         .bus
         .publisher::<ControllerDiagnostics>(Topic::Diagnostics, mode.delivery())?;
+    // Its own diagnostic, only when the launcher laid it out (a run by
+    // hand with --external declared nothing, and the log expects nothing).
+    let own = if config.own_diagnostics == "error_norm:scalar" {
+        Some(
+            link.bus
+                .publisher::<OwnDiagnostics>(Topic::OwnDiagnostics, mode.delivery())?,
+        )
+    } else {
+        None
+    };
     link.ready_and_wait_for_start()?;
     let mut handled = 0;
     'run: loop {
@@ -126,6 +143,15 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 stale_references: references.stale_count(),
             })?;
             diagnostics.send(d)?;
+            if let Some(own) = &own {
+                let mut o = OwnDiagnostics {
+                    header: d.header,
+                    count: 1,
+                    ..OwnDiagnostics::default()
+                };
+                o.values[0] = d.z1[..n].iter().map(|e| e * e).sum::<f64>().sqrt();
+                own.send(o)?;
+            }
             handled += 1;
             // The launcher and STOP are checked every 256 states and on a
             // timeout: the check also sends the heartbeat the launcher expects.

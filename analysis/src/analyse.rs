@@ -7,7 +7,11 @@ use std::io::Write;
 use std::path::Path;
 
 use scenario::{Plan, RobotSource, Scenario};
-use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
+use wire::{
+    Command, ControllerDiagnostics, JointState, OwnDiagnostics, OwnLayout, ReferenceSample, Timing,
+};
+
+use crate::own::{OwnDiagnosticSummary, OwnStats};
 
 use crate::assemble::RecordAssembler;
 use crate::csv_out;
@@ -140,6 +144,9 @@ pub struct LogAnalysis {
     pub wall_span_s: f64,
     /// CLOCK_MONOTONIC of the first and the last logged joint state, ns.
     pub wall_window_ns: (u64, u64),
+    /// An external controller's own diagnostics, summed up (empty when it
+    /// declared none).
+    pub own_diagnostics: Vec<OwnDiagnosticSummary>,
 }
 
 impl LogAnalysis {
@@ -214,6 +221,9 @@ struct Analyser<'a, 'o> {
     verifier: Option<Verifier>,
     csv: Option<&'o mut dyn Write>,
     wall: (u64, u64),
+    /// Values an own-diagnostics sample carries (0: none declared).
+    own_len: usize,
+    own: OwnStats,
 }
 
 impl Analyser<'_, '_> {
@@ -248,6 +258,17 @@ impl Analyser<'_, '_> {
                 }
             }
             t if t == Timing::LOG_TOPIC => self.on_timing(&Timing::decode_as(enc, v)?),
+            t if t == OwnDiagnostics::LOG_TOPIC => {
+                let o = OwnDiagnostics::decode_as(enc, v)?;
+                if o.count as usize != self.own_len {
+                    return Err(DecodeError(format!(
+                        "{} values where the run's controller_diagnostics declares {}",
+                        o.count, self.own_len
+                    ))
+                    .into());
+                }
+                self.assembler.push_own(o);
+            }
             t if t == ReferenceSample::LOG_TOPIC => {
                 ReferenceSample::decode_as(enc, v)?;
             }
@@ -257,8 +278,10 @@ impl Analyser<'_, '_> {
             _ => logger::check_message(enc, v)?,
         }
         let (summary, series, csv) = (&mut self.summary, &mut self.series, &mut self.csv);
+        let own = &mut self.own;
         self.assembler.emit(|r| {
             summary.add(r);
+            own.add(r.own);
             if let Some(s) = series.as_mut() {
                 s.add(r);
             }
@@ -289,6 +312,8 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
     let head = read_log_head(path)?;
     let (plan, mode) = plan_from(&head)?;
     let n = plan.robot.model.dof();
+    let own = own_layout(&head, n)?;
+    let own_len = own.len(n);
     let verifier = if opts.verify {
         Some(Verifier::new(
             plan.controller_node_config()
@@ -307,12 +332,15 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         cause,
     };
     if let Some(w) = csv.as_mut() {
-        writeln!(w, "{}", csv_out::header(n)).map_err(out_err)?;
+        writeln!(w, "{}", csv_out::header_with_own(n, &own.columns(n))).map_err(out_err)?;
     }
     let mut a = Analyser {
         plan: &plan,
         n,
-        assembler: RecordAssembler::new(n, plan.dt(), plan.steps),
+        assembler: match own_len {
+            0 => RecordAssembler::new(n, plan.dt(), plan.steps),
+            len => RecordAssembler::new(n, plan.dt(), plan.steps).with_own(len),
+        },
         summary: SummaryBuilder::new(
             plan.robot.model.joint_names(),
             plan.dt(),
@@ -324,6 +352,8 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         verifier,
         csv,
         wall: (u64::MAX, 0),
+        own_len,
+        own: OwnStats::new(own, n),
     };
     let contents = match read_log(path, Some(&mut |t, e, v| a.on_message(t, e, v))) {
         Err(LogError::Sink { cause, .. }) => return Err(out_err(cause)),
@@ -364,10 +394,30 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         summary,
         timing,
         verify: a.verifier.map(|v| (v.max_abs_torque_diff, v.steps)),
+        own_diagnostics: if own_len == 0 {
+            Vec::new()
+        } else {
+            a.own.finish()
+        },
         series: a.series,
         contents,
         plan,
         mode,
+    })
+}
+
+/// The external controller's declared diagnostics (metadata
+/// `controller_diagnostics`; none in a log without it).
+fn own_layout(contents: &LogContents, n: usize) -> Result<OwnLayout, AnalysisError> {
+    let text = contents
+        .run
+        .get("controller_diagnostics")
+        .map_or("", String::as_str);
+    OwnLayout::parse(text, n).map_err(|e| {
+        meta_err(
+            &contents.path,
+            format!("testbed.run controller_diagnostics: {e}"),
+        )
     })
 }
 

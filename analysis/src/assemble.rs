@@ -2,14 +2,16 @@
 //!
 //! Row k needs joint state k (q, q̇), joint state k+1 (the torque the plant
 //! applied over the step and q̇ for the mean acceleration) and the
-//! controller diagnostics of step k (the reference it used, Z1, Z2, ‖Ŵa‖).
+//! controller diagnostics of step k (the reference it used, Z1, Z2, ‖Ŵa‖);
+//! of an external controller that declared diagnostics of its own, also
+//! those of step k.
 //! The arithmetic is the in-process loop's, so a lockstep run gives the
 //! same bits as `testbed sim`.
 
 use std::collections::BTreeMap;
 
 use scenario::ns_to_s;
-use wire::{ControllerDiagnostics, JointState};
+use wire::{ControllerDiagnostics, JointState, OwnDiagnostics};
 
 use crate::record::StepRecord;
 
@@ -33,6 +35,10 @@ pub struct RecordAssembler {
     // large (a third of `replay`'s copying was B-tree removals).
     states: BTreeMap<u64, Box<JointState>>,
     diags: BTreeMap<u64, Box<ControllerDiagnostics>>,
+    /// Values of the own diagnostics a row needs (None: no row needs any).
+    own_len: Option<usize>,
+    newest_own: Option<u64>,
+    owns: BTreeMap<u64, Box<OwnDiagnostics>>,
     missing: u64,
     qdd: Vec<f64>,
 }
@@ -49,8 +55,27 @@ impl RecordAssembler {
             newest_diag: None,
             states: BTreeMap::new(),
             diags: BTreeMap::new(),
+            own_len: None,
+            newest_own: None,
+            owns: BTreeMap::new(),
             missing: 0,
             qdd: vec![0.0; n],
+        }
+    }
+
+    /// Rows also need an external controller's own diagnostics, `len`
+    /// values each.
+    pub fn with_own(mut self, len: usize) -> Self {
+        self.own_len = Some(len.min(wire::MAX_OWN_DIAGNOSTICS));
+        self
+    }
+
+    /// Adds an own-diagnostics sample (ignored unless rows need them).
+    pub fn push_own(&mut self, o: OwnDiagnostics) {
+        let seq = o.header.seq;
+        if self.own_len.is_some() && seq >= self.next {
+            self.newest_own = Some(self.newest_own.map_or(seq, |n| n.max(seq)));
+            self.owns.insert(seq, Box::new(o));
         }
     }
 
@@ -110,6 +135,17 @@ impl RecordAssembler {
                 }
                 break;
             };
+            let own: &[f64] = match self.own_len {
+                None => &[],
+                Some(len) => match self.owns.get(&k) {
+                    Some(o) => &o.values[..len],
+                    None if past(self.newest_own, k) => {
+                        self.skip(k);
+                        continue;
+                    }
+                    None => break,
+                },
+            };
             let n = self.n;
             for i in 0..n {
                 self.qdd[i] = (s1.qd[i] - s.qd[i]) / self.dt;
@@ -134,10 +170,12 @@ impl RecordAssembler {
                 tau_actor: &d.tau_actor[..n],
                 barrier_breached: d.barrier_breached != 0,
                 fault: d.fault != 0,
+                own,
             };
             on_step(&record)?;
             self.states.remove(&k);
             self.diags.remove(&k);
+            self.owns.remove(&k);
             self.next += 1;
         }
         Ok(())
@@ -146,6 +184,7 @@ impl RecordAssembler {
     fn skip(&mut self, k: u64) {
         self.states.remove(&k);
         self.diags.remove(&k);
+        self.owns.remove(&k);
         self.missing += 1;
         self.next += 1;
     }

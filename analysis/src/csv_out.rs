@@ -28,11 +28,18 @@ const JOINT_COLUMNS: [Column; 12] = [
 /// kc{i} z1_{i} z2_{i} wa{i} qm{i} qdm{i} d{i}`, then `effects` (bits of
 /// `plant_rapier::Effects`).
 pub fn header(dof: usize) -> String {
+    header_with_own(dof, &[])
+}
+
+/// [`header`], then an external controller's own diagnostics as `own.NAME`
+/// columns ([`wire::OwnLayout::columns`]).
+pub fn header_with_own(dof: usize, own: &[String]) -> String {
     let mut cols = vec!["t".to_string()];
     for i in 0..dof {
         cols.extend(JOINT_COLUMNS.iter().map(|(stem, _)| format!("{stem}{i}")));
     }
     cols.push("effects".into());
+    cols.extend(own.iter().map(|c| format!("own.{c}")));
     cols.join(",")
 }
 
@@ -45,5 +52,9 @@ pub fn write_row(w: &mut impl Write, r: &StepRecord<'_>) -> std::io::Result<()> 
             write!(w, ",{:?}", value(r, i))?;
         }
     }
-    writeln!(w, ",{}", r.effects)
+    write!(w, ",{}", r.effects)?;
+    for v in r.own {
+        write!(w, ",{v:?}")?;
+    }
+    writeln!(w)
 }

@@ -15,6 +15,7 @@ pub mod assemble;
 pub mod csv_out;
 pub mod data_path;
 pub mod law_info;
+pub mod own;
 pub mod plots;
 pub mod record;
 pub mod report;

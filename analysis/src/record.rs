@@ -42,4 +42,7 @@ pub struct StepRecord<'a> {
     pub barrier_breached: bool,
     /// The controller published zero torque because of a fault.
     pub fault: bool,
+    /// An external controller's own diagnostics of the step, in its
+    /// declared order (empty when it declared none).
+    pub own: &'a [f64],
 }

@@ -189,6 +189,7 @@ impl Report {
                 .map(|name| ExternalLaw {
                     name,
                     parameters: meta("controller_params"),
+                    diagnostics: a.own_diagnostics,
                 }),
             summary: a.summary,
         }
@@ -202,6 +203,9 @@ pub struct ExternalLaw {
     pub name: String,
     /// Its parameters, `key=value` pairs.
     pub parameters: String,
+    /// Its own diagnostics over the run: last value and largest magnitude.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub diagnostics: Vec<crate::own::OwnDiagnosticSummary>,
 }
 
 fn opt(v: Option<f64>, prec: usize) -> String {
@@ -267,6 +271,15 @@ fn heading(out: &mut String, r: &Report) {
         _ => {
             let _ = writeln!(out, "law {}", r.law.label());
         }
+    }
+    for d in r.controller_law.iter().flat_map(|l| &l.diagnostics) {
+        let _ = writeln!(
+            out,
+            "  its diagnostic {}: last [{}], max |.| [{}]",
+            d.name,
+            fmt(&d.last),
+            fmt(&d.max_abs)
+        );
     }
     if let (None, Some(cmd)) = (&r.controller_law, &r.controller_cmd) {
         let _ = writeln!(

@@ -437,6 +437,7 @@ mod tests {
             tau_actor: tau,
             barrier_breached: false,
             fault: false,
+            own: &[],
         }
     }
 

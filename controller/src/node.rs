@@ -36,6 +36,10 @@ pub struct ControllerNodeConfig {
     /// controller takes none.
     #[serde(default, skip_serializing_if = "serde_json::Map::is_empty")]
     pub own_params: serde_json::Map<String, serde_json::Value>,
+    /// Its own diagnostics, as `name:shape` pairs ([`wire::OwnLayout`]):
+    /// the order it publishes their values in.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub own_diagnostics: String,
 }
 
 /// The URDF a model-based law evaluates, with the run's locked joints.

@@ -563,6 +563,8 @@ fn external_row(
                 declared = (!name.is_empty()).then(|| analysis::report::ExternalLaw {
                     name,
                     parameters: meta("controller_params"),
+                    // Per run, not per law: in each run's own summary.
+                    diagnostics: Vec::new(),
                 });
                 let summary = o.analysis.summary;
                 LawRun {

@@ -12,7 +12,7 @@
 use serde_json::{Map, Value, json};
 use wire::{
     Bound, Command, ControllerDiagnostics, FieldRef, FieldSource, Header, JointState,
-    ReferenceSample, Timing,
+    OwnDiagnostics, ReferenceSample, Timing,
 };
 
 /// A logged message that does not decode: what is missing or wrong.
@@ -46,7 +46,9 @@ pub trait LogMessage: Bound {
                 FieldRef::U(x) => x.into(),
                 FieldRef::I(x) => x.into(),
                 FieldRef::F(x) => number(x),
-                FieldRef::J(xs) => Value::Array(xs.iter().map(|x| number(*x)).collect()),
+                FieldRef::J(xs) | FieldRef::V(xs) => {
+                    Value::Array(xs.iter().map(|x| number(*x)).collect())
+                }
             };
             o.insert(name.into(), v);
         });
@@ -74,7 +76,7 @@ pub trait LogMessage: Bound {
                 FieldRef::U(x) => write_int(out, x),
                 FieldRef::I(x) => write_int(out, x),
                 FieldRef::F(x) => write_real(out, x),
-                FieldRef::J(xs) => {
+                FieldRef::J(xs) | FieldRef::V(xs) => {
                     out.push(b'[');
                     for (i, x) in xs.iter().enumerate() {
                         if i > 0 {
@@ -135,6 +137,10 @@ pub trait LogMessage: Bound {
                     "type": "array",
                     "items": {"type": ["number", "null"]},
                     "description": "one entry per joint, in joint order"
+                }),
+                FieldRef::V(_) => json!({
+                    "type": "array",
+                    "items": {"type": ["number", "null"]},
                 }),
             };
             props.insert(name.into(), s);
@@ -200,6 +206,11 @@ impl LogMessage for Command {
 
 impl LogMessage for ControllerDiagnostics {
     const ABOUT: &'static str = "Everything the controller computed at step seq (SPEC section 12).";
+}
+
+impl LogMessage for OwnDiagnostics {
+    const ABOUT: &'static str = "An external controller's own diagnostics at step seq: the values \
+        of what it declared, in the order the run's metadata (controller_diagnostics) lists them.";
 }
 
 impl LogMessage for Timing {

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use bus::{NodeError, NodeLink, TopicSubscriber};
 use serde::{Deserialize, Serialize};
-use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
+use wire::{Command, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample, Timing};
 
 use crate::live::{LiveConfig, LiveError};
 use crate::outputs::Outputs;
@@ -116,6 +116,7 @@ struct Subs {
     reference: Sub<ReferenceSample>,
     command: Sub<Command>,
     diag: Sub<ControllerDiagnostics>,
+    own: Sub<OwnDiagnostics>,
     timing: Sub<Timing>,
 }
 
@@ -130,7 +131,8 @@ impl Subs {
         self.state.drain(|m| out.take_state(m))?;
         self.reference.drain(|m| out.take(m))?;
         self.command.drain(|m| out.take_command(m))?;
-        self.diag.drain(|m| out.take(m))
+        self.diag.drain(|m| out.take(m))?;
+        self.own.drain(|m| out.take(m))
     }
 
     fn stats(&self) -> BTreeMap<String, String> {
@@ -139,6 +141,7 @@ impl Subs {
         self.reference.stats(&mut out);
         self.command.stats(&mut out);
         self.diag.stats(&mut out);
+        self.own.stats(&mut out);
         self.timing.stats(&mut out);
         out
     }
@@ -164,6 +167,7 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
         reference: Sub::new(link)?,
         command: Sub::new(link)?,
         diag: Sub::new(link)?,
+        own: Sub::new(link)?,
         timing: Sub::new(link)?,
     };
     let model = arm_model::ArmModel::from_urdf_str_locked(&config.urdf, &config.lock)?;

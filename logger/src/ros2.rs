@@ -85,13 +85,15 @@ pub fn msg_text<M: LogMessage>() -> String {
             FieldRef::U(_) => "uint64",
             FieldRef::I(_) => "int64",
             FieldRef::F(_) => "float64",
-            FieldRef::J(_) => "float64[]",
+            FieldRef::J(_) | FieldRef::V(_) => "float64[]",
         };
         s.push_str(ty);
         s.push(' ');
         s.push_str(name);
-        if matches!(f, FieldRef::J(_)) {
-            s.push_str("  # one entry per joint, in joint order");
+        match f {
+            FieldRef::J(_) => s.push_str("  # one entry per joint, in joint order"),
+            FieldRef::V(_) => s.push_str("  # the declared diagnostics' values, in order"),
+            _ => {}
         }
         s.push('\n');
     });
@@ -133,7 +135,7 @@ pub fn encode<M: LogMessage>(m: &M, out: &mut Vec<u8>) {
         FieldRef::U(x) => w.u64(x),
         FieldRef::I(x) => w.i64(x),
         FieldRef::F(x) => w.f64(x),
-        FieldRef::J(xs) => w.f64s(xs),
+        FieldRef::J(xs) | FieldRef::V(xs) => w.f64s(xs),
     });
 }
 
@@ -214,7 +216,7 @@ pub fn decode<M: LogMessage>(data: &[u8]) -> Result<M, DecodeError> {
             FieldRef::U(_) => r.u64(name).map(Val::U),
             FieldRef::I(_) => r.i64(name).map(Val::I),
             FieldRef::F(_) => r.f64(name).map(Val::F),
-            FieldRef::J(_) => r.f64s(name, &mut xs).and_then(|()| {
+            FieldRef::J(_) | FieldRef::V(_) => r.f64s(name, &mut xs).and_then(|()| {
                 if xs.len() > MAX_DOF {
                     Err(DecodeError(format!(
                         "field '{name}' has {} entries (at most {MAX_DOF})",

@@ -70,6 +70,10 @@ pub struct RunMetadata {
     /// Its own parameters as `key=value` pairs.
     #[serde(default)]
     pub controller_params: String,
+    /// Its own diagnostics as `name:shape` pairs ([`wire::OwnLayout`]): what
+    /// the `/controller/own_diagnostics` values are, in order.
+    #[serde(default)]
+    pub controller_diagnostics: String,
 }
 
 /// The log format this logger writes, recorded as `log_format` in the

@@ -8,8 +8,10 @@ and K2 from the scenario's [controller] table and `ki` from its
         # my.toml:  [external]
         #           ki = 5.0
 
-The log and the summary name the law `pid` with its `ki`; what it prints
-is in the run folder (nodes/controller.log).
+The log and the summary name the law `pid` with its `ki`; its integral
+∫e dt is a diagnostic of its own (the log's /controller/own_diagnostics
+channel, the CSV's own.integral<i> columns, the summary's last and largest
+values); what it prints is in the run folder (nodes/controller.log).
 """
 
 import numpy as np
@@ -20,6 +22,7 @@ import testbed_controller as tc
 class PID(tc.Controller):
     name = "pid"
     params = {"ki": 2.0}
+    own_diagnostics = {"integral": "joints"}
 
     def setup(self, run: tc.RunInfo) -> None:
         self.k1 = run.gain("k1")
@@ -34,6 +37,9 @@ class PID(tc.Controller):
         ed = state.qd - ref.qd_d
         self.integral += e * self.dt
         return -self.k2 * (self.k1 * e + ed) - self.ki * self.k2 * self.integral
+
+    def diagnostics(self) -> dict:
+        return {"integral": self.integral}
 
 
 if __name__ == "__main__":

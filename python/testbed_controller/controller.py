@@ -33,6 +33,9 @@ class RunInfo:
     #: This controller's own parameters: its declared `params` with the
     #: scenario's `[external]` table over them (checked by the launcher).
     own: dict = field(default_factory=dict)
+    #: Its own diagnostics as the launcher laid them out: (name, shape)
+    #: pairs, shape "scalar" or "joints", in the order they are published.
+    own_diagnostics: tuple = ()
 
     @property
     def dt(self) -> float:
@@ -79,22 +82,29 @@ class Controller:
     """A control law. Implement `step`; the others are optional.
 
     Declare what the law is, and the launcher names it in the log and the
-    summary, and takes its parameters from the scenario's `[external]`
-    table (checked against these, by name and kind):
+    summary, takes its parameters from the scenario's `[external]` table
+    (checked against these, by name and kind), and logs its own
+    diagnostics on a channel of their own (`/controller/own_diagnostics`),
+    in the CSV (`own.NAME` columns) and in the summary:
 
         class PID(Controller):
             name = "pid"
             params = {"ki": 2.0}      # defaults; run.own["ki"] in setup()
+            own_diagnostics = {"integral": "joints"}   # or "scalar"
     """
 
     #: The law's name (1 to 40 of a-z, 0-9, '-', '_'); "" declares nothing.
     name: str = ""
     #: Its own parameters and their defaults (numbers, booleans, strings, lists).
     params: dict = {}
+    #: Its own diagnostics: name (a-z, 0-9, '_', starting with a letter) →
+    #: "scalar" (one number a step) or "joints" (one per joint); at most 32
+    #: numbers a step in all. `diagnostics()` gives their values each step.
+    own_diagnostics: dict = {}
 
     def describe(self) -> dict:
-        """What `--describe` prints: the law's name and parameters."""
-        return {"name": self.name, "params": dict(self.params)}
+        """What `--describe` prints: the law's name, parameters and diagnostics."""
+        return {"name": self.name, "params": dict(self.params), "diagnostics": dict(self.own_diagnostics)}
 
     def setup(self, run: RunInfo) -> None:
         """Called once before the first step."""
@@ -108,9 +118,10 @@ class Controller:
         raise NotImplementedError
 
     def diagnostics(self) -> Optional[dict[str, Any]]:
-        """Extra diagnostics of the step just made, by ControllerDiagnostics
-        field name (`z1`, `z2`, `alpha`, `tau_actor`, `gamma`, `j_hat`, …);
-        they go to the log beside the defaults (errors, envelope, torque)."""
+        """Diagnostics of the step just made: by ControllerDiagnostics field
+        name (`z1`, `z2`, `alpha`, `tau_actor`, `gamma`, `j_hat`, …), which go
+        to the log beside the defaults (errors, envelope, torque), and every
+        name declared in `own_diagnostics` (a number, or `dof` numbers)."""
         return None
 
 

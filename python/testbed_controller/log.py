@@ -5,6 +5,8 @@
     state = log["/joint_state"]           # dict of numpy arrays
     state["t"], state["q"][:, 0]          # sim time (s), joint 1's position
     diag = log["/controller/diagnostics"]
+    own = log["/controller/own_diagnostics"]   # an external controller's own:
+    own["integral"]                       # by declared name (rows x joints)
     log.run["joint_names"], log.stats     # the run's metadata and the logger's counts
 
 Built on the official readers: `mcap` for the file and `mcap-ros2-support`
@@ -130,7 +132,33 @@ def read_log(path: str, topics: Optional[Iterable[str]] = None) -> Log:
             times.setdefault(channel.topic, []).append(message.log_time)
     for topic, r in rows.items():
         log[topic] = _table(r, times[topic])
+    _name_own_values(log)
     return log
+
+
+OWN_TOPIC = "/controller/own_diagnostics"
+
+
+def _name_own_values(log: Log) -> None:
+    """Adds each declared own diagnostic (metadata `controller_diagnostics`,
+    `name:shape,…`) to its table by name, cut from the `values` rows."""
+    table = log.get(OWN_TOPIC)
+    layout = [e.split(":", 1) for e in log.run.get("controller_diagnostics", "").split(",") if e]
+    if table is None or not layout or "values" not in table:
+        return
+    values = table["values"]
+    if values.dtype == object:
+        raise ValueError(f"{log.path}: {OWN_TOPIC} rows differ in length")
+    # count = dof x (per-joint ones) + (scalars): no joint name is parsed.
+    per_joint = sum(shape == "joints" for _, shape in layout)
+    scalars = len(layout) - per_joint
+    dof = (values.shape[1] - scalars) // per_joint if per_joint else 0
+    at = 0
+    for name, shape in layout:
+        size = dof if shape == "joints" else 1
+        part = values[:, at : at + size]
+        table[name] = part if shape == "joints" else part[:, 0]
+        at += size
 
 
 def to_dataframe(table: Dict[str, np.ndarray]):

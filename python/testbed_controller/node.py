@@ -141,9 +141,19 @@ def read_run_info(path: str, mode: str) -> RunInfo:
             params=dict(cfg["params"]),
             reference_period_ns=int(cfg.get("reference_period_ns", 0)),
             own=dict(cfg.get("own_params", {})),
+            own_diagnostics=parse_own_layout(cfg.get("own_diagnostics", "")),
         )
     except (OSError, ValueError, KeyError, TypeError) as e:
         raise SystemExit(f"controller: cannot read the config {path}: {e!r}") from e
+
+
+def parse_own_layout(text: str) -> tuple:
+    """`name:shape,…` (the launcher's layout of the own diagnostics) as pairs."""
+    pairs = tuple(tuple(e.split(":", 1)) for e in text.split(",") if e)
+    for p in pairs:
+        if len(p) != 2 or p[1] not in ("scalar", "joints"):
+            raise ValueError(f"own_diagnostics entry {':'.join(p)!r} is not name:scalar or name:joints")
+    return pairs
 
 
 class Loop:
@@ -158,6 +168,8 @@ class Loop:
         self.refs = ReferenceWindow(bus, lockstep, info.reference_period_ns or info.period_ns)
         self.commands = bus.publisher("command", lossless=lockstep)
         self.diags = bus.publisher("diagnostics", lossless=lockstep)
+        self.own_layout = info.own_diagnostics
+        self.own = bus.publisher("own_diagnostics", lossless=lockstep) if self.own_layout else None
         self.idle = lambda: (bus.wait(0.001), link.check())
 
     def run(self) -> int:
@@ -206,6 +218,8 @@ class Loop:
         m["stale_references"] = self.refs.stale
         self.commands.send(sample)
         self.publish_diagnostics(h, wall_ns, compute_ns, state, r, fault, tau, extra)
+        if self.own is not None:
+            self.publish_own(h, wall_ns, extra)
 
     def compute(self, state: State, r) -> tuple:
         """(fault, tau, extra diagnostics) of one step."""
@@ -254,14 +268,45 @@ class Loop:
             d["d"][:n] = r["kc"][:n] * r["kc"][:n] - e * e
         d["tau"][:n] = tau
         d["tau_feedback"][:n] = tau
+        own = {name for name, _ in self.own_layout}
         for key, value in (extra or {}).items():
+            if key in own:
+                continue
             if key not in DIAGNOSTIC_FIELDS:
-                raise KeyError(f"{type(self.c).__name__}.diagnostics() names '{key}', not a ControllerDiagnostics field")
+                raise KeyError(
+                    f"{type(self.c).__name__}.diagnostics() names '{key}', neither a ControllerDiagnostics field "
+                    f"nor one of its own_diagnostics ({', '.join(sorted(own)) or 'none declared'})"
+                )
             if key in wire.ControllerDiagnostics.JOINT_FIELDS:
                 d[key][:n] = value
             else:
                 d[key] = value
         self.diags.send(sample)
+
+    def publish_own(self, h, wall_ns, extra) -> None:
+        """The declared diagnostics' values, in the launcher's order; NaN on a
+        step the controller was not asked (a fault before `step`)."""
+        n = self.n
+        sample, o = self.own.loan()
+        o["header"] = (h["seq"], h["t_ns"], wall_ns)
+        at = 0
+        for name, shape in self.own_layout:
+            size = n if shape == "joints" else 1
+            if extra is None:
+                value = np.full(size, np.nan)
+            elif name not in extra:
+                raise KeyError(f"{type(self.c).__name__}.diagnostics() gives no '{name}' (declared in own_diagnostics)")
+            else:
+                value = np.asarray(extra[name], dtype=float).reshape(-1)
+                if value.size != size:
+                    raise ValueError(
+                        f"{type(self.c).__name__}.diagnostics()['{name}'] has {value.size} values; "
+                        f"its shape '{shape}' takes {size}"
+                    )
+            o["values"][at : at + size] = value
+            at += size
+        o["count"] = at
+        self.own.send(sample)
 
 
 def run(controller: Controller, argv: Optional[Sequence[str]] = None) -> None:

@@ -168,6 +168,23 @@ class ControllerDiagnostics(ctypes.Structure):
         return "testbed.ControllerDiagnostics.v3"
 
 
+class OwnDiagnostics(ctypes.Structure):
+    _fields_ = [
+        ("header", Header),
+        ("count", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("values", ctypes.c_double * MAX_DOF),
+    ]
+    SIZE = 288
+    ALIGN = 8
+    OFFSETS = {"header": 0, "count": 24, "reserved": 28, "values": 32}
+    JOINT_FIELDS = ("values",)
+
+    @staticmethod
+    def type_name() -> str:
+        return "testbed.OwnDiagnostics.v1"
+
+
 class Timing(ctypes.Structure):
     _fields_ = [
         ("header", Header),
@@ -233,12 +250,13 @@ TOPICS = {
     "reference": ("testbed/reference", ReferenceSample, 1, 2, False),
     "command": ("testbed/command", Command, 1, 2, True),
     "diagnostics": ("testbed/diagnostics", ControllerDiagnostics, 1, 2, False),
+    "own_diagnostics": ("testbed/own_diagnostics", OwnDiagnostics, 1, 2, False),
     "timing": ("testbed/timing", Timing, 1, 2, False),
     "control": ("testbed/control", Control, 1, 2, True),
     "status": ("testbed/status", NodeStatus, 8, 8, True),
 }
 
-STRUCTURES = ("Header", "JointState", "ReferenceSample", "Command", "ControllerDiagnostics", "Timing", "Control", "NodeStatus")
+STRUCTURES = ("Header", "JointState", "ReferenceSample", "Command", "ControllerDiagnostics", "OwnDiagnostics", "Timing", "Control", "NodeStatus")
 
 
 def _check_layouts() -> None:

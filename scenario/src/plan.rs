@@ -66,6 +66,7 @@ impl Plan {
                     lock: self.scenario.plant.lock.clone(),
                 }),
             own_params: serde_json::Map::new(),
+            own_diagnostics: String::new(),
         }
     }
 

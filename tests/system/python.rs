@@ -161,7 +161,14 @@ fn every_message_of_a_run_decodes_with_the_official_python_reader() {
     for (topic, n) in &per_topic {
         assert_eq!(rows[topic].as_u64(), Some(*n), "{topic}: {py}");
     }
-    assert_eq!(per_topic.len(), logger::channels().len(), "{per_topic:?}");
+    // Every channel but an external controller's own diagnostics (the
+    // testbed's controller declares none).
+    assert_eq!(
+        per_topic.len(),
+        logger::channels().len() - 1,
+        "{per_topic:?}"
+    );
+    assert!(!per_topic.contains_key("/controller/own_diagnostics"));
     assert_eq!(py["log_format"], logger::LOG_FORMAT);
     assert_eq!(py["types"]["/joint_state"], "testbed_msgs/msg/JointState");
     assert_eq!(py["types"]["/joint_states"], "sensor_msgs/msg/JointState");
@@ -350,8 +357,9 @@ fn a_controller_command_that_cannot_start_is_refused_before_any_node() {
 /// #29: a Python controller as a law of its own. The PID example declares
 /// its name and a parameter `ki`; the scenario's `[external]` table sets
 /// it (checked: unknown keys and wrong kinds are refused before the run);
-/// the log and the summary name `pid` with its `ki`; what it printed is in
-/// the run folder.
+/// the log and the summary name `pid` with its `ki`; its integral is a
+/// diagnostic of its own, in the log (its own channel, read by name from
+/// Python), the CSV and the summary; what it printed is in the run folder.
 #[test]
 fn a_python_pid_declares_its_law_and_takes_its_own_parameter() {
     let dir = tempfile::tempdir().unwrap();
@@ -386,6 +394,7 @@ fn a_python_pid_declares_its_law_and_takes_its_own_parameter() {
     let log = s["log"].as_str().unwrap();
     let r = json(&ok(testbed().args(["replay", "--json", log])));
     assert_eq!(r["controller_law"], s["controller_law"]);
+    own_integral_is_everywhere(&s, log, dir.path());
     // A larger integral gain changes the run.
     let s2 = json(&ok(&mut run(&scenario("ki = 50.0"), "pid2")));
     assert_ne!(s2["metrics"], s["metrics"]);
@@ -402,6 +411,47 @@ fn a_python_pid_declares_its_law_and_takes_its_own_parameter() {
             .arg(scenario("ki = 1")),
     );
     assert!(err.contains("is for an external controller"), "{err}");
+}
+
+/// The PID's `integral` diagnostic: in the summary (last and largest per
+/// joint), the CSV's `own.integral<i>` columns and the log's own channel,
+/// all the same numbers.
+fn own_integral_is_everywhere(s: &serde_json::Value, log: &str, dir: &Path) {
+    let d = &s["controller_law"]["diagnostics"][0];
+    assert_eq!(d["name"], "integral", "{s}");
+    let last: Vec<f64> = (d["last"].as_array().unwrap().iter())
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(last.len(), 2, "{s}");
+    assert!(last.iter().all(|x| x.is_finite() && *x != 0.0), "{s}");
+    let csv = dir.join("pid.csv");
+    ok(testbed().args(["replay", log, "--csv"]).arg(&csv));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let row: Vec<f64> = (text.lines().last().unwrap().split(','))
+        .map(|x| x.parse().unwrap())
+        .collect();
+    for (i, want) in last.iter().enumerate() {
+        let col = header.iter().position(|h| *h == format!("own.integral{i}"));
+        assert_eq!(row[col.expect("an own.integral column")], *want);
+    }
+    let out = Command::new(python())
+        .args([
+            "-c",
+            "import sys, json, testbed_controller.log as t\n\
+             o = t.read_log(sys.argv[1])['/controller/own_diagnostics']\n\
+             print(json.dumps(o['integral'][-1].tolist()))",
+            log,
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let py: Vec<f64> = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(py, last);
 }
 
 /// #26 item 4: Python laws as rows of `compare`, scored like the built-in

@@ -191,7 +191,8 @@ fn an_external_node_with_the_wrong_mode_fails_the_run() {
 
 /// #29: the Rust template is a law of its own under `--controller-cmd`:
 /// it declares `pd-example` with `kp` and `kd`, the scenario sets `kp`,
-/// and the summary names both.
+/// and the summary names both; its own diagnostic `error_norm` = ‖q − q_d‖
+/// is summed up there too.
 #[test]
 fn the_rust_template_declares_its_law_and_parameters() {
     let dir = tempfile::tempdir().unwrap();
@@ -209,4 +210,15 @@ fn the_rust_template_declares_its_law_and_parameters() {
     let r = crate::util::json(&out);
     assert_eq!(r["controller_law"]["name"], "pd-example", "{r}");
     assert_eq!(r["controller_law"]["parameters"], "kd=40.0,kp=900", "{r}");
+    let d = &r["controller_law"]["diagnostics"][0];
+    assert_eq!(d["name"], "error_norm", "{r}");
+    // The norm over the whole run is at least any joint's error after T_c.
+    let max_abs = d["max_abs"][0].as_f64().unwrap();
+    let largest = (r["joints"].as_array().unwrap().iter())
+        .map(|j| j["max_abs_error_after_tc"].as_f64().unwrap())
+        .fold(0.0, f64::max);
+    assert!(
+        largest > 0.0 && largest <= max_abs && max_abs.is_finite(),
+        "{r}"
+    );
 }

@@ -4,7 +4,7 @@
 //! generator all take the pairing from here.
 
 use crate::{
-    Command, Control, ControllerDiagnostics, JointState, MessageFields, NodeStatus,
+    Command, Control, ControllerDiagnostics, JointState, MessageFields, NodeStatus, OwnDiagnostics,
     ReferenceSample, Timing, Topic,
 };
 
@@ -44,6 +44,7 @@ bind! {
     ReferenceSample => Reference, Some("/reference"), "testbed.Reference";
     Command => Command, Some("/command"), "testbed.Command";
     ControllerDiagnostics => Diagnostics, Some("/controller/diagnostics"), "testbed.ControllerDiagnostics";
+    OwnDiagnostics => OwnDiagnostics, Some("/controller/own_diagnostics"), "testbed.OwnDiagnostics";
     Timing => Timing, Some("/timing"), "testbed.Timing";
     Control => Control, None, "testbed.Control";
     NodeStatus => Status, None, "testbed.NodeStatus";

@@ -19,6 +19,9 @@ pub enum FieldRef<'a> {
     F(f64),
     /// Per-joint reals.
     J(&'a [f64]),
+    /// Reals that are not per joint (an external controller's own
+    /// diagnostics), trimmed to the message's `count`.
+    V(&'a [f64]),
 }
 
 /// Where [`MessageFields::decode`] takes each field from (a parsed JSON
@@ -57,7 +60,7 @@ pub trait MessageFields: Sized + Copy + Default {
 /// list in one place: the log's codec ([`MessageFields`]) and its memory
 /// layout for other languages ([`crate::WireLayout`]) come from it. Doc
 /// comments come first, then `#[type_name("…")]`. Each field names its kind: `U32`, `U64`, `I64`,
-/// `F64`, `J` (per-joint, trimmed to `dof`) or `Pad` (layout only). A field
+/// `F64`, `J` (per-joint, trimmed to `dof`), `V` (reals trimmed to `count`) or `Pad` (layout only). A field
 /// added after logs of its message were written ends in `| default`: the
 /// value a log without it decodes to (every other field is required).
 #[macro_export]
@@ -141,6 +144,12 @@ macro_rules! field_visit {
             $crate::FieldRef::J(&$s.$f[..($s.dof as usize).min($crate::MAX_DOF)]),
         )
     };
+    (V, $s:ident, $f:ident, $out:ident) => {
+        $out(
+            stringify!($f),
+            $crate::FieldRef::V(&$s.$f[..($s.count as usize).min($crate::MAX_DOF)]),
+        )
+    };
     (Pad, $s:ident, $f:ident, $out:ident) => {};
 }
 
@@ -161,6 +170,9 @@ macro_rules! field_decode {
         $m.$f = $s.f(stringify!($f))?
     };
     (J, $m:ident, $f:ident, $s:ident) => {
+        $m.$f = $s.j(stringify!($f))?
+    };
+    (V, $m:ident, $f:ident, $s:ident) => {
         $m.$f = $s.j(stringify!($f))?
     };
     (Pad, $m:ident, $f:ident, $s:ident) => {};
@@ -216,7 +228,7 @@ mod tests {
                 FieldRef::U(x) => vec![x as f64],
                 FieldRef::I(x) => vec![x as f64],
                 FieldRef::F(x) => vec![x],
-                FieldRef::J(xs) => xs.to_vec(),
+                FieldRef::J(xs) | FieldRef::V(xs) => xs.to_vec(),
             };
             out.push((name, v));
         });

@@ -123,6 +123,7 @@ pub fn all_layouts() -> Vec<TypeLayout> {
         TypeLayout::of::<crate::ReferenceSample>("ReferenceSample"),
         TypeLayout::of::<crate::Command>("Command"),
         TypeLayout::of::<crate::ControllerDiagnostics>("ControllerDiagnostics"),
+        TypeLayout::of::<crate::OwnDiagnostics>("OwnDiagnostics"),
         TypeLayout::of::<crate::Timing>("Timing"),
         TypeLayout::of::<crate::Control>("Control"),
         TypeLayout::of::<crate::NodeStatus>("NodeStatus"),

@@ -2,7 +2,8 @@
 //!
 //! Where it sits: between every pair of processes. The plant publishes
 //! [`JointState`], the trajectory [`ReferenceSample`], the controller
-//! [`Command`] and [`ControllerDiagnostics`], the plant [`Timing`]; the
+//! [`Command`] and [`ControllerDiagnostics`] (an external controller also
+//! its [`OwnDiagnostics`]), the plant [`Timing`]; the
 //! launcher sends [`Control`] and every node reports [`NodeStatus`]. All are
 //! fixed-size `#[repr(C)]` values exchanged zero-copy over iceoryx2 shared
 //! memory, each topic paired with an event service so receivers sleep until
@@ -34,6 +35,7 @@ mod fields;
 mod files;
 mod layout;
 mod messages;
+mod own;
 mod protocol;
 mod reference_rule;
 mod topic;
@@ -50,6 +52,7 @@ pub use layout::{
     FieldLayout, FieldType, TypeLayout, WireField, WireLayout, all_layouts, field_size,
 };
 pub use messages::*;
+pub use own::{OwnLayout, OwnShape, is_diagnostic_name};
 pub use protocol::{HEARTBEAT, Mode, SILENT_AFTER, ns_to_s};
 pub use reference_rule::is_stale;
 pub use topic::{

@@ -199,6 +199,28 @@ crate::data_message! {
     }
 }
 
+/// Most values an external controller's own diagnostics carry a step
+/// (one [`Joints`] array: every joint of the largest arm, or a few vectors
+/// of a smaller one).
+pub const MAX_OWN_DIAGNOSTICS: usize = MAX_DOF;
+
+crate::data_message! {
+    /// An external controller's own diagnostics of one step: the values of
+    /// what it declared (`CMD --describe`), in the order the run's metadata
+    /// (`controller_diagnostics`) lists them.
+    #[type_name("testbed.OwnDiagnostics.v1")]
+    pub struct OwnDiagnostics {
+        /// seq and t_ns of the state acted on.
+        header: Header,
+        /// Values in use.
+        count: u32 => U32,
+        /// Padding.
+        reserved: u32 => Pad,
+        /// The values, the declared diagnostics one after another.
+        values: Joints => V,
+    }
+}
+
 crate::data_message! {
     /// Timing of one plant cycle (published by the plant, which is the clock).
     #[type_name("testbed.Timing.v2")]

@@ -16,6 +16,8 @@ pub enum Topic {
     Command,
     /// Controller → logger: [`crate::ControllerDiagnostics`].
     Diagnostics,
+    /// External controller → logger: [`crate::OwnDiagnostics`].
+    OwnDiagnostics,
     /// Plant → logger: [`crate::Timing`].
     Timing,
     /// Launcher → nodes: [`crate::Control`].
@@ -26,11 +28,12 @@ pub enum Topic {
 
 impl Topic {
     /// Every topic.
-    pub const ALL: [Topic; 7] = [
+    pub const ALL: [Topic; 8] = [
         Topic::JointState,
         Topic::Reference,
         Topic::Command,
         Topic::Diagnostics,
+        Topic::OwnDiagnostics,
         Topic::Timing,
         Topic::Control,
         Topic::Status,
@@ -43,6 +46,7 @@ impl Topic {
             Topic::Reference => "testbed/reference",
             Topic::Command => "testbed/command",
             Topic::Diagnostics => "testbed/diagnostics",
+            Topic::OwnDiagnostics => "testbed/own_diagnostics",
             Topic::Timing => "testbed/timing",
             Topic::Control => "testbed/control",
             Topic::Status => "testbed/status",

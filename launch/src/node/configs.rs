@@ -80,6 +80,7 @@ pub fn logger(
     if let Some(d) = opts.declared {
         metadata.controller_name = d.name.clone();
         metadata.controller_params = d.params_text();
+        metadata.controller_diagnostics = d.diagnostics.text();
     }
     LoggerNodeConfig {
         out: out.to_path_buf(),
@@ -130,6 +131,7 @@ pub fn metadata(plan: &Plan, mode: Mode, out: &Path, toml: &str) -> RunMetadata 
         controller_cmd: String::new(),
         controller_name: String::new(),
         controller_params: String::new(),
+        controller_diagnostics: String::new(),
     }
 }
 
@@ -182,6 +184,7 @@ pub fn write_all(
                 let mut c = controller(plan);
                 if let Some(d) = logger_opts.declared {
                     c.own_params = d.params.clone();
+                    c.own_diagnostics = d.diagnostics.text();
                 }
                 write_config(&path, &c)?
             }

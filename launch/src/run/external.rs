@@ -28,6 +28,9 @@ pub struct Declared {
     /// Its own parameters: the declared defaults with the scenario's
     /// `[external]` values over them.
     pub params: Map<String, Value>,
+    /// Its own diagnostics (published on their own topic, logged on their
+    /// own channel), in the order of their names.
+    pub diagnostics: wire::OwnLayout,
 }
 
 impl Declared {
@@ -51,7 +54,11 @@ fn refused(command: &[String], reason: String) -> RunError {
 /// The declaration of `command` with `table`'s values checked and merged;
 /// None for a command that does not describe itself (it then takes no
 /// `[external]` table).
-pub fn declared(command: &[String], table: &toml::Table) -> Result<Option<Declared>, RunError> {
+pub fn declared(
+    command: &[String],
+    table: &toml::Table,
+    dof: usize,
+) -> Result<Option<Declared>, RunError> {
     let Some(text) = describe(command)? else {
         if let Some(key) = table.keys().next() {
             return Err(refused(
@@ -64,7 +71,7 @@ pub fn declared(command: &[String], table: &toml::Table) -> Result<Option<Declar
         }
         return Ok(None);
     };
-    let mut d = parse(&text).map_err(|reason| refused(command, reason))?;
+    let mut d = parse(&text, dof).map_err(|reason| refused(command, reason))?;
     for (key, value) in table {
         let Some(default) = d.params.get(key) else {
             let known: Vec<&str> = d.params.keys().map(String::as_str).collect();
@@ -121,8 +128,9 @@ pub fn is_law_name(name: &str) -> bool {
 }
 
 /// Reads a description: a name of lowercase letters, digits, `-` and `_`,
-/// and parameters that are numbers, booleans, strings or lists.
-fn parse(text: &str) -> Result<Declared, String> {
+/// parameters that are numbers, booleans, strings or lists, and
+/// diagnostics that are `"scalar"` or `"joints"` (checked for `dof` joints).
+fn parse(text: &str, dof: usize) -> Result<Declared, String> {
     let v: Value = serde_json::from_str(text.trim())
         .map_err(|e| format!("`--describe` printed no JSON object: {e}"))?;
     let name = v["name"].as_str().unwrap_or_default().to_string();
@@ -146,7 +154,35 @@ fn parse(text: &str) -> Result<Declared, String> {
             "`--describe` parameter {k}: a number, boolean, string or list"
         ));
     }
-    Ok(Declared { name, params })
+    Ok(Declared {
+        name,
+        params,
+        diagnostics: diagnostics(&v["diagnostics"], dof)?,
+    })
+}
+
+/// `{"name": "scalar" | "joints", …}` as a layout (names in order).
+fn diagnostics(v: &Value, dof: usize) -> Result<wire::OwnLayout, String> {
+    let entries = match v {
+        Value::Null => Vec::new(),
+        Value::Object(m) => m
+            .iter()
+            .map(|(name, shape)| {
+                let shape = shape.as_str().ok_or(format!(
+                    "`--describe` diagnostic {name}: {shape} is not \"scalar\" or \"joints\""
+                ))?;
+                let shape = wire::OwnShape::parse(shape)
+                    .map_err(|e| format!("`--describe` diagnostic {name}: {e}"))?;
+                Ok((name.clone(), shape))
+            })
+            .collect::<Result<Vec<_>, String>>()?,
+        other => {
+            return Err(format!(
+                "`--describe` gave diagnostics {other}: an object is needed"
+            ));
+        }
+    };
+    wire::OwnLayout::new(entries, dof).map_err(|e| format!("`--describe`: {e}"))
 }
 
 /// `CMD --describe`'s standard output, None if it exits non-zero.
@@ -218,16 +254,29 @@ mod tests {
 
     #[test]
     fn descriptions_are_checked() {
-        let d = parse(r#"{"name": "pid", "params": {"ki": 0.5, "mode": "x"}}"#).unwrap();
+        let d = parse(
+            r#"{"name": "pid", "params": {"ki": 0.5, "mode": "x"},
+                "diagnostics": {"windup": "scalar", "integral": "joints"}}"#,
+            2,
+        )
+        .unwrap();
         assert_eq!(d.name, "pid");
+        assert_eq!(d.diagnostics.text(), "integral:joints,windup:scalar");
         assert_eq!(d.params_text(), "ki=0.5,mode=\"x\"");
         assert!(
-            parse(r#"{"name": "Bad Name"}"#)
+            parse(r#"{"name": "Bad Name"}"#, 2)
                 .unwrap_err()
                 .contains("1 to 40")
         );
-        assert!(parse("nope").unwrap_err().contains("no JSON"));
-        assert!(parse(r#"{"name": "a", "params": {"k": null}}"#).is_err());
+        assert!(parse("nope", 2).unwrap_err().contains("no JSON"));
+        assert!(parse(r#"{"name": "a", "params": {"k": null}}"#, 2).is_err());
+        let e = parse(r#"{"name": "a", "diagnostics": {"x": 3}}"#, 2).unwrap_err();
+        assert!(e.contains("diagnostic x"), "{e}");
+        let e = parse(
+            r#"{"name": "a", "diagnostics": {"a": "joints", "b": "joints"}}"#,
+            20,
+        );
+        assert!(e.unwrap_err().contains("at most 32"));
         assert!(same_kind(&Value::from(1), &Value::from(0.5)));
         assert!(!same_kind(&Value::from(true), &Value::from(0.5)));
     }

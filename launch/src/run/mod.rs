@@ -144,7 +144,11 @@ pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
 fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
     check_up_front(opts)?;
     let declared = match &opts.controller_cmd {
-        Some(command) => external::declared(command, &opts.plan.scenario.external)?,
+        Some(command) => external::declared(
+            command,
+            &opts.plan.scenario.external,
+            opts.plan.robot.model.dof(),
+        )?,
         None => None,
     };
     let files = RunFiles::write(opts, declared.as_ref())?;
