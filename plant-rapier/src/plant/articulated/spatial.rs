@@ -4,6 +4,8 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::mat3::{mm, mv, outer, tm, tv};
+
 /// A motion vector [ω; v].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Motion {
@@ -102,38 +104,37 @@ impl Xform {
     /// A → C from A → B (`self`) then B → C (`then`).
     pub(super) fn then(self, then: Self) -> Self {
         Self {
-            e: then.e * self.e,
-            r: self.r + self.e.transpose() * then.r,
+            e: mm(&then.e, &self.e),
+            r: self.r + tv(&self.e, &then.r),
         }
     }
 
     /// Motion in A's coordinates to B's.
     pub(super) fn motion(&self, m: Motion) -> Motion {
         Motion {
-            w: self.e * m.w,
-            v: self.e * (m.v - self.r.cross(&m.w)),
+            w: mv(&self.e, &m.w),
+            v: mv(&self.e, &(m.v - self.r.cross(&m.w))),
         }
     }
 
     /// Force in B's coordinates back to A's (the transpose of `motion`).
     pub(super) fn force_back(&self, f: Force) -> Force {
-        let ef = self.e.transpose() * f.f;
+        let ef = tv(&self.e, &f.f);
         Force {
-            n: self.e.transpose() * f.n + self.r.cross(&ef),
+            n: tv(&self.e, &f.n) + self.r.cross(&ef),
             f: ef,
         }
     }
 
     /// An inertia in B's coordinates back to A's (Xᵀ I X).
     pub(super) fn inertia_back(&self, b: &Inertia) -> Inertia {
-        let et = self.e.transpose();
-        let h = et * b.h;
+        let h = tv(&self.e, &b.h);
         let r = self.r;
         // Σ m (|p'|² 1 − p' p'ᵀ) with p' = Eᵀ p + r, expanded.
-        let i = et * b.i * self.e
-            + b.m * (Matrix3::identity() * r.dot(&r) - r * r.transpose())
+        let i = mm(&tm(&self.e, &b.i), &self.e)
+            + b.m * (Matrix3::identity() * r.dot(&r) - outer(&r, &r))
             + Matrix3::identity() * (2.0 * r.dot(&h))
-            - (h * r.transpose() + r * h.transpose());
+            - (outer(&h, &r) + outer(&r, &h));
         Inertia {
             m: b.m,
             h: h + r * b.m,
@@ -170,7 +171,7 @@ impl Inertia {
     /// The momentum of a body moving with `m`.
     pub(super) fn apply(&self, m: Motion) -> Force {
         Force {
-            n: self.i * m.w + self.h.cross(&m.v),
+            n: mv(&self.i, &m.w) + self.h.cross(&m.v),
             f: m.v * self.m - self.h.cross(&m.w),
         }
     }
