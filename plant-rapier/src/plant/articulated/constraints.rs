@@ -118,24 +118,21 @@ impl Impulses {
         for &(coord, upper, _) in &stops {
             self.rows.push(Row::Stop { coord, upper });
         }
-        for j in 0..n {
-            let col = &mut self.inverse[j * n..(j + 1) * n];
-            col.iter_mut()
-                .enumerate()
-                .for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
-            m.solve(col);
-            let response = &mut self.friction_response[j * n..(j + 1) * n];
-            match damped {
-                Some(modes) => {
-                    let mut e = std::mem::take(&mut self.friction_impulse);
-                    e.iter_mut()
-                        .enumerate()
-                        .for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
-                    modes.response(|w: &Weights| w.phi1, &e, &mut self.tmp, response);
-                    self.friction_impulse = e;
-                }
-                None => response.copy_from_slice(&self.inverse[j * n..(j + 1) * n]),
+        // M⁻¹ for the stops, and for friction when no damping acts; with
+        // damping, friction's response is the modes' (a stop's impulse is
+        // instantaneous, friction's a torque over the substep).
+        if damped.is_none() || !stops.is_empty() {
+            for j in 0..n {
+                let col = &mut self.inverse[j * n..(j + 1) * n];
+                col.iter_mut()
+                    .enumerate()
+                    .for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
+                m.solve(col);
             }
+        }
+        match damped {
+            Some(modes) => modes.response_matrix(|w: &Weights| w.phi1, &mut self.friction_response),
+            None => self.friction_response.copy_from_slice(&self.inverse),
         }
         self.lambda.clear();
         self.lambda.resize(self.rows.len(), 0.0);

@@ -77,18 +77,27 @@ impl Weights {
 }
 
 /// φ_0..φ_4 at z ≤ 0. Near 0 the recurrence φ_(k+1) = (φ_k − 1/k!)/z
-/// cancels catastrophically, so the series is summed there (30 terms: under
-/// 1e-20 for |z| < 2); beyond, the recurrence loses under a digit a level.
+/// cancels catastrophically, so there φ4's series is summed (to a term
+/// under 1e-18, at most 30) and the others follow downwards; beyond
+/// |z| = 2, the upward recurrence loses under a digit a level.
 pub(super) fn phi(z: f64) -> [f64; 5] {
     let mut out = [0.0; 5];
     if z.abs() < 2.0 {
-        for (k, o) in out.iter_mut().enumerate() {
-            // Σ_j z^j / (j+k)!, term by term.
-            let mut term = 1.0 / (1..=k).map(|i| i as f64).product::<f64>();
-            for j in 0..30 {
-                *o += term;
-                term *= z / (j + k + 1) as f64;
+        // φ4 = Σ_j z^j / (j+4)! term by term, then down by
+        // φ_k = 1/k! + z φ_(k+1), which does not cancel for |z| < 2.
+        let mut term = 1.0 / 24.0;
+        for j in 0..30 {
+            out[4] += term;
+            term *= z / (j + 5) as f64;
+            if term.abs() < 1e-18 {
+                out[4] += term;
+                break;
             }
+        }
+        let mut fact = 6.0;
+        for k in (0..4).rev() {
+            out[k] = 1.0 / fact + z * out[k + 1];
+            fact /= k.max(1) as f64;
         }
     } else {
         out[0] = z.exp();
@@ -220,6 +229,21 @@ impl Modes {
         mul(&self.w, n, tmp, out);
     }
 
+    /// out (row-major, symmetric) = W diag(φ(w_m)) Wᵀ: column j is
+    /// [`Self::response`] to e_j, made in one pass (half the work).
+    pub(super) fn response_matrix(&self, phi: fn(&Weights) -> f64, out: &mut [f64]) {
+        let n = self.n;
+        for i in 0..n {
+            let wi = &self.w[i * n..(i + 1) * n];
+            for j in 0..=i {
+                let wj = &self.w[j * n..(j + 1) * n];
+                let v: f64 = (0..n).map(|m| wi[m] * phi(&self.weights[m]) * wj[m]).sum();
+                out[i * n + j] = v;
+                out[j * n + i] = v;
+            }
+        }
+    }
+
     /// y = W⁻¹ v.
     pub(super) fn to_modes(&self, v: &[f64], y: &mut [f64]) {
         mul(&self.w_inv, self.n, v, y);
@@ -319,6 +343,28 @@ mod tests {
                     (got[i] - want[i]).abs() < 1e-9 * (1.0 + want[i].abs()),
                     "column {j}: {got:?} vs {want:?}"
                 );
+            }
+        }
+    }
+
+    /// The response matrix's columns are the responses to unit impulses.
+    #[test]
+    fn response_matrix_columns_are_unit_responses() {
+        let m = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 0.3];
+        let mut chol = Cholesky::new(3);
+        chol.matrix_mut().copy_from_slice(&m);
+        chol.factor().unwrap_or_else(|row| panic!("row {row}"));
+        let mut modes = Modes::new(3);
+        modes.update(&chol, &[0.0, 2.0, 5e3], 1e-3);
+        let mut all = [0.0; 9];
+        modes.response_matrix(|w| w.phi1, &mut all);
+        for j in 0..3 {
+            let mut e = [0.0; 3];
+            e[j] = 1.0;
+            let (mut tmp, mut col) = ([0.0; 3], [0.0; 3]);
+            modes.response(|w| w.phi1, &e, &mut tmp, &mut col);
+            for i in 0..3 {
+                assert!((all[i * 3 + j] - col[i]).abs() < 1e-12 * (1.0 + col[i].abs()));
             }
         }
     }
