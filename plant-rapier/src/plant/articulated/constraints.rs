@@ -122,13 +122,7 @@ impl Impulses {
         // damping, friction's response is the modes' (a stop's impulse is
         // instantaneous, friction's a torque over the substep).
         if damped.is_none() || !stops.is_empty() {
-            for j in 0..n {
-                let col = &mut self.inverse[j * n..(j + 1) * n];
-                col.iter_mut()
-                    .enumerate()
-                    .for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
-                m.solve(col);
-            }
+            m.inverse_into(&mut self.inverse);
         }
         match damped {
             Some(modes) => modes.response_matrix(|w: &Weights| w.phi1, &mut self.friction_response),

@@ -77,6 +77,23 @@ impl Cholesky {
         }
     }
 
+    /// A⁻¹ into `out` (row-major; symmetric, so column j is row j), after
+    /// `factor`. L⁻¹ e_j is zero above row j, so its forward solve starts
+    /// there: two thirds of the work of n whole solves saved.
+    pub(super) fn inverse_into(&self, out: &mut [f64]) {
+        let (n, l) = (self.n, &self.a);
+        for j in 0..n {
+            let x = &mut out[j * n..(j + 1) * n];
+            x[..j].iter_mut().for_each(|v| *v = 0.0);
+            for i in j..n {
+                let start = if i == j { 1.0 } else { 0.0 };
+                let s = (j..i).fold(start, |s, k| s - l[i * n + k] * x[k]);
+                x[i] = s / l[i * n + i];
+            }
+            self.backward(x);
+        }
+    }
+
     /// L_ij (i ≥ j), after `factor`.
     pub(super) fn lower(&self, i: usize, j: usize) -> f64 {
         self.a[i * self.n + j]
@@ -93,6 +110,16 @@ mod tests {
         let a = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0];
         c.matrix_mut().copy_from_slice(&a);
         c.factor().unwrap_or_else(|row| panic!("row {row}"));
+        let mut inv = [0.0; 9];
+        c.inverse_into(&mut inv);
+        for j in 0..3 {
+            let mut col = [0.0; 3];
+            col[j] = 1.0;
+            c.solve(&mut col);
+            for i in 0..3 {
+                assert!((inv[j * 3 + i] - col[i]).abs() < 1e-15, "{inv:?}");
+            }
+        }
         let mut x = [1.0, -2.0, 0.5];
         c.solve(&mut x);
         for i in 0..3 {

@@ -431,21 +431,8 @@ impl Articulated {
     /// slope `extra` per joint: an upper bound on the largest eigenvalue of
     /// M⁻¹ E, since E is positive semi-definite.
     fn rate_of(&self, extra: &[f64]) -> f64 {
-        let n = self.armature.len();
-        let mut inverse_diagonal = vec![0.0; n];
-        let mut e = vec![0.0; n];
-        for (j, d) in inverse_diagonal.iter_mut().enumerate() {
-            e.iter_mut()
-                .enumerate()
-                .for_each(|(i, x)| *x = f64::from(u8::from(i == j)));
-            self.scratch.chol.solve(&mut e);
-            *d = e[j];
-        }
-        extra
-            .iter()
-            .zip(&inverse_diagonal)
-            .map(|(d, m)| d * m)
-            .sum::<f64>()
+        let mut scratch = vec![0.0; extra.len()];
+        exponential::damping_trace(&self.scratch.chol, extra, &mut scratch)
     }
 
     /// Dry friction and hard stops as impulses at the end of a substep
