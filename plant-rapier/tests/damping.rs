@@ -34,7 +34,7 @@ fn torque(t: f64) -> [f64; 2] {
     [2.0 * (3.0 * t).sin(), step + 0.05 * (20.0 * t).cos()]
 }
 
-fn run(plant: &mut Plant, seconds: f64) -> Vec<(Vec<f64>, Vec<f64>)> {
+fn run(plant: &mut Plant, seconds: f64) -> States {
     let dt = 1e-3;
     plant.set_state(&[0.3, 0.0], &[0.0, 2.0]).unwrap();
     let mut out = Vec::new();
@@ -43,6 +43,20 @@ fn run(plant: &mut Plant, seconds: f64) -> Vec<(Vec<f64>, Vec<f64>)> {
         out.push(plant.state());
     }
     out
+}
+
+type States = Vec<(Vec<f64>, Vec<f64>)>;
+
+/// The largest |Δq| and |Δq̇| between two runs, step by step.
+fn largest_gaps(a: &States, b: &States) -> (f64, f64) {
+    let (mut gap_q, mut gap_qd) = (0.0f64, 0.0f64);
+    for ((qa, va), (qb, vb)) in a.iter().zip(b) {
+        for i in 0..qa.len() {
+            gap_q = gap_q.max((qa[i] - qb[i]).abs());
+            gap_qd = gap_qd.max((va[i] - vb[i]).abs());
+        }
+    }
+    (gap_q, gap_qd)
 }
 
 /// One step per period with URDF damping 10 N m s on a 5 g wheel, against
@@ -70,13 +84,7 @@ fn a_heavily_damped_light_joint_takes_one_step_and_matches_a_fine_reference() {
 
     let a = run(&mut plant, 0.3);
     let b = run(&mut reference, 0.3);
-    let (mut gap_q, mut gap_qd) = (0.0f64, 0.0f64);
-    for ((qa, va), (qb, vb)) in a.iter().zip(&b) {
-        for i in 0..2 {
-            gap_q = gap_q.max((qa[i] - qb[i]).abs());
-            gap_qd = gap_qd.max((va[i] - vb[i]).abs());
-        }
-    }
+    let (gap_q, gap_qd) = largest_gaps(&a, &b);
     let moved = (a[a.len() - 1].0[1] - 0.0).abs();
     assert!(moved > 1e-3, "the wheel did not move ({moved})");
     assert!(
@@ -124,13 +132,7 @@ fn a_mildly_damped_joint_takes_plain_rk4_and_matches_a_fine_reference() {
     assert_eq!(reference.substeps_per_period(1e-3), 64);
     let a = run(&mut plant, 0.3);
     let b = run(&mut reference, 0.3);
-    let (mut gap_q, mut gap_qd) = (0.0f64, 0.0f64);
-    for ((qa, va), (qb, vb)) in a.iter().zip(&b) {
-        for i in 0..2 {
-            gap_q = gap_q.max((qa[i] - qb[i]).abs());
-            gap_qd = gap_qd.max((va[i] - vb[i]).abs());
-        }
-    }
+    let (gap_q, gap_qd) = largest_gaps(&a, &b);
     assert!(
         gap_q < 1e-5 && gap_qd < 2e-3,
         "one step vs 64: |Δq| {gap_q:e} rad, |Δq̇| {gap_qd:e} rad/s"
