@@ -12,6 +12,8 @@ use rayon::prelude::*;
 use scenario::Plan;
 use serde::Serialize;
 
+use crate::compare_external::external_row;
+pub use crate::compare_external::{ExternalRow, ExternalSpec};
 use crate::sim::{self, StepCosts};
 use analysis::law_info::LawInfo;
 use analysis::stats::{MedianInterval, SignedRank, median_interval, quantile, signed_rank};
@@ -77,25 +79,6 @@ pub struct CompareOptions {
     pub runs_dir: std::path::PathBuf,
     /// Show a progress bar on standard error (a terminal).
     pub progress: bool,
-}
-
-/// A user's controller in the table: its row's label and its command.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ExternalSpec {
-    /// The row's name.
-    pub label: String,
-    /// The program and its arguments.
-    pub command: Vec<String>,
-}
-
-/// What a row of a user's controller says about it.
-#[derive(Debug, Clone, Serialize)]
-pub struct ExternalRow {
-    /// The command.
-    pub command: String,
-    /// The law it declared (`CMD --describe`) with its parameters, if it
-    /// declared one.
-    pub declared: Option<analysis::report::ExternalLaw>,
 }
 
 /// The first seed's curves of one law, for the overlay figures.
@@ -524,83 +507,7 @@ pub fn failed_because(failure: Option<&str>, s: &Summary) -> Option<String> {
     (!why.is_empty()).then(|| why.join("; "))
 }
 
-/// A user's controller over every seed: each seed's plan (the scenario's
-/// law and gains, that seed's draws) run in lockstep with the command as
-/// the controller node, one run at a time.
-fn external_row(
-    plan: &Plan,
-    spec: &ExternalSpec,
-    opts: &CompareOptions,
-    bar: Option<&indicatif::ProgressBar>,
-) -> Result<LawRow, CompareError> {
-    let law = plan.undrawn.controller.law;
-    let mut runs = Vec::new();
-    let mut declared = None;
-    for s in 0..opts.seeds {
-        let p = plan_for(plan, law, s, opts.tuning)?;
-        let seed = p.scenario.seed;
-        let run = crate::run::run(crate::run::RunOptions {
-            plan: p,
-            mode: wire::Mode::Lockstep,
-            csv: None,
-            external: Vec::new(),
-            runs_dir: opts.runs_dir.clone(),
-            name: None,
-            progress: false,
-            realtime_setup: false,
-            verbose: false,
-            controller_cmd: Some(spec.command.clone()),
-            live: None,
-            log_compression: logger::LogCompression::default(),
-        });
-        if let Some(b) = bar {
-            b.inc(1);
-        }
-        runs.push(match run {
-            Ok(o) => {
-                let meta = |k: &str| o.analysis.contents.run.get(k).cloned().unwrap_or_default();
-                let name = meta("controller_name");
-                declared = (!name.is_empty()).then(|| analysis::report::ExternalLaw {
-                    name,
-                    parameters: meta("controller_params"),
-                    // Per run, not per law: in each run's own summary.
-                    diagnostics: Vec::new(),
-                });
-                let summary = o.analysis.summary;
-                LawRun {
-                    seed,
-                    failed: failed_because(None, &summary),
-                    failure: None,
-                    summary,
-                    compute_us: o.analysis.timing.controller_compute_us,
-                    series: None,
-                }
-            }
-            Err(e) => {
-                let why = format!("the run failed: {e}");
-                let names = plan.robot.model.joint_names();
-                let empty = SummaryBuilder::new(names, plan.dt(), plan.scenario.controller.tc);
-                LawRun {
-                    seed,
-                    failed: Some(why.clone()),
-                    failure: Some(why),
-                    summary: empty.finish(),
-                    compute_us: Percentiles::of(Vec::new()),
-                    series: None,
-                }
-            }
-        });
-    }
-    let mut r = row(LawInfo::of(&plan.undrawn.controller), runs);
-    r.name = spec.label.clone();
-    r.external = Some(ExternalRow {
-        command: shell_words::join(&spec.command),
-        declared,
-    });
-    Ok(r)
-}
-
-fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
+pub(crate) fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
     let mut rows: [Vec<(&'static str, f64)>; 6] = Default::default();
     let mut ci95 = None;
     for metric in METRICS {

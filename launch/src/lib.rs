@@ -16,6 +16,7 @@ pub mod bench_controller;
 pub mod bench_peer;
 pub mod bench_pingpong;
 pub mod compare;
+pub mod compare_external;
 pub mod compare_findings;
 pub mod compare_plots;
 pub mod compare_ratio_plot;
