@@ -169,6 +169,7 @@ class Loop:
         self.commands = bus.publisher("command", lossless=lockstep)
         self.diags = bus.publisher("diagnostics", lossless=lockstep)
         self.own_layout = info.own_diagnostics
+        self.own_names = frozenset(name for name, _ in self.own_layout)
         self.own = bus.publisher("own_diagnostics", lossless=lockstep) if self.own_layout else None
         self.idle = lambda: (bus.wait(0.001), link.check())
 
@@ -268,7 +269,7 @@ class Loop:
             d["d"][:n] = r["kc"][:n] * r["kc"][:n] - e * e
         d["tau"][:n] = tau
         d["tau_feedback"][:n] = tau
-        own = {name for name, _ in self.own_layout}
+        own = self.own_names
         for key, value in (extra or {}).items():
             if key in own:
                 continue

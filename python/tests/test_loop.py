@@ -83,6 +83,7 @@ class OwnDiagnostics(unittest.TestCase):
     def own_loop(self, layout="integral:joints,windup:scalar"):
         loop = loop_for(Fixed(None))
         loop.own_layout = parse_own_layout(layout)
+        loop.own_names = frozenset(name for name, _ in loop.own_layout)
         loop.own = Port(wire.OwnDiagnostics)
         loop.diags = Port(wire.ControllerDiagnostics)
         return loop
