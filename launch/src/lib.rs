@@ -20,6 +20,7 @@ pub mod compare_external;
 pub mod compare_findings;
 pub mod compare_plots;
 pub mod compare_ratio_plot;
+pub mod compare_scores;
 pub mod compare_tradeoff;
 pub mod mode;
 pub mod node;
