@@ -1,9 +1,10 @@
-//! What the testbed measures of an arm to choose its default gains: M(q)⁻¹
-//! and the gravity load G(q), from the plant's response to unit torques at
-//! rest. The controller never sees any of it; only the gains it leads to.
+//! What the testbed measures of an arm to choose its default gains: M(q),
+//! M(q)⁻¹ and the gravity load G(q), from the plant's own joint-space
+//! dynamics at rest. The controller never sees any of it; only the gains
+//! it leads to.
 
 use nalgebra::{DMatrix, DVector};
-use plant_rapier::{ArmModel, Plant, PlantConfig, PlantError};
+use plant_rapier::{ArmModel, EngineName, Plant, PlantConfig, PlantError};
 
 /// M(q)⁻¹ and G(q) at one posture, in the controlled joints' coordinates
 /// (mimic couplings included, as the controller feels them).
@@ -19,43 +20,37 @@ pub struct Probe {
 
 impl Probe {
     /// Probes `model` at `q` with `armature` (per joint) added.
+    ///
+    /// M and G are read from the articulated engine, not differenced from
+    /// a short step's response to unit torques: on a near-singular arm
+    /// (a head whose inertia is a point mass on its axis, M⁻¹_ii ~ 1e9)
+    /// the step itself moves the joint fast enough that its response is
+    /// no longer linear, and the load G = −M a₀ came out wrong by orders.
     pub fn at(model: &ArmModel, q: &[f64], armature: &[f64]) -> Result<Self, PlantError> {
         let n = model.dof();
-        // Dry friction would hold a unit torque back: probe without it.
         let config = PlantConfig {
+            engine: EngineName::Articulated,
             saturate: false,
             urdf_dynamics: false,
             armature: plant_rapier::PerJoint::Each(armature.to_vec()),
             ..PlantConfig::default()
         };
-        let h = 1e-5;
-        let accel = |tau: &[f64]| -> Result<Vec<f64>, PlantError> {
-            let mut p = Plant::new(model, &config)?;
-            p.set_state(q, &vec![0.0; n])?;
-            p.step(tau, h)?;
-            Ok(p.state().1.iter().map(|v| v / h).collect())
-        };
-        let a0 = accel(&vec![0.0; n])?;
-        let mut minv = DMatrix::zeros(n, n);
-        for k in 0..n {
-            let mut tau = vec![0.0; n];
-            tau[k] = 1.0;
-            let a = accel(&tau)?;
-            for i in 0..n {
-                minv[(i, k)] = a[i] - a0[i];
-            }
-        }
-        let minv = (&minv + minv.transpose()) * 0.5;
+        let mut plant = Plant::new(model, &config)?;
+        plant.set_state(q, &vec![0.0; n])?;
+        let (m, bias) = plant.inertia_and_bias()?;
         let engine = |what: &str| PlantError::Engine(format!("probing M(q) at {q:?}: {what}"));
-        if minv.iter().any(|x| !x.is_finite()) {
-            return Err(engine("the response to a unit torque is not finite"));
-        }
-        let m = minv
+        let m = DMatrix::from_row_slice(n, n, &m);
+        let m = (&m + m.transpose()) * 0.5;
+        let minv = m
             .clone()
-            .try_inverse()
-            .ok_or_else(|| engine("M(q)⁻¹ is singular"))?;
-        // At rest M a0 = −G, so G = −M a0.
-        let gravity = -(&m * DVector::from_vec(a0));
+            .cholesky()
+            .map(|c| c.inverse())
+            .ok_or_else(|| engine("M(q) is not positive definite"))?;
+        if minv.iter().any(|x| !x.is_finite()) {
+            return Err(engine("M(q)⁻¹ is not finite"));
+        }
+        // At rest the bias is G(q) alone.
+        let gravity = DVector::from_vec(bias);
         Ok(Self { minv, m, gravity })
     }
 
@@ -76,7 +71,7 @@ mod tests {
     use super::*;
 
     /// `ctc`'s matched gains use 1/(M⁻¹)_ii from its Newton–Euler model:
-    /// the same as the plant's response to unit torques.
+    /// the same as the plant's M(q)⁻¹.
     #[test]
     fn the_laws_effective_inertia_is_the_plants() {
         let model = ArmModel::from_urdf_str(plant_rapier::TWO_LINK_URDF).unwrap();

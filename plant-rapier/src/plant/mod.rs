@@ -212,6 +212,26 @@ impl Plant {
         }
     }
 
+    /// The joint-space dynamics at the current state, with the plant's
+    /// armature and URDF damping: M(q) (row-major, n × n) and the bias
+    /// h(q, q̇) = C(q, q̇) q̇ + G(q) + D q̇, so M q̈ + h = τ. Exact where a
+    /// step's response to unit torques would mix in the motion within the
+    /// step. Only the articulated engine computes them.
+    pub fn inertia_and_bias(&mut self) -> Result<(Vec<f64>, Vec<f64>), PlantError> {
+        let n = self.dof();
+        let (mut m, mut h) = (vec![0.0; n * n], vec![0.0; n]);
+        match &mut self.engine {
+            Engine::Articulated(a) => a.inertia_and_bias(&mut m, &mut h)?,
+            Engine::Rapier(_) => {
+                return Err(PlantError::Engine(
+                    "the Rapier engine does not give M(q) and h(q, q̇); use the articulated engine"
+                        .into(),
+                ));
+            }
+        }
+        Ok((m, h))
+    }
+
     /// Whether any joint has friction.
     pub fn has_friction(&self) -> bool {
         let f = &self.friction;

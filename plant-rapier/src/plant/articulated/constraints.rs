@@ -39,7 +39,6 @@ pub(super) struct Impulses {
     friction_dv: Vec<f64>,
     /// The friction impulse per controlled joint.
     friction_impulse: Vec<f64>,
-    tmp: Vec<f64>,
     n: usize,
 }
 
@@ -58,7 +57,6 @@ impl Impulses {
             friction_response: vec![0.0; n * n],
             friction_dv: vec![0.0; n],
             friction_impulse: vec![0.0; n],
-            tmp: vec![0.0; n],
             n,
         }
     }
@@ -66,6 +64,28 @@ impl Impulses {
     /// Whether anything may need an impulse after a substep that ends at q.
     pub(super) fn needed(&self, follow: &[Follow], q: &[f64]) -> bool {
         self.friction.iter().any(|f| *f > 0.0) || self.passed(follow, q).next().is_some()
+    }
+
+    /// The joints whose columns the friction rows and the stop rows read,
+    /// each once.
+    fn columns(&self, follow: &[Follow]) -> (Vec<usize>, Vec<usize>) {
+        let (mut friction, mut stops) = (Vec::new(), Vec::new());
+        for row in &self.rows {
+            let (coord, list) = match *row {
+                Row::Friction { coord, .. } => (coord, &mut friction),
+                Row::Stop { coord, .. } => (coord, &mut stops),
+            };
+            let leader = follow[coord].leader;
+            if !list.contains(&leader) {
+                list.push(leader);
+            }
+        }
+        (friction, stops)
+    }
+
+    /// Whether a stop is passed at q.
+    pub(super) fn stop_passed(&self, follow: &[Follow], q: &[f64]) -> bool {
+        self.passed(follow, q).next().is_some()
     }
 
     /// Stops passed at q: (coordinate, upper, limit).
@@ -93,8 +113,9 @@ impl Impulses {
 
     /// Applies the impulses to q̇ (and friction's share of the substep to q),
     /// then puts every passed stop's coordinate back at the stop. `m` holds
-    /// the factored inertia at the end of the substep; `damped`, the URDF
-    /// damping's modes over it, if the arm has any.
+    /// the factored inertia at the end of the substep (read only for a
+    /// passed stop, or for friction when `damped` is None); `damped`, the
+    /// URDF damping's modes over it, if the step used them.
     pub(super) fn apply(
         &mut self,
         follow: &[Follow],
@@ -118,15 +139,24 @@ impl Impulses {
         for &(coord, upper, _) in &stops {
             self.rows.push(Row::Stop { coord, upper });
         }
-        // M⁻¹ for the stops, and for friction when no damping acts; with
-        // damping, friction's response is the modes' (a stop's impulse is
-        // instantaneous, friction's a torque over the substep).
-        if damped.is_none() || !stops.is_empty() {
-            m.inverse_into(&mut self.inverse);
-        }
+        // M⁻¹'s columns for the stops, and for friction when no damping
+        // acts; with damping, friction's response is the modes' (a stop's
+        // impulse is instantaneous, friction's a torque over the substep).
+        // Only the rows' own joints' columns are read.
+        let (friction_cols, stop_cols) = self.columns(follow);
         match damped {
-            Some(modes) => modes.response_matrix(|w: &Weights| w.phi1, &mut self.friction_response),
-            None => self.friction_response.copy_from_slice(&self.inverse),
+            Some(modes) => {
+                modes.response_columns(
+                    |w: &Weights| w.phi1,
+                    &friction_cols,
+                    &mut self.friction_response,
+                );
+                m.inverse_columns(&stop_cols, &mut self.inverse);
+            }
+            None => {
+                m.inverse_columns(&friction_cols, &mut self.friction_response);
+                m.inverse_columns(&stop_cols, &mut self.inverse);
+            }
         }
         self.lambda.clear();
         self.lambda.resize(self.rows.len(), 0.0);
@@ -169,12 +199,7 @@ impl Impulses {
         match damped {
             Some(modes) => {
                 let mut dq = std::mem::take(&mut self.friction_dv);
-                modes.response(
-                    |w: &Weights| w.phi2,
-                    &self.friction_impulse,
-                    &mut self.tmp,
-                    &mut dq,
-                );
+                modes.response(|w: &Weights| w.phi2, &self.friction_impulse, &mut dq);
                 for (q, dq) in q.iter_mut().zip(&dq) {
                     *q += h * dq;
                 }

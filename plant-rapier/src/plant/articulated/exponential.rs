@@ -1,19 +1,20 @@
-//! URDF viscous damping integrated exactly: exponential time differencing
-//! (ETDRK4, Cox & Matthews 2002) on the velocity, with the damping's linear
-//! part −M₀⁻¹D q̇ (M₀ the inertia at the start of the step) solved in closed
-//! form and everything else (gravity, Coriolis, the motors, the change of M
-//! within the step) explicit as in RK4.
+//! URDF viscous damping integrated exactly where it is stiff: exponential
+//! time differencing (ETDRK4, Cox & Matthews 2002) on the velocity, with
+//! the stiff part of the damping's linear term −M₀⁻¹D_S q̇ (M₀ the inertia
+//! at the start of the step) solved in closed form and everything else
+//! (gravity, Coriolis, the motors, the mild rest of the damping, the
+//! change of M within the step) explicit as in RK4.
 //!
 //! Why: explicit RK4 is stable only while h·λmax(M⁻¹D) ≲ 2.8, and a damped
 //! near-massless link has λ in the thousands to millions per second, which
-//! cost 3.5–18× the substeps. Here every damped mode decays by its exact
+//! cost 3.5–18× the substeps. Here every stiff mode decays by its exact
 //! factor e^(−λh) at any h, and a constant forcing reaches its exact steady
 //! velocity, so one step per period stays stable and accurate. With no
 //! damping the weights are RK4's: the engine keeps plain RK4 for such arms.
 //!
-//! M₀⁻¹D is diagonalised through the symmetric S = L⁻¹ D L⁻ᵀ (M₀ = L Lᵀ):
-//! S = V Λ Vᵀ gives M₀⁻¹D = W Λ W⁻¹ with W = L⁻ᵀ V and W⁻¹ = Vᵀ Lᵀ, so each
-//! mode is a scalar ODE and the matrix functions are per-eigenvalue weights.
+//! Only the joints that carry the most of h·tr(M₀⁻¹D) are in S (see
+//! [`Modes`]): M₀⁻¹D_S has rank |S|, so its modes come from an |S| × |S|
+//! eigendecomposition, and every other direction is a mode of rate 0.
 
 use nalgebra::{DMatrix, SymmetricEigen};
 
@@ -110,159 +111,241 @@ pub(super) fn phi(z: f64) -> [f64; 5] {
     out
 }
 
-/// tr(M⁻¹D) = Σ_j d_j ‖L⁻¹ e_j‖² for the factored M = L Lᵀ and the
-/// diagonal damping `d`: an upper bound on M⁻¹D's largest rate (its
-/// eigenvalues are those of L⁻¹ D L⁻ᵀ, all ≥ 0). L⁻¹ e_j is zero above
-/// row j, so each column costs (n − j)² / 2. `x` is scratch of length n.
-pub(super) fn damping_trace(chol: &Cholesky, d: &[f64], x: &mut [f64]) -> f64 {
-    let n = d.len();
+/// Largest h·tr(M⁻¹D) a step's explicit stages carry. tr(M⁻¹D) bounds
+/// the fastest damped rate λmax, so RK4's factor for that mode is within
+/// 5e-4 of the exact e^(−λh) (at λh = 0.5; far less below), and far
+/// inside its stability limit of 2.8. A step whose whole damping is this
+/// mild is plain RK4; otherwise the joints that carry the most of the
+/// trace are solved in modes until the rest is this mild.
+pub(super) const MILD_DAMPING: f64 = 0.5;
+
+/// Per joint j, its share d_j (M⁻¹)_jj of tr(M⁻¹D) into `out`, for the
+/// factored M and the diagonal damping `d`; returns tr(M⁻¹D), an upper
+/// bound on M⁻¹D's largest rate (its eigenvalues are those of
+/// L⁻¹ D L⁻ᵀ, all ≥ 0). `x` is scratch of length n.
+pub(super) fn damping_shares(chol: &Cholesky, d: &[f64], x: &mut [f64], out: &mut [f64]) -> f64 {
     let mut trace = 0.0;
-    for (j, &dj) in d.iter().enumerate() {
-        if dj <= 0.0 {
-            continue;
-        }
-        let mut sq = 0.0;
-        for i in j..n {
-            let start = if i == j { 1.0 } else { 0.0 };
-            let s = (j..i).fold(start, |s, k| s - chol.lower(i, k) * x[k]);
-            x[i] = s / chol.lower(i, i);
-            sq += x[i] * x[i];
-        }
-        trace += dj * sq;
+    for (j, (&dj, share)) in d.iter().zip(out.iter_mut()).enumerate() {
+        *share = if dj > 0.0 {
+            dj * chol.inverse_diagonal(j, x)
+        } else {
+            0.0
+        };
+        trace += *share;
     }
     trace
 }
 
-/// The damping's modes at the start of a step, and the stage buffers.
+/// The stiff damping's modes at the start of a step.
+///
+/// The joints whose shares of h·tr(M₀⁻¹D) are largest, until the rest is
+/// at most [`MILD_DAMPING`], form the stiff set S; their damping D_S is
+/// solved exactly and the rest stays explicit. A = M₀⁻¹D_S has rank |S|:
+/// with C = M₀⁻¹ √D_S and R = √D_S (S's rows), A = C R, and its non-zero
+/// rates are the eigenvalues of the small G = R C = √D_S (M₀⁻¹)_SS √D_S
+/// = U Λ Uᵀ. Mode m has w_m = C u_m / √λ_m and ŵ_m = Rᵀ u_m / √λ_m
+/// (ŵ_mᵀ w_k = δ_mk); every direction ŵ-orthogonal to them has rate 0.
+/// So a velocity's coordinates are the |S| modes' and, for that rest,
+/// the velocity minus its modes' part, in joint coordinates; an arm of 30
+/// joints with 4 stiff ones needs a 4 × 4 eigendecomposition, not 30 × 30.
 #[derive(Debug, Clone)]
 pub(super) struct Modes {
     n: usize,
-    /// W (row-major): a mode's coordinates → joint velocities.
+    /// M₀'s factor, for the responses.
+    m0: Cholesky,
+    /// The stiff joints, and their √d.
+    stiff: Vec<usize>,
+    root_d: Vec<f64>,
+    /// Kept modes: a rate under 1e-12 of the largest is left to the rest.
+    r: usize,
+    /// Mode m's w_m: `w[m * n + i]`.
     w: Vec<f64>,
-    /// W⁻¹ (row-major): joint velocities → the modes' coordinates.
-    w_inv: Vec<f64>,
-    /// The weights per mode for the step size last used.
-    pub(super) weights: Vec<Weights>,
-    /// Decay rates λ_i, 1/s.
+    /// Mode m's ŵ_m on S: `w_hat[m * |S| + a]`.
+    w_hat: Vec<f64>,
     rates: Vec<f64>,
-    col: Vec<f64>,
-    s: DMatrix<f64>,
+    weights: Vec<Weights>,
+    /// The weights at rate 0, for the rest.
+    still: Weights,
+    /// C's columns: `cols[a * n + i]`.
+    cols: Vec<f64>,
+    ranked: Vec<usize>,
 }
 
 impl Modes {
-    pub(super) fn new(n: usize) -> Self {
+    pub(super) fn new(m0: Cholesky, n: usize) -> Self {
         Self {
             n,
+            m0,
+            stiff: Vec::with_capacity(n),
+            root_d: Vec::with_capacity(n),
+            r: 0,
             w: vec![0.0; n * n],
-            w_inv: vec![0.0; n * n],
-            weights: vec![Weights::new(0.0, 0.0); n],
+            w_hat: vec![0.0; n * n],
             rates: vec![0.0; n],
-            col: vec![0.0; n],
-            s: DMatrix::zeros(n, n),
+            weights: vec![Weights::new(0.0, 0.0); n],
+            still: Weights::new(0.0, 0.0),
+            cols: vec![0.0; n * n],
+            ranked: Vec::with_capacity(n),
         }
     }
 
-    /// The modes of M₀⁻¹D for the factored M₀ = L Lᵀ in `chol` and the
-    /// diagonal damping `d` (≥ 0), with the weights for step `h`.
-    pub(super) fn update(&mut self, chol: &Cholesky, d: &[f64], h: f64) {
-        let n = self.n;
-        // B = L⁻¹ √D column by column; S = B Bᵀ.
-        let mut b = vec![0.0; n * n];
-        for j in 0..n {
-            self.col.iter_mut().for_each(|x| *x = 0.0);
-            self.col[j] = d[j].max(0.0).sqrt();
-            chol.forward(&mut self.col);
-            for i in 0..n {
-                b[i * n + j] = self.col[i];
-            }
+    /// The modes for the factored M₀ in `chol`, the diagonal damping `d`
+    /// (≥ 0) and its `shares` (from [`damping_shares`]), with the weights
+    /// for step `h`.
+    pub(super) fn update(&mut self, chol: &Cholesky, d: &[f64], shares: &[f64], h: f64) {
+        self.m0.copy_factor(chol);
+        self.choose_stiff(d, shares, h);
+        let (n, s) = (self.n, self.stiff.len());
+        for (a, &b) in self.stiff.iter().enumerate() {
+            let col = &mut self.cols[a * n..(a + 1) * n];
+            col.iter_mut().for_each(|x| *x = 0.0);
+            col[b] = self.root_d[a];
+            chol.solve(col);
         }
-        for i in 0..n {
-            for j in 0..=i {
-                let v: f64 = (0..n).map(|k| b[i * n + k] * b[j * n + k]).sum();
-                self.s[(i, j)] = v;
-                self.s[(j, i)] = v;
+        let g = DMatrix::from_fn(s, s, |a, b| {
+            let ab = self.root_d[a] * self.cols[b * n + self.stiff[a]];
+            let ba = self.root_d[b] * self.cols[a * n + self.stiff[b]];
+            0.5 * (ab + ba)
+        });
+        let eig = SymmetricEigen::new(g);
+        let top = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
+        self.r = 0;
+        for (m, &lambda) in eig.eigenvalues.iter().enumerate() {
+            if lambda.is_nan() || lambda <= 1e-12 * top {
+                continue;
             }
+            let r = self.r;
+            let scale = lambda.sqrt().recip();
+            let u = eig.eigenvectors.column(m);
+            let wr = &mut self.w[r * n..(r + 1) * n];
+            wr.iter_mut().for_each(|x| *x = 0.0);
+            for (b, col) in self.cols.chunks_exact(n).take(s).enumerate() {
+                let c = u[b] * scale;
+                for (x, v) in wr.iter_mut().zip(col) {
+                    *x += c * v;
+                }
+            }
+            for a in 0..s {
+                self.w_hat[r * s + a] = self.root_d[a] * u[a] * scale;
+            }
+            self.rates[r] = lambda;
+            self.weights[r] = Weights::new(lambda, h);
+            self.r += 1;
         }
-        let eig = SymmetricEigen::new(self.s.clone());
-        for m in 0..n {
-            // W's column m = L⁻ᵀ v_m.
-            for i in 0..n {
-                self.col[i] = eig.eigenvectors[(i, m)];
+        self.still = Weights::new(0.0, h);
+    }
+
+    /// S: the joints with the largest shares until the rest is mild.
+    fn choose_stiff(&mut self, d: &[f64], shares: &[f64], h: f64) {
+        self.ranked.clear();
+        self.ranked.extend((0..self.n).filter(|&j| shares[j] > 0.0));
+        self.ranked
+            .sort_by(|&a, &b| shares[b].total_cmp(&shares[a]).then(a.cmp(&b)));
+        let mut rest: f64 = shares.iter().sum();
+        self.stiff.clear();
+        self.root_d.clear();
+        for &j in &self.ranked {
+            if h * rest <= MILD_DAMPING {
+                break;
             }
-            chol.backward(&mut self.col);
-            for i in 0..n {
-                self.w[i * n + m] = self.col[i];
-            }
-            // W⁻¹'s row m = v_mᵀ Lᵀ, i.e. (L v_m)ᵀ.
-            for i in 0..n {
-                self.w_inv[m * n + i] = (0..=i)
-                    .map(|k| chol.lower(i, k) * eig.eigenvectors[(k, m)])
-                    .sum();
-            }
-            // Rounding can leave a zero rate slightly negative.
-            self.rates[m] = eig.eigenvalues[m].max(0.0);
-            self.weights[m] = Weights::new(self.rates[m], h);
+            rest -= shares[j];
+            self.stiff.push(j);
+            self.root_d.push(d[j].sqrt());
         }
     }
 
-    /// Decay rate of mode `m`.
+    /// The length of a velocity's coordinates: the modes, then the rest.
+    pub(super) fn len(&self) -> usize {
+        self.r + self.n
+    }
+
+    /// The weights of coordinate `m`.
+    pub(super) fn weight(&self, m: usize) -> Weights {
+        if m < self.r {
+            self.weights[m]
+        } else {
+            self.still
+        }
+    }
+
+    /// Decay rate of coordinate `m`.
     pub(super) fn rate(&self, m: usize) -> f64 {
-        self.rates[m]
+        if m < self.r { self.rates[m] } else { 0.0 }
     }
 
-    /// out = W diag(φ(w_m)) Wᵀ x: with φ1, the velocity a constant torque
-    /// whose impulse over the step is x leaves (M₀⁻¹ x undamped; W Wᵀ =
-    /// M₀⁻¹); with φ2, its displacement per step.
-    /// `tmp` is scratch of length n.
-    pub(super) fn response(
+    /// out = φ(A) M₀⁻¹ x = φ(0) M₀⁻¹ x + Σ_m (φ(λ_m) − φ(0)) w_m w_mᵀ x
+    /// (ŵ_mᵀ M₀⁻¹ = w_mᵀ): with φ1, the velocity a constant torque whose
+    /// impulse over the step is x leaves (M₀⁻¹ x undamped); with φ2, its
+    /// displacement per step.
+    pub(super) fn response(&self, phi: fn(&Weights) -> f64, x: &[f64], out: &mut [f64]) {
+        let n = self.n;
+        out.copy_from_slice(x);
+        self.m0.solve(out);
+        let p0 = phi(&self.still);
+        out.iter_mut().for_each(|v| *v *= p0);
+        for m in 0..self.r {
+            let wm = &self.w[m * n..(m + 1) * n];
+            let c = (phi(&self.weights[m]) - p0) * dot(wm, x);
+            for (o, w) in out.iter_mut().zip(wm) {
+                *o += c * w;
+            }
+        }
+    }
+
+    /// Columns `cols` of φ(A) M₀⁻¹ (symmetric) into `out` (row-major
+    /// n × n, column j as row j; other rows untouched): column j is
+    /// [`Self::response`] to e_j.
+    pub(super) fn response_columns(
         &self,
         phi: fn(&Weights) -> f64,
-        x: &[f64],
-        tmp: &mut [f64],
+        cols: &[usize],
         out: &mut [f64],
     ) {
         let n = self.n;
-        for (m, c) in tmp.iter_mut().enumerate() {
-            let wt_x: f64 = (0..n).map(|i| self.w[i * n + m] * x[i]).sum();
-            *c = phi(&self.weights[m]) * wt_x;
-        }
-        mul(&self.w, n, tmp, out);
-    }
-
-    /// out (row-major, symmetric) = W diag(φ(w_m)) Wᵀ: column j is
-    /// [`Self::response`] to e_j, made in one pass (half the work).
-    pub(super) fn response_matrix(&self, phi: fn(&Weights) -> f64, out: &mut [f64]) {
-        let n = self.n;
-        for i in 0..n {
-            let wi = &self.w[i * n..(i + 1) * n];
-            for j in 0..=i {
-                let wj = &self.w[j * n..(j + 1) * n];
-                let v: f64 = (0..n).map(|m| wi[m] * phi(&self.weights[m]) * wj[m]).sum();
-                out[i * n + j] = v;
-                out[j * n + i] = v;
+        self.m0.inverse_columns(cols, out);
+        let p0 = phi(&self.still);
+        for &j in cols {
+            let col = &mut out[j * n..(j + 1) * n];
+            col.iter_mut().for_each(|v| *v *= p0);
+            for m in 0..self.r {
+                let wm = &self.w[m * n..(m + 1) * n];
+                let c = (phi(&self.weights[m]) - p0) * wm[j];
+                for (o, w) in col.iter_mut().zip(wm) {
+                    *o += c * w;
+                }
             }
         }
     }
 
-    /// y = W⁻¹ v.
+    /// The coordinates of v: y_m = ŵ_mᵀ v, then v − Σ_m w_m y_m.
     pub(super) fn to_modes(&self, v: &[f64], y: &mut [f64]) {
-        mul(&self.w_inv, self.n, v, y);
+        let (n, r, s) = (self.n, self.r, self.stiff.len());
+        for (ym, wh) in y[..r].iter_mut().zip(self.w_hat.chunks_exact(s.max(1))) {
+            *ym = self.stiff.iter().zip(wh).map(|(&j, w)| w * v[j]).sum();
+        }
+        let (modes, rest) = y.split_at_mut(r);
+        rest[..n].copy_from_slice(v);
+        for (m, ym) in modes.iter().enumerate() {
+            for (o, w) in rest[..n].iter_mut().zip(&self.w[m * n..(m + 1) * n]) {
+                *o -= ym * w;
+            }
+        }
     }
 
-    /// v = W y.
+    /// v = Σ_m w_m y_m + the rest.
     pub(super) fn to_joints(&self, y: &[f64], v: &mut [f64]) {
-        mul(&self.w, self.n, y, v);
+        let (n, r) = (self.n, self.r);
+        v.copy_from_slice(&y[r..r + n]);
+        for (m, ym) in y[..r].iter().enumerate() {
+            for (o, w) in v.iter_mut().zip(&self.w[m * n..(m + 1) * n]) {
+                *o += ym * w;
+            }
+        }
     }
 }
 
-fn mul(a: &[f64], n: usize, x: &[f64], out: &mut [f64]) {
-    for (i, o) in out.iter_mut().enumerate().take(n) {
-        *o = a[i * n..(i + 1) * n]
-            .iter()
-            .zip(x)
-            .map(|(a, x)| a * x)
-            .sum();
-    }
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
 }
 
 #[cfg(test)]
@@ -311,81 +394,91 @@ mod tests {
         }
     }
 
-    /// W⁻¹ W = I and W Λ W⁻¹ = M⁻¹ D on a coupled inertia with one
-    /// undamped, one mildly and one stiffly damped joint.
-    #[test]
-    fn the_modes_diagonalise_m_inverse_d() {
-        let m = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 0.3];
-        let d = [0.0, 2.0, 5e3];
+    const M: [f64; 9] = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 0.3];
+    const D: [f64; 3] = [0.0, 2.0, 5e3];
+
+    fn modes_at(h: f64) -> (Cholesky, Modes) {
         let mut chol = Cholesky::new(3);
-        chol.matrix_mut().copy_from_slice(&m);
+        chol.matrix_mut().copy_from_slice(&M);
         chol.factor().unwrap_or_else(|row| panic!("row {row}"));
-        let mut modes = Modes::new(3);
-        modes.update(&chol, &d, 1e-3);
-        for j in 0..3 {
-            // Column j of M⁻¹ D, and of W Λ W⁻¹, and W W⁻¹ e_j.
-            let mut want = [0.0; 3];
-            want[j] = d[j];
-            chol.solve(&mut want);
-            let mut e = [0.0; 3];
-            e[j] = 1.0;
-            let (mut y, mut back) = ([0.0; 3], [0.0; 3]);
-            modes.to_modes(&e, &mut y);
-            modes.to_joints(&y, &mut back);
-            y.iter_mut()
-                .enumerate()
-                .for_each(|(k, y)| *y *= modes.rate(k));
-            let mut got = [0.0; 3];
-            modes.to_joints(&y, &mut got);
-            for i in 0..3 {
-                assert!((back[i] - e[i]).abs() < 1e-12, "W W⁻¹ column {j}: {back:?}");
-                assert!(
-                    (got[i] - want[i]).abs() < 1e-9 * (1.0 + want[i].abs()),
-                    "column {j}: {got:?} vs {want:?}"
-                );
+        let mut shares = [0.0; 3];
+        damping_shares(&chol, &D, &mut [0.0; 3], &mut shares);
+        let mut modes = Modes::new(chol.clone(), 3);
+        modes.update(&chol, &D, &shares, h);
+        (chol, modes)
+    }
+
+    /// The coordinates go back to the same velocity, and A = W Λ Ŵᵀ is
+    /// M⁻¹ D_S: at 1 ms only the stiff joint (h·share 17) is in S, the
+    /// mild one (7e-4) stays explicit; at 1 s both are in S.
+    #[test]
+    fn the_modes_diagonalise_the_stiff_part_of_m_inverse_d() {
+        for (h, stiff) in [(1e-3, [0.0, 0.0, D[2]]), (1.0, D)] {
+            let (chol, modes) = modes_at(h);
+            assert_eq!(modes.len(), 3 + stiff.iter().filter(|d| **d > 0.0).count());
+            for j in 0..3 {
+                let mut want = [0.0; 3];
+                want[j] = stiff[j];
+                chol.solve(&mut want);
+                let mut e = [0.0; 3];
+                e[j] = 1.0;
+                let (mut y, mut back) = ([0.0; 6], [0.0; 3]);
+                modes.to_modes(&e, &mut y);
+                modes.to_joints(&y, &mut back);
+                y.iter_mut()
+                    .enumerate()
+                    .for_each(|(k, y)| *y *= modes.rate(k));
+                let mut got = [0.0; 3];
+                modes.to_joints(&y, &mut got);
+                for i in 0..3 {
+                    assert!(
+                        (back[i] - e[i]).abs() < 1e-12,
+                        "h {h}, column {j}: {back:?}"
+                    );
+                    assert!(
+                        (got[i] - want[i]).abs() < 1e-9 * (1.0 + want[i].abs()),
+                        "h {h}, column {j}: {got:?} vs {want:?}"
+                    );
+                }
             }
         }
     }
 
-    /// The response matrix's columns are the responses to unit impulses.
+    /// The response matrix's columns are the responses to unit impulses,
+    /// and φ1(A) M⁻¹ with every joint stiff is W diag(φ1) Wᵀ.
     #[test]
     fn response_matrix_columns_are_unit_responses() {
-        let m = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 0.3];
-        let mut chol = Cholesky::new(3);
-        chol.matrix_mut().copy_from_slice(&m);
-        chol.factor().unwrap_or_else(|row| panic!("row {row}"));
-        let mut modes = Modes::new(3);
-        modes.update(&chol, &[0.0, 2.0, 5e3], 1e-3);
-        let mut all = [0.0; 9];
-        modes.response_matrix(|w| w.phi1, &mut all);
-        for j in 0..3 {
-            let mut e = [0.0; 3];
-            e[j] = 1.0;
-            let (mut tmp, mut col) = ([0.0; 3], [0.0; 3]);
-            modes.response(|w| w.phi1, &e, &mut tmp, &mut col);
-            for i in 0..3 {
-                assert!((all[i * 3 + j] - col[i]).abs() < 1e-12 * (1.0 + col[i].abs()));
+        for h in [1e-3, 1.0] {
+            let (_, modes) = modes_at(h);
+            let mut all = [0.0; 9];
+            modes.response_columns(|w| w.phi1, &[0, 1, 2], &mut all);
+            for j in 0..3 {
+                let mut e = [0.0; 3];
+                e[j] = 1.0;
+                let mut col = [0.0; 3];
+                modes.response(|w| w.phi1, &e, &mut col);
+                for i in 0..3 {
+                    assert!((all[i * 3 + j] - col[i]).abs() < 1e-12 * (1.0 + col[i].abs()));
+                }
             }
         }
     }
 
-    /// tr(M⁻¹D) from the factor equals the trace of M⁻¹D computed whole.
+    /// tr(M⁻¹D) from the shares equals the trace of M⁻¹D computed whole.
     #[test]
-    fn damping_trace_is_the_trace_of_m_inverse_d() {
-        let m = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 0.3];
-        let d = [0.0, 2.0, 5e3];
-        let mut chol = Cholesky::new(3);
-        chol.matrix_mut().copy_from_slice(&m);
-        chol.factor().unwrap_or_else(|row| panic!("row {row}"));
+    fn damping_shares_sum_to_the_trace_of_m_inverse_d() {
+        let (chol, _) = modes_at(1e-3);
         let mut want = 0.0;
         for j in 0..3 {
             let mut col = [0.0; 3];
-            col[j] = d[j];
+            col[j] = D[j];
             chol.solve(&mut col);
             want += col[j];
         }
-        let got = damping_trace(&chol, &d, &mut [0.0; 3]);
+        let mut shares = [0.0; 3];
+        let got = damping_shares(&chol, &D, &mut [0.0; 3], &mut shares);
         assert!((got - want).abs() < 1e-12 * want, "{got} vs {want}");
+        assert_eq!(shares[0], 0.0);
     }
 
     /// A constant forcing f on v̇ = −λv + f over one step lands exactly on

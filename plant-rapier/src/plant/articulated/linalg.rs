@@ -1,102 +1,190 @@
-//! A Cholesky factorisation of a small symmetric positive-definite matrix in
-//! place, with no allocation per call (the joint-space inertia, factored
-//! four times per RK4 step).
+//! A Cholesky factorisation of the joint-space inertia in place, with no
+//! allocation per call (it is factored four or five times per step), that
+//! skips the zeros a branched arm's inertia has.
+//!
+//! Two joints on different branches (a left and a right arm) do not couple:
+//! their entry of M is zero. Eliminated leaves first, a tree's factor has
+//! no fill: column k of L is non-zero only at k's ancestors (Featherstone
+//! 2008, §6.5). So the factor is made in an elimination order (children
+//! before parents) and each column keeps the rows it can reach; a serial
+//! arm has all of them, a humanoid's 30 joints a tenth of the dense work.
+//! The order and the rows are fixed when the arm is built; the matrix in
+//! and the vectors out stay in the joints' own order.
 
-/// An n × n matrix (row-major) and, after `factor`, its lower factor L.
+/// An n × n matrix (row-major, the joints' order) and, after `factor`, its
+/// factor L L̃ᵀ = P M Pᵀ in the elimination order.
 #[derive(Debug, Clone)]
 pub(super) struct Cholesky {
     n: usize,
     a: Vec<f64>,
+    /// The factor, row-major in the elimination order (lower part).
+    l: Vec<f64>,
+    /// 1 / L_kk: the solves multiply (a division is ten times a product).
+    inv_diag: Vec<f64>,
+    /// Elimination position → joint.
+    order: Vec<usize>,
+    /// Joint → elimination position.
+    pos: Vec<usize>,
+    /// Per position k: the later positions where column k of L may be
+    /// non-zero, ascending (fill included).
+    below: Vec<Vec<usize>>,
 }
 
 impl Cholesky {
+    /// A dense n × n factorisation in the joints' order.
+    #[cfg(test)]
     pub(super) fn new(n: usize) -> Self {
+        Self::with_structure((0..n).collect(), |_, _| true)
+    }
+
+    /// A factorisation that eliminates the joints in `order` (each joint
+    /// once) where M's entry (i, j) can be non-zero only when
+    /// `coupled(i, j)`.
+    pub(super) fn with_structure(
+        order: Vec<usize>,
+        coupled: impl Fn(usize, usize) -> bool,
+    ) -> Self {
+        let n = order.len();
+        let mut pos = vec![0; n];
+        for (k, &j) in order.iter().enumerate() {
+            pos[j] = k;
+        }
+        // Symbolic elimination: removing k couples every pair it reaches.
+        let mut reach = vec![false; n * n];
+        for i in 0..n {
+            for k in 0..i {
+                let c = coupled(order[i], order[k]) || coupled(order[k], order[i]);
+                reach[i * n + k] = c;
+            }
+        }
+        let mut below = Vec::with_capacity(n);
+        for k in 0..n {
+            let rows: Vec<usize> = (k + 1..n).filter(|&i| reach[i * n + k]).collect();
+            for (x, &i) in rows.iter().enumerate() {
+                for &j in &rows[..x] {
+                    reach[i * n + j] = true;
+                }
+            }
+            below.push(rows);
+        }
         Self {
             n,
             a: vec![0.0; n * n],
+            l: vec![0.0; n * n],
+            inv_diag: vec![0.0; n],
+            order,
+            pos,
+            below,
         }
     }
 
-    /// The matrix to fill before `factor` (row-major).
+    /// The matrix to fill before `factor` (row-major, the joints' order).
     pub(super) fn matrix_mut(&mut self) -> &mut [f64] {
         &mut self.a
     }
 
-    /// A = L Lᵀ in place; Err(row) where A is not positive definite (or NaN).
+    /// The matrix as filled (`factor` leaves it).
+    pub(super) fn matrix(&self) -> &[f64] {
+        &self.a
+    }
+
+    /// Factors the matrix; Err(joint) where it is not positive definite (or
+    /// NaN): the first joint whose pivot is.
     pub(super) fn factor(&mut self) -> Result<(), usize> {
-        let (n, a) = (self.n, &mut self.a);
-        for j in 0..n {
-            let mut d = a[j * n + j];
-            for k in 0..j {
-                d -= a[j * n + k] * a[j * n + k];
+        let n = self.n;
+        for (k, &jk) in self.order.iter().enumerate() {
+            self.l[k * n + k] = self.a[jk * n + jk];
+            for &i in &self.below[k] {
+                self.l[i * n + k] = self.a[self.order[i] * n + jk];
             }
+        }
+        let l = &mut self.l;
+        for k in 0..n {
+            let d = l[k * n + k];
             // Not positive, or NaN.
             if d.is_nan() || d <= 0.0 {
-                return Err(j);
+                return Err(self.order[k]);
             }
             let d = d.sqrt();
-            a[j * n + j] = d;
-            for i in j + 1..n {
-                let mut s = a[i * n + j];
-                for k in 0..j {
-                    s -= a[i * n + k] * a[j * n + k];
+            l[k * n + k] = d;
+            let inv = d.recip();
+            self.inv_diag[k] = inv;
+            let rows = &self.below[k];
+            for &i in rows {
+                l[i * n + k] *= inv;
+            }
+            // The Schur complement on the rows k reaches.
+            for (x, &i) in rows.iter().enumerate() {
+                let lik = l[i * n + k];
+                for &j in &rows[..=x] {
+                    l[i * n + j] -= lik * l[j * n + k];
                 }
-                a[i * n + j] = s / d;
             }
         }
         Ok(())
     }
 
-    /// x = A⁻¹ b in place, after `factor`.
+    /// x = M⁻¹ b in place, after `factor`.
     pub(super) fn solve(&self, b: &mut [f64]) {
-        self.forward(b);
+        self.forward(b, 0);
         self.backward(b);
     }
 
-    /// x = L⁻¹ b in place, after `factor`.
-    pub(super) fn forward(&self, b: &mut [f64]) {
-        let (n, l) = (self.n, &self.a);
-        for i in 0..n {
-            let mut s = b[i];
-            for k in 0..i {
-                s -= l[i * n + k] * b[k];
+    /// b ← L⁻¹ P b (kept in the joints' slots), where P b is zero before
+    /// position `from`.
+    fn forward(&self, b: &mut [f64], from: usize) {
+        let (n, l) = (self.n, &self.l);
+        for k in from..self.n {
+            let jk = self.order[k];
+            if b[jk] == 0.0 {
+                continue;
             }
-            b[i] = s / l[i * n + i];
+            let y = b[jk] * self.inv_diag[k];
+            b[jk] = y;
+            for &i in &self.below[k] {
+                b[self.order[i]] -= l[i * n + k] * y;
+            }
         }
     }
 
-    /// x = L⁻ᵀ b in place, after `factor`.
-    pub(super) fn backward(&self, b: &mut [f64]) {
-        let (n, l) = (self.n, &self.a);
-        for i in (0..n).rev() {
-            let mut s = b[i];
-            for k in i + 1..n {
-                s -= l[k * n + i] * b[k];
-            }
-            b[i] = s / l[i * n + i];
+    /// b ← Pᵀ L⁻ᵀ b, after [`Self::forward`].
+    fn backward(&self, b: &mut [f64]) {
+        let (n, l) = (self.n, &self.l);
+        for k in (0..n).rev() {
+            let s = self.below[k].iter().fold(b[self.order[k]], |s, &i| {
+                s - l[i * n + k] * b[self.order[i]]
+            });
+            b[self.order[k]] = s * self.inv_diag[k];
         }
     }
 
-    /// A⁻¹ into `out` (row-major; symmetric, so column j is row j), after
-    /// `factor`. L⁻¹ e_j is zero above row j, so its forward solve starts
-    /// there: two thirds of the work of n whole solves saved.
-    pub(super) fn inverse_into(&self, out: &mut [f64]) {
-        let (n, l) = (self.n, &self.a);
-        for j in 0..n {
+    /// (M⁻¹)_jj = ‖L⁻¹ P e_j‖², after `factor`; `x` is scratch of length n.
+    /// P e_j is zero before j's position, so only the rows j reaches work.
+    pub(super) fn inverse_diagonal(&self, j: usize, x: &mut [f64]) -> f64 {
+        x.iter_mut().for_each(|v| *v = 0.0);
+        x[j] = 1.0;
+        self.forward(x, self.pos[j]);
+        x.iter().map(|v| v * v).sum()
+    }
+
+    /// M⁻¹'s columns `cols` into `out` (row-major n × n; symmetric, so
+    /// column j is row j; other rows untouched), after `factor`: each
+    /// column's forward solve starts at its joint's position.
+    pub(super) fn inverse_columns(&self, cols: &[usize], out: &mut [f64]) {
+        let n = self.n;
+        for &j in cols {
             let x = &mut out[j * n..(j + 1) * n];
-            x[..j].iter_mut().for_each(|v| *v = 0.0);
-            for i in j..n {
-                let start = if i == j { 1.0 } else { 0.0 };
-                let s = (j..i).fold(start, |s, k| s - l[i * n + k] * x[k]);
-                x[i] = s / l[i * n + i];
-            }
+            x.iter_mut().for_each(|v| *v = 0.0);
+            x[j] = 1.0;
+            self.forward(x, self.pos[j]);
             self.backward(x);
         }
     }
 
-    /// L_ij (i ≥ j), after `factor`.
-    pub(super) fn lower(&self, i: usize, j: usize) -> f64 {
-        self.a[i * self.n + j]
+    /// Takes `other`'s factor (same structure), keeping this one's buffers.
+    pub(super) fn copy_factor(&mut self, other: &Self) {
+        self.l.copy_from_slice(&other.l);
+        self.inv_diag.copy_from_slice(&other.inv_diag);
     }
 }
 
@@ -104,14 +192,20 @@ impl Cholesky {
 mod tests {
     use super::*;
 
+    fn factored(n: usize, a: &[f64]) -> Cholesky {
+        let mut c = Cholesky::new(n);
+        c.matrix_mut().copy_from_slice(a);
+        c.factor().unwrap_or_else(|row| panic!("row {row}"));
+        c
+    }
+
     #[test]
     fn solves_a_spd_system_and_refuses_a_singular_one() {
-        let mut c = Cholesky::new(3);
         let a = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0];
-        c.matrix_mut().copy_from_slice(&a);
-        c.factor().unwrap_or_else(|row| panic!("row {row}"));
+        let c = factored(3, &a);
         let mut inv = [0.0; 9];
-        c.inverse_into(&mut inv);
+        c.inverse_columns(&[0, 1, 2], &mut inv);
+        let mut x = [0.0; 3];
         for j in 0..3 {
             let mut col = [0.0; 3];
             col[j] = 1.0;
@@ -119,6 +213,7 @@ mod tests {
             for i in 0..3 {
                 assert!((inv[j * 3 + i] - col[i]).abs() < 1e-15, "{inv:?}");
             }
+            assert!((c.inverse_diagonal(j, &mut x) - col[j]).abs() < 1e-15);
         }
         let mut x = [1.0, -2.0, 0.5];
         c.solve(&mut x);
@@ -126,10 +221,67 @@ mod tests {
             let ax: f64 = (0..3).map(|k| a[i * 3 + k] * x[k]).sum();
             assert!((ax - [1.0, -2.0, 0.5][i]).abs() < 1e-14);
         }
+        let mut c = Cholesky::new(3);
         c.matrix_mut()
             .copy_from_slice(&[1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
         assert_eq!(c.factor(), Err(1));
         c.matrix_mut()[0] = f64::NAN;
         assert_eq!(c.factor(), Err(0));
+    }
+
+    /// A branched arm's inertia, eliminated leaves first with only the
+    /// ancestors' rows, solves as the dense factor does, and a singular
+    /// pivot names its joint in the joints' order.
+    #[test]
+    fn a_tree_eliminated_leaves_first_solves_as_the_dense_factor() {
+        // Joint 0 is the root; 1 → 2 one branch, 3 → 4 the other.
+        let parent = [None, Some(0), Some(1), Some(0), Some(3)];
+        let ancestor = |a: usize, mut b: usize| loop {
+            if a == b {
+                return true;
+            }
+            match parent[b] {
+                Some(p) => b = p,
+                None => return false,
+            }
+        };
+        let coupled = |i: usize, j: usize| ancestor(i, j) || ancestor(j, i);
+        let n = 5;
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                if coupled(i, j) {
+                    a[i * n + j] = if i == j {
+                        6.0 + i as f64
+                    } else {
+                        1.0 / (1 + i + j) as f64
+                    };
+                }
+            }
+        }
+        let dense = factored(n, &a);
+        let mut tree = Cholesky::with_structure(vec![4, 2, 3, 1, 0], coupled);
+        // No fill: every column reaches only its joint's ancestors.
+        let reached: usize = tree.below.iter().map(Vec::len).sum();
+        assert_eq!(reached, 4 + 2);
+        tree.matrix_mut().copy_from_slice(&a);
+        tree.factor().unwrap_or_else(|row| panic!("row {row}"));
+        let (mut got, mut want) = (vec![0.0; n * n], vec![0.0; n * n]);
+        let all: Vec<usize> = (0..n).collect();
+        tree.inverse_columns(&all, &mut got);
+        dense.inverse_columns(&all, &mut want);
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).abs() < 1e-14, "{got:?} vs {want:?}");
+        }
+        let mut b = [1.0, -2.0, 0.5, 3.0, 0.25];
+        let mut c = b;
+        tree.solve(&mut b);
+        dense.solve(&mut c);
+        for (x, y) in b.iter().zip(&c) {
+            assert!((x - y).abs() < 1e-14);
+        }
+        // Joint 2 massless: its pivot is the first not positive.
+        tree.matrix_mut()[2 * n + 2] = 0.0;
+        assert_eq!(tree.factor(), Err(2));
     }
 }

@@ -2,8 +2,9 @@
 //! M(q) q̈ + h(q, q̇) = τ, with URDF damping, dry friction and hard stops.
 //! URDF damping is integrated exactly (exponential time differencing,
 //! `exponential.rs`), so a damped light link takes one step per period;
-//! a step whose damping is mild (h·tr(M⁻¹D) ≤ [`MILD_DAMPING`]) is plain
-//! RK4 with the damping explicit, which needs no eigendecomposition.
+//! a step whose damping is mild (h·tr(M⁻¹D) ≤ `MILD_DAMPING`) is plain
+//! RK4 with the damping explicit, which needs no eigendecomposition, and
+//! otherwise only the stiffly damped joints are solved in modes.
 //!
 //! Rapier steps a multibody through its whole pipeline (islands, constraint
 //! assembly, a first-order integrator), which for an arm without colliders
@@ -26,17 +27,10 @@ use nalgebra::Vector3;
 use crate::PlantError;
 use arm_model::ArmModel;
 use constraints::Impulses;
-use exponential::Modes;
+use exponential::{MILD_DAMPING, Modes};
 use linalg::Cholesky;
 use spatial::Inertia;
 use tree::Tree;
-
-/// Largest h·tr(M⁻¹D) a step integrates with plain RK4. tr(M⁻¹D) bounds
-/// the fastest damped rate λmax, so RK4's factor for that mode is within
-/// 5e-4 of the exact e^(−λh) (at λh = 0.5; far less below), and far
-/// inside its stability limit of 2.8. Damping that mild left the modes'
-/// eigendecomposition a third of an 18-joint arm's step for nothing.
-const MILD_DAMPING: f64 = 0.5;
 
 /// How one full coordinate (controlled or mimic) follows the controlled ones:
 /// q_full = multiplier · q[leader] + offset.
@@ -98,8 +92,9 @@ struct Scratch {
     k_qd: [Vec<f64>; 4],
 }
 
-/// ETDRK4's buffers: per joint, the start, the stages' velocities and (in
-/// the damping's modes) their velocities and forcings.
+/// ETDRK4's buffers: per joint, the start, the damping's shares, the
+/// stages' velocities and (in the damping's coordinates, up to 2n long)
+/// their velocities and forcings and the step's end.
 #[derive(Debug, Clone)]
 struct Exponential {
     modes: Modes,
@@ -109,24 +104,29 @@ struct Exponential {
     v0: Vec<f64>,
     qs: Vec<f64>,
     g: Vec<f64>,
+    shares: Vec<f64>,
     v: [Vec<f64>; 3],
     y: [Vec<f64>; 4],
     f: [Vec<f64>; 4],
+    end: [Vec<f64>; 2],
 }
 
 impl Exponential {
-    fn new(n: usize) -> Self {
+    fn new(chol: &Cholesky, n: usize) -> Self {
         let v = || vec![0.0; n];
+        let v2 = || vec![0.0; 2 * n];
         Self {
-            modes: Modes::new(n),
+            modes: Modes::new(chol.clone(), n),
             modal: false,
             q0: v(),
             v0: v(),
             qs: v(),
             g: v(),
+            shares: v(),
             v: std::array::from_fn(|_| v()),
-            y: std::array::from_fn(|_| v()),
-            f: std::array::from_fn(|_| v()),
+            y: std::array::from_fn(|_| v2()),
+            f: std::array::from_fn(|_| v2()),
+            end: std::array::from_fn(|_| v2()),
         }
     }
 }
@@ -178,10 +178,11 @@ impl Articulated {
         for (f, d) in follow.iter().zip(&damping) {
             reduced_damping[f.leader] += f.multiplier * f.multiplier * d;
         }
+        let chol = mass_structure(&tree, &follow, n);
         let exponential = reduced_damping
             .iter()
             .any(|d| *d > 0.0)
-            .then(|| Box::new(Exponential::new(n)));
+            .then(|| Box::new(Exponential::new(&chol, n)));
         let mut arm = Self {
             names: model.joint_names(),
             impulses: Impulses::new(of(|j| j.friction), limits, n),
@@ -202,7 +203,7 @@ impl Articulated {
                 hf: vec![0.0; nf],
                 mf: vec![0.0; nf * nf],
                 tau: vec![0.0; n],
-                chol: Cholesky::new(n),
+                chol,
                 q0: vec![0.0; n],
                 qd0: vec![0.0; n],
                 k_q: std::array::from_fn(|_| vec![0.0; n]),
@@ -225,6 +226,26 @@ impl Articulated {
     pub(crate) fn set_state(&mut self, q: &[f64], qd: &[f64]) {
         self.q.copy_from_slice(q);
         self.qd.copy_from_slice(qd);
+    }
+
+    /// M(q) with armature (row-major) into `inertia`, and the bias
+    /// h(q, q̇) with URDF damping into `bias`, at the current state in the
+    /// controlled joints' coordinates: what the arm computes before it
+    /// solves for q̈. Err where M(q) is singular (naming the joint).
+    pub(crate) fn inertia_and_bias(
+        &mut self,
+        inertia: &mut [f64],
+        bias: &mut [f64],
+    ) -> Result<(), PlantError> {
+        let (q, qd) = (self.q.clone(), self.qd.clone());
+        self.factor_mass(&q, &qd)?;
+        let s = &self.scratch;
+        inertia.copy_from_slice(s.chol.matrix());
+        bias.iter_mut().for_each(|b| *b = 0.0);
+        for (k, f) in self.follow.iter().enumerate() {
+            bias[f.leader] += f.multiplier * (s.hf[k] + self.damping[k] * s.qdf[k]);
+        }
+        Ok(())
     }
 
     /// Adds a point mass to link `link` at `point` (its frame), replacing
@@ -281,14 +302,16 @@ impl Articulated {
             self.qd.iter_mut().for_each(|v| *v = f64::NAN);
             return;
         }
+        let chol = &self.scratch.chol;
         let trace =
-            exponential::damping_trace(&self.scratch.chol, &self.reduced_damping, &mut x.qs);
+            exponential::damping_shares(chol, &self.reduced_damping, &mut x.qs, &mut x.shares);
         x.modal = h * trace > MILD_DAMPING;
         if !x.modal {
             self.rk4(drive, h, true);
             return;
         }
-        x.modes.update(&self.scratch.chol, &self.reduced_damping, h);
+        x.modes.update(chol, &self.reduced_damping, &x.shares, h);
+        let len = x.modes.len();
         self.accelerate_factored(drive, &x.v0, &mut x.g);
         x.modes.to_modes(&x.v0, &mut x.y[0]);
         forcing(x, 0);
@@ -302,8 +325,8 @@ impl Articulated {
                 };
                 x.qs[i] = x.q0[i] + if stage == 3 { h * v } else { 0.5 * h * v };
             }
-            for m in 0..n {
-                let w = x.modes.weights[m];
+            for m in 0..len {
+                let w = x.modes.weight(m);
                 x.y[stage][m] = match stage {
                     1 => w.e2 * x.y[0][m] + w.half * x.f[0][m],
                     2 => w.e2 * x.y[0][m] + w.half * x.f[1][m],
@@ -321,9 +344,9 @@ impl Articulated {
             forcing(x, stage);
         }
         // The step's end: velocity and displacement, per mode.
-        let (mut y1, mut dy) = (std::mem::take(&mut x.qs), std::mem::take(&mut x.g));
-        for m in 0..n {
-            let (w, f) = (x.modes.weights[m], &x.f);
+        let [mut y1, mut dy] = std::mem::take(&mut x.end);
+        for m in 0..len {
+            let (w, f) = (x.modes.weight(m), &x.f);
             y1[m] = w.e * x.y[0][m]
                 + w.f1 * f[0][m]
                 + 2.0 * w.f2 * (f[1][m] + f[2][m])
@@ -335,7 +358,7 @@ impl Articulated {
         for (q, q0) in self.q.iter_mut().zip(&x.q0) {
             *q += q0;
         }
-        (x.qs, x.g) = (y1, dy);
+        x.end = [y1, dy];
     }
 
     /// One RK4 step of `h`; `factored`: the inertia at the start is the
@@ -408,11 +431,17 @@ impl Articulated {
             .dynamics(&s.qf, &s.qdf, self.gravity, &mut s.hf, &mut s.mf);
         let nf = self.follow.len();
         let m = s.chol.matrix_mut();
-        m.iter_mut().for_each(|x| *x = 0.0);
         let n = self.armature.len();
-        for (k, fk) in self.follow.iter().enumerate() {
-            for (l, fl) in self.follow.iter().enumerate() {
-                m[fk.leader * n + fl.leader] += fk.multiplier * fl.multiplier * s.mf[k * nf + l];
+        if nf == n {
+            // No mimic joint: the coordinates are the joints.
+            m.copy_from_slice(&s.mf);
+        } else {
+            m.iter_mut().for_each(|x| *x = 0.0);
+            for (k, fk) in self.follow.iter().enumerate() {
+                for (l, fl) in self.follow.iter().enumerate() {
+                    m[fk.leader * n + fl.leader] +=
+                        fk.multiplier * fl.multiplier * s.mf[k * nf + l];
+                }
             }
         }
         for (i, a) in self.armature.iter().enumerate() {
@@ -431,8 +460,8 @@ impl Articulated {
     /// slope `extra` per joint: an upper bound on the largest eigenvalue of
     /// M⁻¹ E, since E is positive semi-definite.
     fn rate_of(&self, extra: &[f64]) -> f64 {
-        let mut scratch = vec![0.0; extra.len()];
-        exponential::damping_trace(&self.scratch.chol, extra, &mut scratch)
+        let (mut x, mut shares) = (vec![0.0; extra.len()], vec![0.0; extra.len()]);
+        exponential::damping_shares(&self.scratch.chol, extra, &mut x, &mut shares)
     }
 
     /// Dry friction and hard stops as impulses at the end of a substep
@@ -442,7 +471,11 @@ impl Articulated {
             return;
         }
         let (mut q, mut qd) = (std::mem::take(&mut self.q), std::mem::take(&mut self.qd));
-        if self.factor_mass(&q, &qd).is_ok() {
+        // The inertia at the end of the substep serves a passed stop, and
+        // friction where no modes give the damped response (from M₀).
+        let modal = self.exponential.as_deref().is_some_and(|x| x.modal);
+        let end_inertia = !modal || self.impulses.stop_passed(&self.follow, &q);
+        if !end_inertia || self.factor_mass(&q, &qd).is_ok() {
             let chol = &self.scratch.chol;
             let modes = (self.exponential.as_deref())
                 .filter(|x| x.modal)
@@ -454,10 +487,38 @@ impl Articulated {
     }
 }
 
+/// The inertia's factorisation for the arm's branches: joints eliminated
+/// children first, coupled where a coordinate following one is on the
+/// same branch as a coordinate following the other.
+fn mass_structure(tree: &Tree, follow: &[Follow], n: usize) -> Cholesky {
+    let nf = follow.len();
+    let full = tree.coupling();
+    let mut coupled = vec![false; n * n];
+    for (k, fk) in follow.iter().enumerate() {
+        for (l, fl) in follow.iter().enumerate() {
+            if full[k * nf + l] {
+                coupled[fk.leader * n + fl.leader] = true;
+            }
+        }
+    }
+    let mut order: Vec<usize> = tree
+        .coords_in_order()
+        .into_iter()
+        .filter(|&c| c < n)
+        .collect();
+    order.reverse();
+    if order.len() != n {
+        // Not every joint on the tree: no structure to rely on.
+        order = (0..n).collect();
+        coupled.iter_mut().for_each(|c| *c = true);
+    }
+    Cholesky::with_structure(order, |i, j| coupled[i * n + j])
+}
+
 /// The modal forcing of stage `stage`: W⁻¹ q̈ + Λ y, i.e. everything but
 /// the damping's linear part at M₀ (q̈ is in `x.g`).
 fn forcing(x: &mut Exponential, stage: usize) {
-    let f = &mut x.f[stage];
+    let f = &mut x.f[stage][..x.modes.len()];
     x.modes.to_modes(&x.g, f);
     for (m, f) in f.iter_mut().enumerate() {
         *f += x.modes.rate(m) * x.y[stage][m];

@@ -131,6 +131,31 @@ impl Tree {
         self.nf
     }
 
+    /// The coordinates in tree order (parents before children).
+    pub(super) fn coords_in_order(&self) -> Vec<usize> {
+        self.joints.iter().filter_map(|j| j.coord).collect()
+    }
+
+    /// nf × nf (row-major): whether M's entry for two coordinates can be
+    /// non-zero, i.e. one moves the other's joint (same branch).
+    pub(super) fn coupling(&self) -> Vec<bool> {
+        let nf = self.nf;
+        let mut out = vec![false; nf * nf];
+        for (i, j) in self.joints.iter().enumerate() {
+            let Some(ci) = j.coord else { continue };
+            out[ci * nf + ci] = true;
+            let mut k = i;
+            while let Some(p) = self.joints[k].parent {
+                k = p;
+                if let Some(ck) = self.joints[k].coord {
+                    out[ci * nf + ck] = true;
+                    out[ck * nf + ci] = true;
+                }
+            }
+        }
+        out
+    }
+
     /// Sets link `link`'s spatial inertia (a payload added to it).
     pub(super) fn set_link_inertia(&mut self, link: usize, inertia: Inertia) {
         self.inertia[link] = inertia;
