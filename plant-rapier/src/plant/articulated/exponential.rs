@@ -111,35 +111,46 @@ pub(super) fn phi(z: f64) -> [f64; 5] {
     out
 }
 
-/// Largest h·tr(M⁻¹D) a step's explicit stages carry. tr(M⁻¹D) bounds
-/// the fastest damped rate λmax, so RK4's factor for that mode is within
-/// 5e-4 of the exact e^(−λh) (at λh = 0.5; far less below), and far
-/// inside its stability limit of 2.8. A step whose whole damping is this
-/// mild is plain RK4; otherwise the joints that carry the most of the
-/// trace are solved in modes until the rest is this mild.
+/// Largest h·tr(M⁻¹D) a step's explicit stages carry in any group of
+/// joints that couple (M⁻¹D is block diagonal over the groups, so its
+/// fastest rate λmax is the largest of the blocks', each at most the
+/// block's trace). RK4's factor for that mode is then within 5e-4 of the
+/// exact e^(−λh) (at λh = 0.5; far less below), and far inside its
+/// stability limit of 2.8. A step whose damping is this mild in every
+/// group is plain RK4; otherwise, in each group, the joints that carry the
+/// most of its trace are solved in modes until the rest is this mild.
 pub(super) const MILD_DAMPING: f64 = 0.5;
 
 /// Per joint j, its share d_j (M⁻¹)_jj of tr(M⁻¹D) into `out`, for the
-/// factored M and the diagonal damping `d`; returns tr(M⁻¹D), an upper
-/// bound on M⁻¹D's largest rate (its eigenvalues are those of
-/// L⁻¹ D L⁻ᵀ, all ≥ 0). `x` is scratch of length n.
+/// factored M and the diagonal damping `d`; returns the largest trace of
+/// a group's block of M⁻¹D, an upper bound on M⁻¹D's largest rate (each
+/// block's eigenvalues are ≥ 0, those of its L⁻¹ D L⁻ᵀ). `x` is scratch
+/// of length n.
 pub(super) fn damping_shares(chol: &Cholesky, d: &[f64], x: &mut [f64], out: &mut [f64]) -> f64 {
-    let mut trace = 0.0;
     for (j, (&dj, share)) in d.iter().zip(out.iter_mut()).enumerate() {
         *share = if dj > 0.0 {
             dj * chol.inverse_diagonal(j, x)
         } else {
             0.0
         };
-        trace += *share;
     }
-    trace
+    group_traces(chol, out, x);
+    x.iter().copied().fold(0.0, f64::max)
+}
+
+/// Per group label g, the sum of the shares of its joints into `out[g]`.
+fn group_traces(chol: &Cholesky, shares: &[f64], out: &mut [f64]) {
+    out.iter_mut().for_each(|x| *x = 0.0);
+    for (j, share) in shares.iter().enumerate() {
+        out[chol.group(j)] += share;
+    }
 }
 
 /// The stiff damping's modes at the start of a step.
 ///
-/// The joints whose shares of h·tr(M₀⁻¹D) are largest, until the rest is
-/// at most [`MILD_DAMPING`], form the stiff set S; their damping D_S is
+/// In each group of joints that couple, the joints whose shares of
+/// h·tr(M₀⁻¹D) are largest, until the group's rest is at most
+/// [`MILD_DAMPING`], form the stiff set S; their damping D_S is
 /// solved exactly and the rest stays explicit. A = M₀⁻¹D_S has rank |S|:
 /// with C = M₀⁻¹ √D_S and R = √D_S (S's rows), A = C R, and its non-zero
 /// rates are the eigenvalues of the small G = R C = √D_S (M₀⁻¹)_SS √D_S
@@ -169,6 +180,8 @@ pub(super) struct Modes {
     /// C's columns: `cols[a * n + i]`.
     cols: Vec<f64>,
     ranked: Vec<usize>,
+    /// Per group label: its trace not yet in S.
+    rest: Vec<f64>,
 }
 
 impl Modes {
@@ -186,6 +199,7 @@ impl Modes {
             still: Weights::new(0.0, 0.0),
             cols: vec![0.0; n * n],
             ranked: Vec::with_capacity(n),
+            rest: vec![0.0; n],
         }
     }
 
@@ -194,7 +208,7 @@ impl Modes {
     /// for step `h`.
     pub(super) fn update(&mut self, chol: &Cholesky, d: &[f64], shares: &[f64], h: f64) {
         self.m0.copy_factor(chol);
-        self.choose_stiff(d, shares, h);
+        self.choose_stiff(chol, d, shares, h);
         let (n, s) = (self.n, self.stiff.len());
         for (a, &b) in self.stiff.iter().enumerate() {
             let col = &mut self.cols[a * n..(a + 1) * n];
@@ -202,14 +216,33 @@ impl Modes {
             col[b] = self.root_d[a];
             chol.solve(col);
         }
-        let g = DMatrix::from_fn(s, s, |a, b| {
+        // G is block diagonal over the joints' groups (the fixed root's
+        // subtrees do not couple): one small eigenproblem per block.
+        self.r = 0;
+        let mut start = 0;
+        while start < s {
+            let group = chol.group(self.stiff[start]);
+            let len = self.stiff[start..]
+                .iter()
+                .take_while(|&&j| chol.group(j) == group)
+                .count();
+            self.add_block(start, start + len, h);
+            start += len;
+        }
+        self.still = Weights::new(0.0, h);
+    }
+
+    /// The modes of G's block over the stiff joints `from..to` (one group).
+    fn add_block(&mut self, from: usize, to: usize, h: f64) {
+        let (n, s) = (self.n, self.stiff.len());
+        let g = DMatrix::from_fn(to - from, to - from, |a, b| {
+            let (a, b) = (from + a, from + b);
             let ab = self.root_d[a] * self.cols[b * n + self.stiff[a]];
             let ba = self.root_d[b] * self.cols[a * n + self.stiff[b]];
             0.5 * (ab + ba)
         });
         let eig = SymmetricEigen::new(g);
         let top = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
-        self.r = 0;
         for (m, &lambda) in eig.eigenvalues.iter().enumerate() {
             if lambda.is_nan() || lambda <= 1e-12 * top {
                 continue;
@@ -219,39 +252,43 @@ impl Modes {
             let u = eig.eigenvectors.column(m);
             let wr = &mut self.w[r * n..(r + 1) * n];
             wr.iter_mut().for_each(|x| *x = 0.0);
-            for (b, col) in self.cols.chunks_exact(n).take(s).enumerate() {
+            for (b, col) in self.cols[from * n..to * n].chunks_exact(n).enumerate() {
                 let c = u[b] * scale;
                 for (x, v) in wr.iter_mut().zip(col) {
                     *x += c * v;
                 }
             }
-            for a in 0..s {
-                self.w_hat[r * s + a] = self.root_d[a] * u[a] * scale;
+            let wh = &mut self.w_hat[r * s..(r + 1) * s];
+            wh.iter_mut().for_each(|x| *x = 0.0);
+            for a in from..to {
+                wh[a] = self.root_d[a] * u[a - from] * scale;
             }
             self.rates[r] = lambda;
             self.weights[r] = Weights::new(lambda, h);
             self.r += 1;
         }
-        self.still = Weights::new(0.0, h);
     }
 
-    /// S: the joints with the largest shares until the rest is mild.
-    fn choose_stiff(&mut self, d: &[f64], shares: &[f64], h: f64) {
+    /// S: in each group, the joints with the largest shares until the
+    /// group's rest is mild; ordered by group.
+    fn choose_stiff(&mut self, chol: &Cholesky, d: &[f64], shares: &[f64], h: f64) {
         self.ranked.clear();
         self.ranked.extend((0..self.n).filter(|&j| shares[j] > 0.0));
         self.ranked
             .sort_by(|&a, &b| shares[b].total_cmp(&shares[a]).then(a.cmp(&b)));
-        let mut rest: f64 = shares.iter().sum();
+        let rest = &mut self.rest;
+        group_traces(chol, shares, rest);
         self.stiff.clear();
         self.root_d.clear();
         for &j in &self.ranked {
-            if h * rest <= MILD_DAMPING {
-                break;
+            let g = chol.group(j);
+            if h * rest[g] > MILD_DAMPING {
+                rest[g] -= shares[j];
+                self.stiff.push(j);
             }
-            rest -= shares[j];
-            self.stiff.push(j);
-            self.root_d.push(d[j].sqrt());
         }
+        self.stiff.sort_by_key(|&j| (chol.group(j), j));
+        self.root_d.extend(self.stiff.iter().map(|&j| d[j].sqrt()));
     }
 
     /// The length of a velocity's coordinates: the modes, then the rest.
@@ -440,6 +477,60 @@ mod tests {
                         "h {h}, column {j}: {got:?} vs {want:?}"
                     );
                 }
+            }
+        }
+    }
+
+    /// Two arms on a fixed base do not couple: G splits into one block per
+    /// arm, and the modes from the blocks still give M⁻¹ D_S whole.
+    #[test]
+    fn uncoupled_groups_take_one_eigenproblem_each() {
+        let n = 4;
+        // Joints 0, 1 one arm, 2, 3 the other.
+        let same = |i: usize, j: usize| (i < 2) == (j < 2);
+        let mut m = [0.0; 16];
+        for i in 0..n {
+            for j in 0..n {
+                if same(i, j) {
+                    m[i * n + j] = if i == j { 0.3 + i as f64 } else { 0.1 };
+                }
+            }
+        }
+        let d = [5e3, 0.0, 2e3, 1.0];
+        let mut chol = Cholesky::with_structure(vec![1, 0, 3, 2], same);
+        assert_ne!(chol.group(0), chol.group(2));
+        chol.matrix_mut().copy_from_slice(&m);
+        chol.factor().unwrap_or_else(|row| panic!("row {row}"));
+        let mut shares = [0.0; 4];
+        // Each arm's damping mild on its own (h·trace 0.41 and 0.39), the
+        // two together not: the fastest rate is one arm's, so the step is
+        // mild.
+        let top = damping_shares(&chol, &[120.0, 0.0, 900.0, 0.0], &mut [0.0; 4], &mut shares);
+        assert!(1e-3 * top < MILD_DAMPING && 1e-3 * shares.iter().sum::<f64>() > MILD_DAMPING);
+        damping_shares(&chol, &d, &mut [0.0; 4], &mut shares);
+        let mut modes = Modes::new(chol.clone(), n);
+        modes.update(&chol, &d, &shares, 1e-3);
+        assert_eq!(modes.stiff, [0, 2]);
+        assert_eq!(modes.len(), n + 2);
+        for j in 0..n {
+            let mut want = [0.0; 4];
+            want[j] = if modes.stiff.contains(&j) { d[j] } else { 0.0 };
+            chol.solve(&mut want);
+            let mut e = [0.0; 4];
+            e[j] = 1.0;
+            let (mut y, mut back, mut got) = ([0.0; 8], [0.0; 4], [0.0; 4]);
+            modes.to_modes(&e, &mut y);
+            modes.to_joints(&y, &mut back);
+            y.iter_mut()
+                .enumerate()
+                .for_each(|(k, y)| *y *= modes.rate(k));
+            modes.to_joints(&y, &mut got);
+            for i in 0..n {
+                assert!((back[i] - e[i]).abs() < 1e-12, "column {j}: {back:?}");
+                assert!(
+                    (got[i] - want[i]).abs() < 1e-9 * (1.0 + want[i].abs()),
+                    "column {j}: {got:?} vs {want:?}"
+                );
             }
         }
     }

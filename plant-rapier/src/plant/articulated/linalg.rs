@@ -28,6 +28,10 @@ pub(super) struct Cholesky {
     /// Per position k: the later positions where column k of L may be
     /// non-zero, ascending (fill included).
     below: Vec<Vec<usize>>,
+    /// Per joint: its group of joints that couple, directly or through
+    /// others (the fixed root's subtrees). M and M⁻¹ are block diagonal
+    /// over the groups.
+    group: Vec<usize>,
 }
 
 impl Cholesky {
@@ -57,6 +61,16 @@ impl Cholesky {
                 reach[i * n + k] = c;
             }
         }
+        // Groups: joints joined by a chain of couplings share a label.
+        let mut group: Vec<usize> = (0..n).collect();
+        for i in 0..n {
+            for j in 0..i {
+                let (a, b) = (group[i], group[j]);
+                if a != b && (coupled(i, j) || coupled(j, i)) {
+                    group.iter_mut().filter(|g| **g == a).for_each(|g| *g = b);
+                }
+            }
+        }
         let mut below = Vec::with_capacity(n);
         for k in 0..n {
             let rows: Vec<usize> = (k + 1..n).filter(|&i| reach[i * n + k]).collect();
@@ -75,7 +89,13 @@ impl Cholesky {
             order,
             pos,
             below,
+            group,
         }
+    }
+
+    /// The group of joint `j`: joints of different groups do not couple.
+    pub(super) fn group(&self, j: usize) -> usize {
+        self.group[j]
     }
 
     /// The matrix to fill before `factor` (row-major, the joints' order).
@@ -261,6 +281,8 @@ mod tests {
         }
         let dense = factored(n, &a);
         let mut tree = Cholesky::with_structure(vec![4, 2, 3, 1, 0], coupled);
+        // One group: everything hangs from joint 0.
+        assert!((0..n).all(|j| tree.group(j) == tree.group(0)));
         // No fill: every column reaches only its joint's ancestors.
         let reached: usize = tree.below.iter().map(Vec::len).sum();
         assert_eq!(reached, 4 + 2);

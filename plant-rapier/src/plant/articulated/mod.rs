@@ -2,9 +2,10 @@
 //! M(q) q̈ + h(q, q̇) = τ, with URDF damping, dry friction and hard stops.
 //! URDF damping is integrated exactly (exponential time differencing,
 //! `exponential.rs`), so a damped light link takes one step per period;
-//! a step whose damping is mild (h·tr(M⁻¹D) ≤ `MILD_DAMPING`) is plain
-//! RK4 with the damping explicit, which needs no eigendecomposition, and
-//! otherwise only the stiffly damped joints are solved in modes.
+//! a step whose damping is mild (h·tr(M⁻¹D) ≤ `MILD_DAMPING` over each
+//! group of joints that couple) is plain RK4 with the damping explicit,
+//! which needs no eigendecomposition, and otherwise only the stiffly
+//! damped joints are solved in modes.
 //!
 //! Rapier steps a multibody through its whole pipeline (islands, constraint
 //! assembly, a first-order integrator), which for an arm without colliders
@@ -303,9 +304,9 @@ impl Articulated {
             return;
         }
         let chol = &self.scratch.chol;
-        let trace =
+        let stiffest =
             exponential::damping_shares(chol, &self.reduced_damping, &mut x.qs, &mut x.shares);
-        x.modal = h * trace > MILD_DAMPING;
+        x.modal = h * stiffest > MILD_DAMPING;
         if !x.modal {
             self.rk4(drive, h, true);
             return;
@@ -456,9 +457,10 @@ impl Articulated {
         })
     }
 
-    /// trace(M⁻¹ E) at the factored posture, E the scenario's friction
-    /// slope `extra` per joint: an upper bound on the largest eigenvalue of
-    /// M⁻¹ E, since E is positive semi-definite.
+    /// The largest trace of a group's block of M⁻¹ E at the factored
+    /// posture, E the scenario's friction slope `extra` per joint: an upper
+    /// bound on the largest eigenvalue of M⁻¹ E, since E is positive
+    /// semi-definite and M⁻¹ block diagonal over the groups.
     fn rate_of(&self, extra: &[f64]) -> f64 {
         let (mut x, mut shares) = (vec![0.0; extra.len()], vec![0.0; extra.len()]);
         exponential::damping_shares(&self.scratch.chol, extra, &mut x, &mut shares)

@@ -161,8 +161,9 @@ impl Tree {
         self.inertia[link] = inertia;
     }
 
-    /// The bias h(q, q̇) into `h` and M(q) into `m` (row-major nf × nf), for
-    /// full coordinates `q`, `qd` and gravity `g` in the root frame.
+    /// The bias h(q, q̇) into `h` and M(q) into `m` (row-major nf × nf,
+    /// zeroed before the first call and used for nothing else), for full
+    /// coordinates `q`, `qd` and gravity `g` in the root frame.
     pub(super) fn dynamics(
         &mut self,
         q: &[f64],
@@ -229,9 +230,11 @@ impl Tree {
     }
 
     /// The composite-rigid-body algorithm on the transforms of `forward`.
+    /// It writes every entry where two coordinates share a branch (the
+    /// same ones each call); the others are zero and left alone, so `m`
+    /// must start zeroed and serve only this tree.
     fn mass_matrix(&mut self, m: &mut [f64]) {
         let nf = self.nf;
-        m.iter_mut().for_each(|x| *x = 0.0);
         for (c, j) in self.composite.iter_mut().zip(&self.joints) {
             *c = self.inertia[j.link];
         }
