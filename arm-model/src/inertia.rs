@@ -79,18 +79,30 @@ pub(super) fn merge_mass(parent: &mut LinkInfo, child: &LinkInfo, t: &Isometry3<
 }
 
 /// How far published files break the triangle inequality (relative to the
-/// largest moment) and are still simulated as given, with a note.
+/// largest moment) from rounding alone: a plain note. Beyond it no rigid
+/// body has the tensor, and the note says so.
 const TRIANGLE_SLACK: f64 = 0.25;
+
+/// What a positive semi-definite tensor is.
+#[derive(Debug, PartialEq)]
+pub(super) enum Tensor {
+    /// A rigid body's, or near enough (the note, if any, says how near).
+    Fine(Option<String>),
+    /// No rigid body's (the triangle inequality broken beyond rounding),
+    /// yet it simulates: M stays positive semi-definite. The reason.
+    Impossible(String),
+}
 
 /// Principal moments below this (kg m²) are zero to rounding.
 const POINT_MASS_MOMENT: f64 = 1e-12;
 
 /// A physical inertia tensor is positive semi-definite (a point mass or a
 /// thin rod has zero moments) and its principal moments obey the triangle
-/// inequality. Rounding in published files is allowed for: a tensor that
-/// breaks the inequality by at most 25 % (published files do) is still positive semi-definite and
-/// simulates; the note returned says so.
-pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Option<String>, ModelError> {
+/// inequality. Only the first is required to simulate: a tensor that is
+/// not positive semi-definite is refused; one that breaks the inequality
+/// simulates, with a note (up to 25 % is rounding in published files;
+/// beyond, it is [`Tensor::Impossible`]).
+pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Tensor, ModelError> {
     let bad = |reason: String| {
         Err(ModelError::BadInertia {
             link: link.to_string(),
@@ -103,13 +115,13 @@ pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Option<String>, 
     // shape: such a link is a point mass, whatever the signs.
     if ev.iter().all(|e| e.abs() <= POINT_MASS_MOMENT) {
         let zero = ev.iter().any(|e| *e != 0.0);
-        return Ok(zero.then(|| {
+        return Ok(Tensor::Fine(zero.then(|| {
             format!(
                 "link '{link}': principal moments {:.3e}, {:.3e}, {:.3e} are zero to rounding: \
                  taken as a point mass",
                 ev[0], ev[1], ev[2]
             )
-        }));
+        })));
     }
     let scale = ev[2].abs().max(f64::MIN_POSITIVE);
     if ev[0] < -1e-9 * scale {
@@ -120,12 +132,15 @@ pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Option<String>, 
     }
     let short = (ev[2] - ev[0] - ev[1]) / scale;
     if short > TRIANGLE_SLACK {
-        return bad(format!(
-            "principal moments {:.3e}, {:.3e}, {:.3e} break the triangle inequality (the largest must not exceed the sum of the other two): correct the tensor, or give a placeholder link mass 0",
-            ev[0], ev[1], ev[2]
-        ));
+        return Ok(Tensor::Impossible(format!(
+            "principal moments {:.3e}, {:.3e}, {:.3e} break the triangle inequality by {:.0} % of the largest (no rigid body has them; MuJoCo and Drake refuse such a tensor)",
+            ev[0],
+            ev[1],
+            ev[2],
+            100.0 * short
+        )));
     }
-    Ok((short > 1e-6).then(|| {
+    Ok(Tensor::Fine((short > 1e-6).then(|| {
         format!(
             "link '{link}': principal moments {:.3e}, {:.3e}, {:.3e} break the triangle inequality by {:.2} % of the largest; simulated as given",
             ev[0],
@@ -133,5 +148,5 @@ pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Option<String>, 
             ev[2],
             100.0 * short
         )
-    }))
+    })))
 }

@@ -25,6 +25,7 @@
 //! assert!(g[0] > 0.0); // holding the arm level takes a positive shoulder torque
 //! ```
 
+mod diagnose;
 pub mod dynamics;
 mod error;
 mod file_refs;
@@ -240,8 +241,10 @@ impl ArmModel {
         }
         let (text, undeclared) = prefixes::declare_undeclared(text);
         let (text, unnamed_files) = file_refs::fill_missing(&text);
-        let robot =
-            urdf_rs::read_from_string(&text).map_err(|e| ModelError::Parse(e.to_string()))?;
+        let robot = urdf_rs::read_from_string(&text).map_err(|e| {
+            let said = e.to_string();
+            ModelError::Parse(diagnose::diagnose(&text, &said).unwrap_or(said))
+        })?;
         let mut model = tree::build(&robot, locks)?;
         for (element, n) in unnamed_files.iter().rev() {
             model.notes.insert(

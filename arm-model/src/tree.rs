@@ -6,7 +6,8 @@ use std::collections::HashMap;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use super::inertia::{
-    NEGLIGIBLE_MASS_RATIO, PLACEHOLDER_MASS_RATIO, check_inertia, iso, merge_mass, origin_of,
+    NEGLIGIBLE_MASS_RATIO, PLACEHOLDER_MASS_RATIO, Tensor, check_inertia, iso, merge_mass,
+    origin_of,
 };
 use super::parse::{joint_info, link_info};
 use super::{
@@ -326,11 +327,11 @@ fn settle_masses(
             continue;
         }
         match check_inertia(&l.name, &l.inertia) {
-            Ok(note) => notes.extend(note),
+            Ok(Tensor::Fine(note)) => notes.extend(note),
             // A placeholder (a fingertip frame of a few grams) with a
             // tensor no body has: what it adds is below what the arm's
             // own rounding moves, so it is dropped rather than refused.
-            Err(ModelError::BadInertia { reason, .. })
+            Ok(Tensor::Impossible(reason)) | Err(ModelError::BadInertia { reason, .. })
                 if l.mass < PLACEHOLDER_MASS_RATIO * heaviest =>
             {
                 ignored.push(IgnoredLink {
@@ -345,6 +346,12 @@ fn settle_masses(
                 l.mass = 0.0;
                 l.inertia = [0.0; 6];
             }
+            // A real link with such a tensor still simulates (M stays
+            // positive semi-definite), as Pinocchio and PyBullet take it.
+            Ok(Tensor::Impossible(reason)) => notes.push(format!(
+                "link '{}': {reason}: simulated as given; correct the tensor if this link's motion matters",
+                l.name
+            )),
             Err(e) => return Err(e),
         }
     }

@@ -232,19 +232,6 @@ fn malformed_and_unsupported_urdfs_are_clear_errors() {
             "link 'a': the inertia tensor is not positive semi-definite",
         ),
         (
-            "triangle",
-            robot(format!(
-                "{}{}",
-                link(
-                    "a",
-                    "1",
-                    r#"ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.5""#
-                ),
-                joint("j", "revolute", "base", "a", "")
-            )),
-            "triangle inequality",
-        ),
-        (
             "negative_mass",
             robot(format!(
                 "{}{}",

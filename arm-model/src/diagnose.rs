@@ -1,0 +1,298 @@
+//! Where a URDF the reader refused goes wrong. `urdf-rs` reports only
+//! "missing field `inertia`" or "invalid float literal", not which link or
+//! joint; so when it refuses a file, the file's elements are walked again
+//! (with `quick-xml`, the reader under `urdf-rs`) against the fields
+//! `urdf-rs` requires and the attributes that hold numbers, and the error
+//! names the element, its link or joint, and what to write.
+
+use quick_xml::Reader;
+use quick_xml::events::{BytesStart, Event};
+
+/// Attributes an element must have (`urdf-rs`'s fields without a default).
+const REQUIRED_ATTRIBUTES: &[(&str, &[&str])] = &[
+    ("link", &["name"]),
+    ("joint", &["name", "type"]),
+    ("mass", &["value"]),
+    ("inertia", &["ixx", "ixy", "ixz", "iyy", "iyz", "izz"]),
+    ("parent", &["link"]),
+    ("child", &["link"]),
+    ("axis", &["xyz"]),
+    ("limit", &["velocity"]),
+    ("mimic", &["joint"]),
+    ("safety_controller", &["k_velocity"]),
+    ("color", &["rgba"]),
+    ("box", &["size"]),
+    ("cylinder", &["radius", "length"]),
+    ("capsule", &["radius", "length"]),
+    ("sphere", &["radius"]),
+];
+
+/// Child elements an element must have.
+const REQUIRED_CHILDREN: &[(&str, &[&str])] = &[
+    ("inertial", &["mass", "inertia"]),
+    ("joint", &["parent", "child"]),
+    ("visual", &["geometry"]),
+    ("collision", &["geometry"]),
+];
+
+/// Attributes that hold numbers, and how many (0: one or more).
+const NUMBERS: &[(&str, &[(&str, usize)])] = &[
+    ("mass", &[("value", 1)]),
+    ("origin", &[("xyz", 3), ("rpy", 3)]),
+    (
+        "inertia",
+        &[
+            ("ixx", 1),
+            ("ixy", 1),
+            ("ixz", 1),
+            ("iyy", 1),
+            ("iyz", 1),
+            ("izz", 1),
+        ],
+    ),
+    ("axis", &[("xyz", 3)]),
+    (
+        "limit",
+        &[("lower", 1), ("upper", 1), ("effort", 1), ("velocity", 1)],
+    ),
+    ("dynamics", &[("damping", 1), ("friction", 1)]),
+    ("mimic", &[("multiplier", 1), ("offset", 1)]),
+    ("color", &[("rgba", 4)]),
+    ("box", &[("size", 3)]),
+    ("cylinder", &[("radius", 1), ("length", 1)]),
+    ("capsule", &[("radius", 1), ("length", 1)]),
+    ("sphere", &[("radius", 1)]),
+    ("mesh", &[("scale", 3)]),
+];
+
+/// One open element: its name, the link or joint it is in, the children
+/// seen so far.
+struct Open {
+    name: String,
+    owner: String,
+    children: Vec<String>,
+}
+
+/// What is wrong, if the walk finds it: the first problem that matches
+/// `reader_error` (a missing field it names, or a number it could not
+/// read), else the first problem of any kind. None where the walk finds
+/// nothing (the reader's own message stands).
+pub(super) fn diagnose(text: &str, reader_error: &str) -> Option<String> {
+    let problems = walk(text);
+    let missing = reader_error
+        .split("missing field `")
+        .nth(1)
+        .and_then(|r| r.split('`').next());
+    let wanted = |p: &&Problem| match missing {
+        Some(field) => p.field == field,
+        None => p.number && reader_error.contains("float"),
+    };
+    let found = problems.iter().find(wanted).or(problems.first())?;
+    Some(found.message.clone())
+}
+
+struct Problem {
+    field: String,
+    number: bool,
+    message: String,
+}
+
+fn walk(text: &str) -> Vec<Problem> {
+    let mut reader = Reader::from_str(text);
+    let (mut stack, mut out): (Vec<Open>, Vec<Problem>) = (Vec::new(), Vec::new());
+    loop {
+        match reader.read_event() {
+            Ok(Event::Start(e)) => {
+                let open = opened(&e, &mut stack, &mut out);
+                stack.push(open);
+            }
+            Ok(Event::Empty(e)) => {
+                let open = opened(&e, &mut stack, &mut out);
+                closed(&open, &mut out);
+            }
+            Ok(Event::End(_)) => {
+                if let Some(open) = stack.pop() {
+                    closed(&open, &mut out);
+                }
+            }
+            Ok(Event::Eof) | Err(_) => return out,
+            Ok(_) => {}
+        }
+    }
+}
+
+/// Checks a start tag's attributes and records it as its parent's child.
+fn opened(e: &BytesStart, stack: &mut [Open], out: &mut Vec<Problem>) -> Open {
+    let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+    if let Some(parent) = stack.last_mut() {
+        parent.children.push(name.clone());
+    }
+    let attrs: Vec<(String, String)> = e
+        .attributes()
+        .flatten()
+        .map(|a| {
+            let key = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
+            let value = a.unescape_value().map_or_else(
+                |_| String::from_utf8_lossy(&a.value).into_owned(),
+                |v| v.into_owned(),
+            );
+            (key, value)
+        })
+        .collect();
+    let attr = |k: &str| {
+        attrs
+            .iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.as_str())
+    };
+    let parent_owner = stack
+        .last()
+        .map_or_else(|| "the robot".to_string(), |o| o.owner.clone());
+    let owner = match (name.as_str(), attr("name"), stack.len()) {
+        ("link" | "joint" | "material", Some(n), 1) => format!("{name} '{n}'"),
+        _ => parent_owner,
+    };
+    let at = format!("{owner}: <{name}>");
+    for (element, required) in REQUIRED_ATTRIBUTES {
+        if *element == name {
+            for field in required.iter().filter(|f| attr(f).is_none()) {
+                out.push(Problem {
+                    field: field.to_string(),
+                    number: false,
+                    message: format!("{at} has no {field}=\"…\", which the URDF format requires"),
+                });
+            }
+        }
+    }
+    for (element, numbers) in NUMBERS {
+        if *element != name {
+            continue;
+        }
+        for (field, count) in *numbers {
+            if let Some(v) = attr(field)
+                && let Some(why) = not_numbers(v, *count)
+            {
+                out.push(Problem {
+                    field: field.to_string(),
+                    number: true,
+                    message: format!("{at} {field}=\"{v}\": {why}"),
+                });
+            }
+        }
+    }
+    Open {
+        name,
+        owner,
+        children: Vec::new(),
+    }
+}
+
+/// Checks that a closing element had the children it needs.
+fn closed(open: &Open, out: &mut Vec<Problem>) {
+    for (element, required) in REQUIRED_CHILDREN {
+        if *element == open.name {
+            for child in required
+                .iter()
+                .filter(|c| !open.children.iter().any(|h| h == *c))
+            {
+                out.push(Problem {
+                    field: child.to_string(),
+                    number: false,
+                    message: format!(
+                        "{}: <{}> has no <{child}>, which the URDF format requires{}",
+                        open.owner,
+                        open.name,
+                        hint(&open.name, child)
+                    ),
+                });
+            }
+        }
+    }
+}
+
+/// What to write for a missing child.
+fn hint(element: &str, child: &str) -> &'static str {
+    match (element, child) {
+        ("inertial", "inertia") => {
+            " (write ixx … izz; zeros make the link a point mass, or leave out <inertial> for a massless link)"
+        }
+        ("inertial", "mass") => {
+            " (write <mass value=\"…\"/>, or leave out <inertial> for a massless link)"
+        }
+        _ => "",
+    }
+}
+
+/// Why `v` is not `count` numbers (0: any positive count), if it is not.
+fn not_numbers(v: &str, count: usize) -> Option<String> {
+    let parts: Vec<&str> = v.split_whitespace().collect();
+    if let Some(bad) = parts.iter().find(|p| p.parse::<f64>().is_err()) {
+        return Some(format!("'{bad}' is not a number"));
+    }
+    match (count, parts.len()) {
+        (0, 0) => Some("no number".into()),
+        (0, _) => None,
+        (c, n) if c != n => Some(format!("{n} numbers where {c} belong")),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::ArmModel;
+    use proptest::prelude::*;
+
+    fn refusal(body: &str) -> String {
+        let text = format!(r#"<robot name="t"><link name="base"/>{body}</robot>"#);
+        match ArmModel::from_urdf_str(&text) {
+            Ok(_) => panic!("accepted: {text}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    const LINK_A: &str = r#"<link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>"#;
+
+    fn joint(inner: &str) -> String {
+        format!(r#"{LINK_A}<joint name="j" type="revolute">{inner}<axis xyz="0 0 1"/></joint>"#)
+    }
+
+    /// Each refusal names the link or joint, the element and what is wrong.
+    #[test]
+    fn a_refused_urdf_names_the_element_at_fault() {
+        let parent_child = r#"<parent link="base"/><child link="a"/>"#;
+        for (body, want) in [
+            (
+                r#"<link name="a"><inertial><mass value="1"/></inertial></link>"#.to_string(),
+                "link 'a': <inertial> has no <inertia>, which the URDF format requires (write ixx",
+            ),
+            (
+                r#"<link name="a"><inertial><mass value="MASS"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>"#.into(),
+                "link 'a': <mass> value=\"MASS\": 'MASS' is not a number",
+            ),
+            (
+                joint(r#"<parent link="base"/><origin xyz="0 0"/><child link="a"/><limit effort="1" velocity="1"/>"#),
+                "joint 'j': <origin> xyz=\"0 0\": 2 numbers where 3 belong",
+            ),
+            (
+                joint(r#"<child link="a"/><limit effort="1" velocity="1"/>"#),
+                "joint 'j': <joint> has no <parent>",
+            ),
+            (
+                joint(&format!(r#"{parent_child}<limit effort="1"/>"#)),
+                "joint 'j': <limit> has no velocity=\"…\"",
+            ),
+        ] {
+            let got = refusal(&body);
+            assert!(got.contains(want), "{got}\n  wanted: {want}");
+        }
+    }
+
+    proptest! {
+        /// Any text is walked without a panic.
+        #[test]
+        fn any_text_is_walked_without_panic(text in "[<>/=\"' a-z:!?-]{0,80}") {
+            let _ = super::diagnose(&text, "missing field `mass`");
+            let _ = super::diagnose(&text, "invalid float literal");
+        }
+    }
+}
