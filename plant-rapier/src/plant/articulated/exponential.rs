@@ -205,8 +205,11 @@ impl Modes {
 
     /// The modes for the factored M₀ in `chol`, the diagonal damping `d`
     /// (≥ 0) and its `shares` (from [`damping_shares`]), with the weights
-    /// for step `h`.
-    pub(super) fn update(&mut self, chol: &Cholesky, d: &[f64], shares: &[f64], h: f64) {
+    /// for step `h`. False where there are none to make: a state blown up
+    /// so far that G is not finite, or (never seen) an eigenproblem that
+    /// does not converge.
+    #[must_use]
+    pub(super) fn update(&mut self, chol: &Cholesky, d: &[f64], shares: &[f64], h: f64) -> bool {
         self.m0.copy_factor(chol);
         self.choose_stiff(chol, d, shares, h);
         let (n, s) = (self.n, self.stiff.len());
@@ -226,14 +229,18 @@ impl Modes {
                 .iter()
                 .take_while(|&&j| chol.group(j) == group)
                 .count();
-            self.add_block(start, start + len, h);
+            if !self.add_block(start, start + len, h) {
+                return false;
+            }
             start += len;
         }
         self.still = Weights::new(0.0, h);
+        true
     }
 
-    /// The modes of G's block over the stiff joints `from..to` (one group).
-    fn add_block(&mut self, from: usize, to: usize, h: f64) {
+    /// The modes of G's block over the stiff joints `from..to` (one group);
+    /// false where G is not finite or its eigenproblem does not converge.
+    fn add_block(&mut self, from: usize, to: usize, h: f64) -> bool {
         let (n, s) = (self.n, self.stiff.len());
         let g = DMatrix::from_fn(to - from, to - from, |a, b| {
             let (a, b) = (from + a, from + b);
@@ -241,7 +248,13 @@ impl Modes {
             let ba = self.root_d[b] * self.cols[a * n + self.stiff[b]];
             0.5 * (ab + ba)
         });
-        let eig = SymmetricEigen::new(g);
+        if g.iter().any(|x| !x.is_finite()) {
+            return false;
+        }
+        // A bound on the QR sweeps: nalgebra's default has none.
+        let Some(eig) = SymmetricEigen::try_new(g, f64::EPSILON, 100 * (to - from) + 100) else {
+            return false;
+        };
         let top = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
         for (m, &lambda) in eig.eigenvalues.iter().enumerate() {
             if lambda.is_nan() || lambda <= 1e-12 * top {
@@ -267,6 +280,7 @@ impl Modes {
             self.weights[r] = Weights::new(lambda, h);
             self.r += 1;
         }
+        true
     }
 
     /// S: in each group, the joints with the largest shares until the
@@ -441,7 +455,7 @@ mod tests {
         let mut shares = [0.0; 3];
         damping_shares(&chol, &D, &mut [0.0; 3], &mut shares);
         let mut modes = Modes::new(chol.clone(), 3);
-        modes.update(&chol, &D, &shares, h);
+        assert!(modes.update(&chol, &D, &shares, h));
         (chol, modes)
     }
 
@@ -481,6 +495,21 @@ mod tests {
         }
     }
 
+    /// A damping blown up to infinity gives no modes (the step then
+    /// reports the state non-finite) instead of an eigenproblem that
+    /// never converges.
+    #[test]
+    fn no_modes_from_a_non_finite_damping() {
+        let mut chol = Cholesky::new(3);
+        chol.matrix_mut().copy_from_slice(&M);
+        chol.factor().unwrap_or_else(|row| panic!("row {row}"));
+        let d = [0.0, f64::INFINITY, 5e3];
+        let mut shares = [0.0; 3];
+        damping_shares(&chol, &d, &mut [0.0; 3], &mut shares);
+        let mut modes = Modes::new(chol.clone(), 3);
+        assert!(!modes.update(&chol, &d, &shares, 1e-3));
+    }
+
     /// Two arms on a fixed base do not couple: G splits into one block per
     /// arm, and the modes from the blocks still give M⁻¹ D_S whole.
     #[test]
@@ -509,7 +538,7 @@ mod tests {
         assert!(1e-3 * top < MILD_DAMPING && 1e-3 * shares.iter().sum::<f64>() > MILD_DAMPING);
         damping_shares(&chol, &d, &mut [0.0; 4], &mut shares);
         let mut modes = Modes::new(chol.clone(), n);
-        modes.update(&chol, &d, &shares, 1e-3);
+        assert!(modes.update(&chol, &d, &shares, 1e-3));
         assert_eq!(modes.stiff, [0, 2]);
         assert_eq!(modes.len(), n + 2);
         for j in 0..n {

@@ -299,8 +299,7 @@ impl Articulated {
         x.v0.copy_from_slice(&self.qd);
         if self.factor_mass(&x.q0, &x.v0).is_err() {
             // Blown up (see `acceleration`): report the non-finite state.
-            self.q.iter_mut().for_each(|v| *v = f64::NAN);
-            self.qd.iter_mut().for_each(|v| *v = f64::NAN);
+            self.blown_up();
             return;
         }
         let chol = &self.scratch.chol;
@@ -311,7 +310,11 @@ impl Articulated {
             self.rk4(drive, h, true);
             return;
         }
-        x.modes.update(chol, &self.reduced_damping, &x.shares, h);
+        if !x.modes.update(chol, &self.reduced_damping, &x.shares, h) {
+            // Blown up past a finite G: report the non-finite state.
+            self.blown_up();
+            return;
+        }
         let len = x.modes.len();
         self.accelerate_factored(drive, &x.v0, &mut x.g);
         x.modes.to_modes(&x.v0, &mut x.y[0]);
@@ -360,6 +363,12 @@ impl Articulated {
             *q += q0;
         }
         x.end = [y1, dy];
+    }
+
+    /// Marks the state non-finite, as a blown-up run is reported.
+    fn blown_up(&mut self) {
+        self.q.iter_mut().for_each(|v| *v = f64::NAN);
+        self.qd.iter_mut().for_each(|v| *v = f64::NAN);
     }
 
     /// One RK4 step of `h`; `factored`: the inertia at the start is the
@@ -477,7 +486,8 @@ impl Articulated {
         // friction where no modes give the damped response (from M₀).
         let modal = self.exponential.as_deref().is_some_and(|x| x.modal);
         let end_inertia = !modal || self.impulses.stop_passed(&self.follow, &q);
-        if !end_inertia || self.factor_mass(&q, &qd).is_ok() {
+        let finite = q.iter().chain(&qd).all(|v| v.is_finite());
+        if finite && (!end_inertia || self.factor_mass(&q, &qd).is_ok()) {
             let chol = &self.scratch.chol;
             let modes = (self.exponential.as_deref())
                 .filter(|x| x.modal)
