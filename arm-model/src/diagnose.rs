@@ -65,30 +65,35 @@ const NUMBERS: &[(&str, &[(&str, usize)])] = &[
     ("mesh", &[("scale", 3)]),
 ];
 
-/// One open element: its name, the link or joint it is in, the children
-/// seen so far.
+/// The robot-level elements `urdf-rs` reads; what is inside anything else
+/// (`<transmission>`, `<gazebo>`, whose `<joint>` is another element) is
+/// not checked.
+const READ: [&str; 3] = ["link", "joint", "material"];
+
+/// One open element: its name, the link or joint it is in, whether
+/// `urdf-rs` reads it, the children seen so far.
 struct Open {
     name: String,
     owner: String,
+    read: bool,
     children: Vec<String>,
 }
 
-/// What is wrong, if the walk finds it: the first problem that matches
-/// `reader_error` (a missing field it names, or a number it could not
-/// read), else the first problem of any kind. None where the walk finds
-/// nothing (the reader's own message stands).
+/// What is wrong, if the walk finds what `reader_error` says: a missing
+/// field it names, or a number it could not read. None otherwise (the
+/// reader's own message stands).
 pub(super) fn diagnose(text: &str, reader_error: &str) -> Option<String> {
-    let problems = walk(text);
     let missing = reader_error
         .split("missing field `")
         .nth(1)
         .and_then(|r| r.split('`').next());
     let wanted = |p: &&Problem| match missing {
         Some(field) => p.field == field,
-        None => p.number && reader_error.contains("float"),
+        None => {
+            p.number && (reader_error.contains("float") || reader_error.contains("element count"))
+        }
     };
-    let found = problems.iter().find(wanted).or(problems.first())?;
-    Some(found.message.clone())
+    walk(text).iter().find(wanted).map(|p| p.message.clone())
 }
 
 struct Problem {
@@ -121,14 +126,42 @@ fn walk(text: &str) -> Vec<Problem> {
     }
 }
 
-/// Checks a start tag's attributes and records it as its parent's child.
+/// A start tag: recorded as its parent's child, and, where `urdf-rs`
+/// reads it, its attributes checked.
 fn opened(e: &BytesStart, stack: &mut [Open], out: &mut Vec<Problem>) -> Open {
     let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
-    if let Some(parent) = stack.last_mut() {
+    let parent = stack.last_mut();
+    let (parent_owner, parent_read) = parent.as_ref().map_or_else(
+        || ("the robot".to_string(), false),
+        |o| (o.owner.clone(), o.read),
+    );
+    if let Some(parent) = parent {
         parent.children.push(name.clone());
     }
-    let attrs: Vec<(String, String)> = e
-        .attributes()
+    let read = match stack.len() {
+        0 => false,
+        1 => READ.contains(&name.as_str()),
+        _ => parent_read,
+    };
+    let attrs = attributes(e);
+    let owner = match (name.as_str(), attr(&attrs, "name"), stack.len()) {
+        ("link" | "joint" | "material", Some(n), 1) => format!("{name} '{n}'"),
+        _ => parent_owner,
+    };
+    if read {
+        check_attributes(&format!("{owner}: <{name}>"), &name, &attrs, out);
+    }
+    Open {
+        name,
+        owner,
+        read,
+        children: Vec::new(),
+    }
+}
+
+/// A tag's attributes, names without prefix, values unescaped.
+fn attributes(e: &BytesStart) -> Vec<(String, String)> {
+    e.attributes()
         .flatten()
         .map(|a| {
             let key = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
@@ -138,24 +171,22 @@ fn opened(e: &BytesStart, stack: &mut [Open], out: &mut Vec<Problem>) -> Open {
             );
             (key, value)
         })
-        .collect();
-    let attr = |k: &str| {
-        attrs
-            .iter()
-            .find(|(key, _)| key == k)
-            .map(|(_, v)| v.as_str())
-    };
-    let parent_owner = stack
-        .last()
-        .map_or_else(|| "the robot".to_string(), |o| o.owner.clone());
-    let owner = match (name.as_str(), attr("name"), stack.len()) {
-        ("link" | "joint" | "material", Some(n), 1) => format!("{name} '{n}'"),
-        _ => parent_owner,
-    };
-    let at = format!("{owner}: <{name}>");
+        .collect()
+}
+
+/// The value of attribute `key`.
+fn attr<'a>(attrs: &'a [(String, String)], key: &str) -> Option<&'a str> {
+    attrs
+        .iter()
+        .find(|(k, _)| k == key)
+        .map(|(_, v)| v.as_str())
+}
+
+/// The attributes element `name` (at `at`) must have, and its numbers.
+fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut Vec<Problem>) {
     for (element, required) in REQUIRED_ATTRIBUTES {
         if *element == name {
-            for field in required.iter().filter(|f| attr(f).is_none()) {
+            for field in required.iter().filter(|f| attr(attrs, f).is_none()) {
                 out.push(Problem {
                     field: field.to_string(),
                     number: false,
@@ -169,7 +200,7 @@ fn opened(e: &BytesStart, stack: &mut [Open], out: &mut Vec<Problem>) -> Open {
             continue;
         }
         for (field, count) in *numbers {
-            if let Some(v) = attr(field)
+            if let Some(v) = attr(attrs, field)
                 && let Some(why) = not_numbers(v, *count)
             {
                 out.push(Problem {
@@ -180,15 +211,13 @@ fn opened(e: &BytesStart, stack: &mut [Open], out: &mut Vec<Problem>) -> Open {
             }
         }
     }
-    Open {
-        name,
-        owner,
-        children: Vec::new(),
-    }
 }
 
 /// Checks that a closing element had the children it needs.
 fn closed(open: &Open, out: &mut Vec<Problem>) {
+    if !open.read {
+        return;
+    }
     for (element, required) in REQUIRED_CHILDREN {
         if *element == open.name {
             for child in required
@@ -285,6 +314,22 @@ mod tests {
             let got = refusal(&body);
             assert!(got.contains(want), "{got}\n  wanted: {want}");
         }
+    }
+
+    /// A `<joint>` inside a `<transmission>` is not the robot's: a typo
+    /// elsewhere keeps the reader's own message, not a false one about it.
+    #[test]
+    fn elements_urdf_rs_does_not_read_are_not_blamed() {
+        let body = format!(
+            r#"{}<transmission name="t"><joint name="j"><hardwareInterface>x</hardwareInterface></joint></transmission>"#,
+            joint(r#"<parent link="base"/><child link="a"/><limit effort="1" velocity="1"/>"#)
+                .replace("revolute", "continous")
+        );
+        let got = refusal(&body);
+        assert!(
+            got.contains("continous") && !got.contains("has no"),
+            "{got}"
+        );
     }
 
     proptest! {

@@ -23,7 +23,7 @@ impl Probe {
     ///
     /// M and G are read from the articulated engine, not differenced from
     /// a short step's response to unit torques: on a near-singular arm
-    /// (a head whose inertia is a point mass on its axis, M⁻¹_ii ~ 1e9)
+    /// (a head whose inertia is a point mass on its axis, M⁻¹_ii ~ 1e8)
     /// the step itself moves the joint fast enough that its response is
     /// no longer linear, and the load G = −M a₀ came out wrong by orders.
     pub fn at(model: &ArmModel, q: &[f64], armature: &[f64]) -> Result<Self, PlantError> {

@@ -4,10 +4,11 @@
 //! stop's only pushes back, and a stop is enforced once it is passed.
 //!
 //! With URDF damping integrated exactly, a friction impulse stands for a
-//! constant torque over the substep, so it moves each damped mode by what
-//! that torque would (φ1 of its velocity, φ2 of its displacement): an
-//! undamped impulse on a stiffly damped light joint would overshoot it by
-//! λh and creep a stuck arm. A stop acts at once (M⁻¹ as before).
+//! constant torque over the substep, so it moves each stiff mode of the
+//! damping by what that torque would (φ1 of its velocity, φ2 of its
+//! displacement; the rest as undamped): an undamped impulse on a stiffly
+//! damped light joint would overshoot it by λh and creep a stuck arm. A
+//! stop acts at once (M⁻¹ as before).
 
 use super::Follow;
 use super::exponential::{Modes, Weights};
@@ -39,6 +40,9 @@ pub(super) struct Impulses {
     friction_dv: Vec<f64>,
     /// The friction impulse per controlled joint.
     friction_impulse: Vec<f64>,
+    /// The joints whose columns the friction rows and the stop rows read.
+    friction_cols: Vec<usize>,
+    stop_cols: Vec<usize>,
     n: usize,
 }
 
@@ -57,6 +61,8 @@ impl Impulses {
             friction_response: vec![0.0; n * n],
             friction_dv: vec![0.0; n],
             friction_impulse: vec![0.0; n],
+            friction_cols: Vec::with_capacity(n),
+            stop_cols: Vec::with_capacity(n),
             n,
         }
     }
@@ -68,19 +74,20 @@ impl Impulses {
 
     /// The joints whose columns the friction rows and the stop rows read,
     /// each once.
-    fn columns(&self, follow: &[Follow]) -> (Vec<usize>, Vec<usize>) {
-        let (mut friction, mut stops) = (Vec::new(), Vec::new());
+    /// Into `friction_cols` and `stop_cols`.
+    fn columns(&mut self, follow: &[Follow]) {
+        self.friction_cols.clear();
+        self.stop_cols.clear();
         for row in &self.rows {
             let (coord, list) = match *row {
-                Row::Friction { coord, .. } => (coord, &mut friction),
-                Row::Stop { coord, .. } => (coord, &mut stops),
+                Row::Friction { coord, .. } => (coord, &mut self.friction_cols),
+                Row::Stop { coord, .. } => (coord, &mut self.stop_cols),
             };
             let leader = follow[coord].leader;
             if !list.contains(&leader) {
                 list.push(leader);
             }
         }
-        (friction, stops)
     }
 
     /// Whether a stop is passed at q.
@@ -112,10 +119,10 @@ impl Impulses {
     }
 
     /// Applies the impulses to q̇ (and friction's share of the substep to q),
-    /// then puts every passed stop's coordinate back at the stop. `m` holds
-    /// the factored inertia at the end of the substep (read only for a
-    /// passed stop, or for friction when `damped` is None); `damped`, the
-    /// URDF damping's modes over it, if the step used them.
+    /// then puts every passed stop's coordinate back at the stop. `m` is
+    /// read only for a passed stop, or for friction when `damped` is None,
+    /// and then holds the factored inertia at the end of the substep;
+    /// `damped`, the URDF damping's modes over it, if the step used them.
     pub(super) fn apply(
         &mut self,
         follow: &[Follow],
@@ -143,21 +150,16 @@ impl Impulses {
         // acts; with damping, friction's response is the modes' (a stop's
         // impulse is instantaneous, friction's a torque over the substep).
         // Only the rows' own joints' columns are read.
-        let (friction_cols, stop_cols) = self.columns(follow);
+        self.columns(follow);
         match damped {
-            Some(modes) => {
-                modes.response_columns(
-                    |w: &Weights| w.phi1,
-                    &friction_cols,
-                    &mut self.friction_response,
-                );
-                m.inverse_columns(&stop_cols, &mut self.inverse);
-            }
-            None => {
-                m.inverse_columns(&friction_cols, &mut self.friction_response);
-                m.inverse_columns(&stop_cols, &mut self.inverse);
-            }
+            Some(modes) => modes.response_columns(
+                |w: &Weights| w.phi1,
+                &self.friction_cols,
+                &mut self.friction_response,
+            ),
+            None => m.inverse_columns(&self.friction_cols, &mut self.friction_response),
         }
+        m.inverse_columns(&self.stop_cols, &mut self.inverse);
         self.lambda.clear();
         self.lambda.resize(self.rows.len(), 0.0);
         self.friction_dv.iter_mut().for_each(|x| *x = 0.0);

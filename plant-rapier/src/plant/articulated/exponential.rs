@@ -167,7 +167,8 @@ pub(super) struct Modes {
     /// The stiff joints, and their √d.
     stiff: Vec<usize>,
     root_d: Vec<f64>,
-    /// Kept modes: a rate under 1e-12 of the largest is left to the rest.
+    /// Kept modes: a rate under 1e-12 of its group's largest is left to
+    /// the rest.
     r: usize,
     /// Mode m's w_m: `w[m * n + i]`.
     w: Vec<f64>,
@@ -564,8 +565,43 @@ mod tests {
         }
     }
 
-    /// The response matrix's columns are the responses to unit impulses,
-    /// and φ1(A) M⁻¹ with every joint stiff is W diag(φ1) Wᵀ.
+    /// φ1(A) M⁻¹ from the split equals W diag(φ1) Wᵀ from the whole
+    /// eigendecomposition of L⁻¹ D_S L⁻ᵀ (W = L⁻ᵀ V), made here with
+    /// nalgebra on dense matrices: with one joint stiff and with all.
+    #[test]
+    fn the_response_equals_the_whole_eigendecomposition() {
+        use nalgebra::Matrix3;
+        let m = Matrix3::from_row_slice(&M);
+        let l = m.cholesky().map(|c| c.l()).unwrap_or_else(|| panic!("M"));
+        let l_inv = l.try_inverse().unwrap_or_else(|| panic!("L"));
+        for (h, stiff) in [(1e-3, [0.0, 0.0, D[2]]), (1.0, D)] {
+            let s = l_inv * Matrix3::from_diagonal(&stiff.into()) * l_inv.transpose();
+            let eig = SymmetricEigen::new(s);
+            let w = l_inv.transpose() * eig.eigenvectors;
+            let phi = Matrix3::from_fn(|i, j| {
+                if i == j {
+                    Weights::new(eig.eigenvalues[i].max(0.0), h).phi1
+                } else {
+                    0.0
+                }
+            });
+            let want = w * phi * w.transpose();
+            let (_, modes) = modes_at(h);
+            let mut got = [0.0; 9];
+            modes.response_columns(|w| w.phi1, &[0, 1, 2], &mut got);
+            for i in 0..3 {
+                for j in 0..3 {
+                    let (g, x) = (got[j * 3 + i], want[(i, j)]);
+                    assert!(
+                        (g - x).abs() < 1e-10 * (1.0 + x.abs()),
+                        "h {h} ({i},{j}): {g} vs {x}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The response matrix's columns are the responses to unit impulses.
     #[test]
     fn response_matrix_columns_are_unit_responses() {
         for h in [1e-3, 1.0] {

@@ -109,7 +109,9 @@ impl Cholesky {
     }
 
     /// Factors the matrix; Err(joint) where it is not positive definite (or
-    /// NaN): the first joint whose pivot is.
+    /// NaN): the first joint, in the joints' order, whose inertia about its
+    /// axis the joints before it already account for (see
+    /// [`Self::first_singular_in_order`]).
     pub(super) fn factor(&mut self) -> Result<(), usize> {
         let n = self.n;
         for (k, &jk) in self.order.iter().enumerate() {
@@ -123,7 +125,7 @@ impl Cholesky {
             let d = l[k * n + k];
             // Not positive, or NaN.
             if d.is_nan() || d <= 0.0 {
-                return Err(self.order[k]);
+                return Err(self.first_singular_in_order().unwrap_or(self.order[k]));
             }
             let d = d.sqrt();
             l[k * n + k] = d;
@@ -142,6 +144,32 @@ impl Cholesky {
             }
         }
         Ok(())
+    }
+
+    /// Where a matrix that failed is singular, named as a dense factor in
+    /// the joints' (tree) order names it: leaves first, the failing pivot
+    /// can be a parent whose own links have mass, while root first it is
+    /// the joint that adds nothing. Only a finite matrix is searched (a
+    /// blown-up state has nothing to name); this runs only on failure.
+    fn first_singular_in_order(&self) -> Option<usize> {
+        let n = self.n;
+        if self.a.iter().any(|x| !x.is_finite()) {
+            return None;
+        }
+        let mut l = self.a.clone();
+        for j in 0..n {
+            let d = l[j * n + j] - (0..j).map(|k| l[j * n + k] * l[j * n + k]).sum::<f64>();
+            if d.is_nan() || d <= 0.0 {
+                return Some(j);
+            }
+            let d = d.sqrt();
+            l[j * n + j] = d;
+            for i in j + 1..n {
+                let s = l[i * n + j] - (0..j).map(|k| l[i * n + k] * l[j * n + k]).sum::<f64>();
+                l[i * n + j] = s / d;
+            }
+        }
+        None
     }
 
     /// x = M⁻¹ b in place, after `factor`.
@@ -305,5 +333,60 @@ mod tests {
         // Joint 2 massless: its pivot is the first not positive.
         tree.matrix_mut()[2 * n + 2] = 0.0;
         assert_eq!(tree.factor(), Err(2));
+        // Joints 3 and 4 turn together (a coaxial pair with nothing
+        // between): leaves first, joint 3's pivot fails; the joint named is
+        // the one that adds nothing in tree order, joint 4, as before.
+        tree.matrix_mut().copy_from_slice(&a);
+        for (i, j) in [(3, 3), (3, 4), (4, 3), (4, 4)] {
+            tree.matrix_mut()[i * n + j] = 1.0;
+        }
+        assert_eq!(tree.factor(), Err(4));
+    }
+
+    /// A coupling across branches (a mimic joint on one that follows the
+    /// other's joint) makes fill; the factor takes it in and still solves
+    /// as the dense one does.
+    #[test]
+    fn a_coupling_across_branches_is_filled_in() {
+        let parent = [None, Some(0), Some(1), Some(0), Some(3)];
+        let ancestor = |a: usize, mut b: usize| loop {
+            if a == b {
+                return true;
+            }
+            match parent[b] {
+                Some(p) => b = p,
+                None => return false,
+            }
+        };
+        let cross = |i: usize, j: usize| (i, j) == (2, 4) || (i, j) == (4, 2);
+        let coupled = |i: usize, j: usize| ancestor(i, j) || ancestor(j, i) || cross(i, j);
+        let n = 5;
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                if coupled(i, j) {
+                    a[i * n + j] = if i == j {
+                        6.0 + i as f64
+                    } else {
+                        0.5 / (1 + i + j) as f64
+                    };
+                }
+            }
+        }
+        let dense = factored(n, &a);
+        let mut tree = Cholesky::with_structure(vec![4, 2, 3, 1, 0], coupled);
+        // The tree's 6, the cross coupling, and two of fill: eliminating
+        // joint 4 couples 2 with 3, then eliminating 2 couples 3 with 1.
+        let reached: usize = tree.below.iter().map(Vec::len).sum();
+        assert_eq!(reached, 6 + 1 + 2);
+        tree.matrix_mut().copy_from_slice(&a);
+        tree.factor().unwrap_or_else(|row| panic!("row {row}"));
+        let (mut got, mut want) = (vec![0.0; n * n], vec![0.0; n * n]);
+        let all: Vec<usize> = (0..n).collect();
+        tree.inverse_columns(&all, &mut got);
+        dense.inverse_columns(&all, &mut want);
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).abs() < 1e-14, "{got:?} vs {want:?}");
+        }
     }
 }
