@@ -277,14 +277,11 @@ mod tests {
         assert_eq!(c.factor(), Err(0));
     }
 
-    /// A branched arm's inertia, eliminated leaves first with only the
-    /// ancestors' rows, solves as the dense factor does, and a singular
-    /// pivot names its joint in the joints' order.
-    #[test]
-    fn a_tree_eliminated_leaves_first_solves_as_the_dense_factor() {
-        // Joint 0 is the root; 1 → 2 one branch, 3 → 4 the other.
+    /// Five joints: 0 the root; 1 → 2 one branch, 3 → 4 the other; with
+    /// `cross`, joints 2 and 4 couple too (a mimic across the branches).
+    fn branched(cross: bool) -> impl Fn(usize, usize) -> bool {
         let parent = [None, Some(0), Some(1), Some(0), Some(3)];
-        let ancestor = |a: usize, mut b: usize| loop {
+        let ancestor = move |a: usize, mut b: usize| loop {
             if a == b {
                 return true;
             }
@@ -293,7 +290,16 @@ mod tests {
                 None => return false,
             }
         };
-        let coupled = |i: usize, j: usize| ancestor(i, j) || ancestor(j, i);
+        move |i, j| {
+            ancestor(i, j) || ancestor(j, i) || (cross && ((i, j) == (2, 4) || (i, j) == (4, 2)))
+        }
+    }
+
+    /// A positive definite matrix on the `coupled` pattern, its dense
+    /// factor, and the leaves-first one (factored).
+    fn both_factors(
+        coupled: impl Fn(usize, usize) -> bool + Copy,
+    ) -> (Vec<f64>, Cholesky, Cholesky) {
         let n = 5;
         let mut a = vec![0.0; n * n];
         for i in 0..n {
@@ -302,20 +308,20 @@ mod tests {
                     a[i * n + j] = if i == j {
                         6.0 + i as f64
                     } else {
-                        1.0 / (1 + i + j) as f64
+                        0.5 / (1 + i + j) as f64
                     };
                 }
             }
         }
-        let dense = factored(n, &a);
         let mut tree = Cholesky::with_structure(vec![4, 2, 3, 1, 0], coupled);
-        // One group: everything hangs from joint 0.
-        assert!((0..n).all(|j| tree.group(j) == tree.group(0)));
-        // No fill: every column reaches only its joint's ancestors.
-        let reached: usize = tree.below.iter().map(Vec::len).sum();
-        assert_eq!(reached, 4 + 2);
         tree.matrix_mut().copy_from_slice(&a);
         tree.factor().unwrap_or_else(|row| panic!("row {row}"));
+        (a.clone(), factored(n, &a), tree)
+    }
+
+    /// M⁻¹ and a solve from both factors agree.
+    fn assert_same(tree: &Cholesky, dense: &Cholesky) {
+        let n = 5;
         let (mut got, mut want) = (vec![0.0; n * n], vec![0.0; n * n]);
         let all: Vec<usize> = (0..n).collect();
         tree.inverse_columns(&all, &mut got);
@@ -323,13 +329,28 @@ mod tests {
         for (g, w) in got.iter().zip(&want) {
             assert!((g - w).abs() < 1e-14, "{got:?} vs {want:?}");
         }
-        let mut b = [1.0, -2.0, 0.5, 3.0, 0.25];
-        let mut c = b;
+        let (mut b, mut c) = ([1.0, -2.0, 0.5, 3.0, 0.25], [1.0, -2.0, 0.5, 3.0, 0.25]);
         tree.solve(&mut b);
         dense.solve(&mut c);
         for (x, y) in b.iter().zip(&c) {
             assert!((x - y).abs() < 1e-14);
         }
+    }
+
+    /// A branched arm's inertia, eliminated leaves first with only the
+    /// ancestors' rows, solves as the dense factor does, and a singular
+    /// pivot names its joint in the joints' order.
+    #[test]
+    fn a_tree_eliminated_leaves_first_solves_as_the_dense_factor() {
+        let n = 5;
+        let coupled = branched(false);
+        let (a, dense, mut tree) = both_factors(&coupled);
+        // One group: everything hangs from joint 0.
+        assert!((0..n).all(|j| tree.group(j) == tree.group(0)));
+        // No fill: every column reaches only its joint's ancestors.
+        let reached: usize = tree.below.iter().map(Vec::len).sum();
+        assert_eq!(reached, 4 + 2);
+        assert_same(&tree, &dense);
         // Joint 2 massless: its pivot is the first not positive.
         tree.matrix_mut()[2 * n + 2] = 0.0;
         assert_eq!(tree.factor(), Err(2));
@@ -348,45 +369,12 @@ mod tests {
     /// as the dense one does.
     #[test]
     fn a_coupling_across_branches_is_filled_in() {
-        let parent = [None, Some(0), Some(1), Some(0), Some(3)];
-        let ancestor = |a: usize, mut b: usize| loop {
-            if a == b {
-                return true;
-            }
-            match parent[b] {
-                Some(p) => b = p,
-                None => return false,
-            }
-        };
-        let cross = |i: usize, j: usize| (i, j) == (2, 4) || (i, j) == (4, 2);
-        let coupled = |i: usize, j: usize| ancestor(i, j) || ancestor(j, i) || cross(i, j);
-        let n = 5;
-        let mut a = vec![0.0; n * n];
-        for i in 0..n {
-            for j in 0..n {
-                if coupled(i, j) {
-                    a[i * n + j] = if i == j {
-                        6.0 + i as f64
-                    } else {
-                        0.5 / (1 + i + j) as f64
-                    };
-                }
-            }
-        }
-        let dense = factored(n, &a);
-        let mut tree = Cholesky::with_structure(vec![4, 2, 3, 1, 0], coupled);
+        let coupled = branched(true);
+        let (_, dense, tree) = both_factors(&coupled);
         // The tree's 6, the cross coupling, and two of fill: eliminating
         // joint 4 couples 2 with 3, then eliminating 2 couples 3 with 1.
         let reached: usize = tree.below.iter().map(Vec::len).sum();
         assert_eq!(reached, 6 + 1 + 2);
-        tree.matrix_mut().copy_from_slice(&a);
-        tree.factor().unwrap_or_else(|row| panic!("row {row}"));
-        let (mut got, mut want) = (vec![0.0; n * n], vec![0.0; n * n]);
-        let all: Vec<usize> = (0..n).collect();
-        tree.inverse_columns(&all, &mut got);
-        dense.inverse_columns(&all, &mut want);
-        for (g, w) in got.iter().zip(&want) {
-            assert!((g - w).abs() < 1e-14, "{got:?} vs {want:?}");
-        }
+        assert_same(&tree, &dense);
     }
 }
