@@ -36,7 +36,7 @@ pub const TRAJECTORY_FILE_BYTES: u64 = 128 << 20;
 pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
 pub use default_for_arm::{ArmDefault, GRIPPER_LOCK};
 pub use gains::{ArmatureFor, GainChoice, JointGain};
-pub use plan::{Overrides, Plan, load, parse_set, plan};
+pub use plan::{Overrides, Plan, load, load_named, parse_set, plan, resolve_scenario};
 pub use probe::Probe;
 pub use randomise::{Dist, Randomise, drawn};
 pub use robot::RobotSource;
@@ -117,6 +117,16 @@ pub enum ScenarioError {
         example: String,
         /// The joints past [`wire::MAX_DOF`], in joint order.
         beyond: String,
+    },
+    /// A scenario argument that is neither a file nor a shipped scenario.
+    #[error(
+        "{name}: no such file, and not a shipped scenario; the shipped ones are {shipped} (`testbed scenarios` describes them)"
+    )]
+    NotFound {
+        /// The argument as given.
+        name: String,
+        /// The shipped scenarios' names, comma-separated.
+        shipped: String,
     },
     /// The plant settings or the robot are unusable.
     #[error("{file}: {cause}")]

@@ -242,6 +242,33 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
     plan(scenario, source, toml_text, robot)
 }
 
+/// A scenario argument as `--scenario` takes it: a file, or else the name
+/// of a shipped scenario (with or without `.toml`), as its file.
+pub fn resolve_scenario(arg: &Path) -> Result<PathBuf, ScenarioError> {
+    if arg.exists() || arg.components().count() > 1 {
+        return Ok(arg.to_path_buf());
+    }
+    match arg.to_str().and_then(crate::find_shipped) {
+        Some(s) => Ok(s.path()),
+        None => Err(ScenarioError::NotFound {
+            name: arg.display().to_string(),
+            shipped: crate::SHIPPED
+                .iter()
+                .map(|s| s.name)
+                .collect::<Vec<_>>()
+                .join(", "),
+        }),
+    }
+}
+
+/// [`load`] with the scenario given as `--scenario` takes it
+/// ([`resolve_scenario`]); None: the built-in paper scenario, or the
+/// default scenario of `overrides.robot`.
+pub fn load_named(arg: Option<&Path>, overrides: &Overrides) -> Result<Plan, ScenarioError> {
+    let path = arg.map(resolve_scenario).transpose()?;
+    load(path.as_deref(), overrides)
+}
+
 /// Checks a parsed scenario against a robot and fixes the time grid.
 pub fn plan(
     scenario: Scenario,

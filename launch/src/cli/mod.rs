@@ -239,20 +239,10 @@ pub(crate) fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario:
         law: common.law,
         set: common.set.clone(),
     };
-    let path = common.scenario.as_deref().map(resolve_scenario);
-    if let Some(p) = &path
-        && !p.exists()
-        && p.components().count() == 1
-    {
-        let names: Vec<&str> = scenario::SHIPPED.iter().map(|s| s.name).collect();
-        anyhow::bail!(
-            "--scenario {}: no such file, and not a shipped scenario; the shipped ones are {} \
-             (`testbed scenarios` describes them)",
-            p.display(),
-            names.join(", ")
-        );
-    }
-    Ok(scenario::load(path.as_deref(), &overrides)?)
+    Ok(scenario::load_named(
+        common.scenario.as_deref(),
+        &overrides,
+    )?)
 }
 
 /// Refuses a scenario with an `[external]` table where no external
@@ -266,18 +256,6 @@ pub(crate) fn no_external(plan: &scenario::Plan, command: &str) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// A scenario argument that is not a file but names a shipped scenario
-/// becomes that scenario's file.
-fn resolve_scenario(arg: &std::path::Path) -> PathBuf {
-    if arg.exists() || arg.components().count() > 1 {
-        return arg.to_path_buf();
-    }
-    match arg.to_str().and_then(scenario::find_shipped) {
-        Some(s) => s.path(),
-        None => arg.to_path_buf(),
-    }
 }
 
 pub(crate) fn print_report(report: &Report, json: bool) -> Result<()> {

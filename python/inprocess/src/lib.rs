@@ -1,0 +1,53 @@
+//! `testbed._native`: the testbed in process, for Python (PyO3). The
+//! Python package `testbed` (beside this crate) wraps it: robots and their
+//! dynamics, scenarios with `--set` overrides, `sim` as `testbed sim` runs
+//! it, the built-in laws as objects, `compare`, and the Gymnasium
+//! environment's core, one arm or many stepped in one call.
+//!
+//! Where it sits: beside the `testbed` binary, on the same libraries. It
+//! drives the role crates' step machines ([`plant_rapier::PlantMachine`],
+//! [`trajectory::TrajectoryMachine`], [`controller::ControllerMachine`]) as
+//! `testbed sim` does, so a run from Python has the same bits. No I/O, no
+//! IPC; nothing here may panic across the boundary: every error becomes a
+//! Python exception that names its cause.
+
+mod convert;
+mod env;
+mod laws;
+mod robot;
+mod runs;
+
+use pyo3::prelude::*;
+
+pyo3::create_exception!(
+    _native,
+    TestbedError,
+    pyo3::exceptions::PyValueError,
+    "A scenario, robot or argument the testbed cannot use (the message names the file and key)."
+);
+
+/// The module `testbed._native`.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("TestbedError", m.py().get_type::<TestbedError>())?;
+    m.add("MAX_DOF", wire::MAX_DOF)?;
+    m.add(
+        "LAWS",
+        controller::LawName::ALL
+            .iter()
+            .map(|l| l.as_str())
+            .collect::<Vec<_>>(),
+    )?;
+    m.add(
+        "SCENARIOS",
+        scenario::SHIPPED.iter().map(|s| s.name).collect::<Vec<_>>(),
+    )?;
+    m.add_class::<robot::Robot>()?;
+    m.add_class::<laws::PyLaw>()?;
+    m.add_class::<env::py::EnvCore>()?;
+    m.add_class::<env::py::VecEnvCore>()?;
+    m.add_function(wrap_pyfunction!(runs::sim, m)?)?;
+    m.add_function(wrap_pyfunction!(runs::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(runs::scenario_toml, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,210 @@
+//! `testbed.sim`, `testbed.compare` and `testbed.scenario_toml`: whole
+//! runs, as the CLI's commands of the same names make them.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use analysis::record::StepRecord;
+use analysis::report::Report;
+use analysis::summary::SummaryBuilder;
+use launch::compare::{CompareOptions, DEFAULT_LAWS};
+
+use crate::convert::{ScenarioArgs, err, json_to_py};
+
+/// Every row of a run, one growing column per field.
+struct Columns {
+    n: usize,
+    t: Vec<f64>,
+    per_joint: Vec<(&'static str, Vec<f64>)>,
+    effects: Vec<u32>,
+}
+
+type Field = for<'a> fn(&StepRecord<'a>) -> &'a [f64];
+
+/// The per-joint columns `sim` returns, each read from a step's record.
+const JOINT_FIELDS: [(&str, Field); 13] = [
+    ("q", |r| r.q),
+    ("qd", |r| r.qd),
+    ("qdd", |r| r.qdd),
+    ("tau", |r| r.tau),
+    ("q_d", |r| r.q_d),
+    ("qd_d", |r| r.qd_d),
+    ("kc", |r| r.kc),
+    ("z1", |r| r.z1),
+    ("z2", |r| r.z2),
+    ("wa_norm", |r| r.wa_norm),
+    ("q_measured", |r| r.q_measured),
+    ("qd_measured", |r| r.qd_measured),
+    ("disturbance", |r| r.disturbance),
+];
+
+impl Columns {
+    fn new(n: usize, steps: usize) -> Self {
+        Self {
+            n,
+            t: Vec::with_capacity(steps),
+            per_joint: JOINT_FIELDS
+                .iter()
+                .map(|(name, _)| (*name, Vec::with_capacity(steps * n)))
+                .collect(),
+            effects: Vec::with_capacity(steps),
+        }
+    }
+
+    fn add(&mut self, r: &StepRecord<'_>) {
+        self.t.push(r.t);
+        for ((_, col), (_, field)) in self.per_joint.iter_mut().zip(JOINT_FIELDS.iter()) {
+            col.extend_from_slice(field(r));
+        }
+        self.effects.push(r.effects);
+    }
+
+    fn into_dict(self, py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+        let d = PyDict::new(py);
+        let rows = self.t.len();
+        d.set_item("t", PyArray1::from_vec(py, self.t))?;
+        for (name, col) in self.per_joint {
+            d.set_item(name, PyArray1::from_vec(py, col).reshape([rows, self.n])?)?;
+        }
+        d.set_item("effects", PyArray1::from_vec(py, self.effects))?;
+        Ok(d)
+    }
+}
+
+/// Runs a scenario in process, as `testbed sim` does, and returns
+/// `(rows, summary)`: `rows` a dict of numpy arrays, one row per step
+/// (`t`; per joint `q`, `qd`, `qdd`, `tau`, `q_d`, `qd_d`, `kc`, `z1`,
+/// `z2`, `wa_norm`, `q_measured`, `qd_measured`, `disturbance`; `effects`),
+/// the same bits as `testbed sim --csv`; `summary` the dict `testbed sim
+/// --json` prints.
+#[pyfunction]
+#[pyo3(signature = (scenario=None, *, robot=None, set=None, duration=None, law=None))]
+pub fn sim<'py>(
+    py: Python<'py>,
+    scenario: Option<PathBuf>,
+    robot: Option<PathBuf>,
+    set: Option<&Bound<'py, PyAny>>,
+    duration: Option<f64>,
+    law: Option<&str>,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyAny>)> {
+    let plan = ScenarioArgs {
+        scenario,
+        robot,
+        set,
+        duration,
+        law,
+    }
+    .load()?;
+    no_external(&plan)?;
+    let n = plan.robot.model.dof();
+    let (columns, report) = py
+        .detach(|| {
+            let mut columns = Columns::new(n, plan.steps as usize);
+            let mut summary = SummaryBuilder::new(
+                plan.robot.model.joint_names(),
+                plan.dt(),
+                plan.scenario.controller.tc,
+            );
+            let mut costs = launch::sim::StepCosts::default();
+            let start = Instant::now();
+            launch::sim::run_measured(&plan, Some(&mut costs), |r| {
+                summary.add(r);
+                columns.add(r);
+                Ok(())
+            })
+            .map_err(|e| format!("running {}: {e}", plan.source))?;
+            let wall = start.elapsed().as_secs_f64();
+            let report =
+                Report::from_sim(&plan, summary.finish(), wall, costs.controller_us.finish());
+            Ok::<_, String>((columns, report))
+        })
+        .map_err(err)?;
+    Ok((columns.into_dict(py)?, json_to_py(py, &report)?))
+}
+
+/// The laws on one scenario and its seeds, scored, as `testbed compare
+/// --json` prints them (a dict; `laws` holds each law's row).
+#[pyfunction]
+#[pyo3(signature = (scenario=None, *, laws=None, seeds=1, robot=None, set=None, duration=None, threads=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn compare<'py>(
+    py: Python<'py>,
+    scenario: Option<PathBuf>,
+    laws: Option<Vec<String>>,
+    seeds: u64,
+    robot: Option<PathBuf>,
+    set: Option<&Bound<'py, PyAny>>,
+    duration: Option<f64>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let plan = ScenarioArgs {
+        scenario,
+        robot,
+        set,
+        duration,
+        law: None,
+    }
+    .load()?;
+    no_external(&plan)?;
+    let laws = match laws {
+        None => DEFAULT_LAWS.to_vec(),
+        Some(l) => l
+            .iter()
+            .map(|s| s.parse::<controller::LawName>().map_err(err))
+            .collect::<PyResult<Vec<_>>>()?,
+    };
+    if seeds == 0 || threads == Some(0) {
+        return Err(err("compare needs at least one seed and one thread"));
+    }
+    let opts = CompareOptions {
+        laws,
+        seeds,
+        threads,
+        series: false,
+        tuning: None,
+        external: Vec::new(),
+        runs_dir: std::env::temp_dir(),
+        progress: false,
+    };
+    let result = py
+        .detach(|| launch::compare::compare(&plan, &opts).map_err(|e| e.to_string()))
+        .map_err(err)?;
+    json_to_py(py, &result)
+}
+
+/// The scenario as it would run (overrides applied), as TOML text.
+#[pyfunction]
+#[pyo3(signature = (scenario=None, *, robot=None, set=None, duration=None, law=None))]
+pub fn scenario_toml<'py>(
+    scenario: Option<PathBuf>,
+    robot: Option<PathBuf>,
+    set: Option<&Bound<'py, PyAny>>,
+    duration: Option<f64>,
+    law: Option<&str>,
+) -> PyResult<String> {
+    let plan = ScenarioArgs {
+        scenario,
+        robot,
+        set,
+        duration,
+        law,
+    }
+    .load()?;
+    plan.effective_toml().map_err(err)
+}
+
+/// A scenario with an `[external]` table is for an external controller.
+pub fn no_external(plan: &scenario::Plan) -> PyResult<()> {
+    match plan.scenario.external.keys().next() {
+        Some(key) => Err(err(format!(
+            "{}: [external] {key} is for an external controller (`testbed run --controller-cmd`); \
+             the in-process module runs the testbed's own laws",
+            plan.source
+        ))),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,90 @@
+"""A linear policy on the environment's observation, a dependency-free
+learner for it (random search), and its file: what a trained policy takes
+back into `testbed compare` and a real-time run (`testbed.policy_node`).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+
+
+@dataclass
+class LinearPolicy:
+    """a = clip(W · obs + b, -1, 1), with the environment it was made for."""
+
+    weights: np.ndarray
+    bias: np.ndarray
+    #: The environment's arguments (scenario, robot, set, duration,
+    #: base_law, residual_scale, torque_scale, …) and its sizes (dof, steps).
+    env: dict = field(default_factory=dict)
+
+    @classmethod
+    def zeros(cls, dof: int, obs_dim: int, env: Optional[dict] = None) -> "LinearPolicy":
+        return cls(np.zeros((dof, obs_dim)), np.zeros(dof), dict(env or {}))
+
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        return np.clip(self.weights @ obs + self.bias, -1.0, 1.0)
+
+    def save(self, path) -> None:
+        """Writes the policy as .npz (weights, bias, the environment as JSON)."""
+        np.savez(path, weights=self.weights, bias=self.bias, env=json.dumps(self.env))
+
+    @classmethod
+    def load(cls, path) -> "LinearPolicy":
+        with np.load(path, allow_pickle=False) as f:
+            missing = {"weights", "bias", "env"} - set(f.files)
+            if missing:
+                raise ValueError(f"{path}: not a testbed policy file (no {', '.join(sorted(missing))})")
+            weights, bias, env = f["weights"], f["bias"], json.loads(str(f["env"]))
+        if weights.ndim != 2 or bias.shape != (weights.shape[0],):
+            raise ValueError(f"{path}: weights {weights.shape} and bias {bias.shape} do not fit")
+        return cls(weights.astype(np.float64), bias.astype(np.float64), env)
+
+
+def env_record(env) -> dict:
+    """What a policy file keeps of an `ArmTrackingEnv` made with `make_kwargs`."""
+    core = env.unwrapped.core
+    return {"dof": core.dof, "obs_dim": core.obs_dim, "steps": core.steps,
+            "torque_scale": core.torque_scale.tolist()}
+
+
+def episode_return(env, policy: LinearPolicy, seed: int) -> float:
+    """The undiscounted return of one episode from reset(seed=seed)."""
+    obs, _ = env.reset(seed=seed)
+    total, done = 0.0, False
+    while not done:
+        obs, reward, terminated, truncated, _ = env.step(policy.act(obs))
+        total += reward
+        done = terminated or truncated
+    return total
+
+
+def random_search(env, policy: LinearPolicy, *, iterations: int = 10, directions: int = 8,
+                  top: int = 4, step_size: float = 0.02, noise: float = 0.03, seed: int = 0,
+                  episode_seed: int = 0,
+                  callback: Optional[Callable[[int, float], None]] = None) -> LinearPolicy:
+    """Augmented random search (Mania et al. 2018, V1-t) on the weights:
+    each iteration tries `directions` random perturbations both ways on the
+    episode of `episode_seed` and moves along the best `top` of them."""
+    rng = np.random.default_rng(seed)
+    params = np.concatenate([policy.weights, policy.bias[:, None]], axis=1)
+
+    def ret(p):
+        trial = LinearPolicy(p[:, :-1], p[:, -1], policy.env)
+        return episode_return(env, trial, episode_seed)
+
+    for it in range(iterations):
+        deltas = rng.standard_normal((directions,) + params.shape)
+        plus = np.array([ret(params + noise * d) for d in deltas])
+        minus = np.array([ret(params - noise * d) for d in deltas])
+        best = np.argsort(-np.maximum(plus, minus))[:top]
+        sigma = np.concatenate([plus[best], minus[best]]).std() or 1.0
+        step = sum((plus[k] - minus[k]) * deltas[k] for k in best)
+        params = params + step_size / (top * sigma) * step
+        if callback is not None:
+            callback(it, ret(params))
+    return LinearPolicy(params[:, :-1].copy(), params[:, -1].copy(), policy.env)
