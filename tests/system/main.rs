@@ -12,6 +12,7 @@ mod liveness;
 mod log_replay;
 mod many_joints;
 mod python;
+mod python_in_process;
 mod realtime_integrity;
 mod replace_nodes;
 mod robots;

@@ -211,7 +211,15 @@ pub(crate) struct BenchArgs {
     /// in --repeats alternating pairs.
     #[arg(long, conflicts_with = "controller_cmd")]
     pub(crate) peer: bool,
-    /// The Python that runs the loop (set up by `bash python/setup-venv.sh --peer`).
+    /// Measure only the Gymnasium environment from Python: env.step a
+    /// second (one two-link arm), arm-steps a second (64 arms in one
+    /// vector call; two-link and iiwa14), beside Gymnasium's MuJoCo
+    /// Reacher-v5 in the same run (python/bench/gym_steps.py; build the
+    /// module with `bash python/build-module.sh --release`).
+    #[arg(long, conflicts_with_all = ["controller_cmd", "peer"])]
+    pub(crate) gym: bool,
+    /// The Python that runs the loop of --peer or --gym (set up by `bash
+    /// python/setup-venv.sh --peer` and `bash python/build-module.sh`).
     #[arg(
         long,
         value_name = "CMD",

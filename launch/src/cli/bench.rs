@@ -3,7 +3,7 @@
 use std::fmt::Write;
 use std::process::ExitCode;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use launch::bench_controller::ControllerBench;
 
 use super::args::BenchArgs;
@@ -36,6 +36,9 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
         law: args.law,
     };
     let progress = |what: &str| eprintln!("testbed bench: {what}");
+    if args.gym {
+        return gym(&args.peer_python, args.repeats, args.json);
+    }
     if args.peer {
         let python = super::args::command_words(&args.peer_python)?;
         let report = launch::bench_peer::run(&opts, &python, progress)?;
@@ -134,4 +137,35 @@ fn controller_table(b: &ControllerBench) -> String {
         }
     }
     out
+}
+
+/// `bench --gym`: the Gymnasium benchmark script, its figures printed as
+/// it prints them (a table, or one JSON object).
+fn gym(python: &str, repeats: usize, json: bool) -> Result<ExitCode> {
+    let words = super::args::command_words(python)?;
+    let Some((program, pre)) = words.split_first() else {
+        anyhow::bail!("--peer-python: no Python command");
+    };
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../python/bench/gym_steps.py");
+    let mut cmd = std::process::Command::new(program);
+    cmd.args(pre)
+        .arg(&script)
+        .args(["--repeats", &repeats.to_string()]);
+    if json {
+        cmd.arg("--json");
+    }
+    eprintln!("testbed bench: Gymnasium environments from Python ({})", script.display());
+    let out = cmd
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .with_context(|| format!("cannot start {program}"))?;
+    if !out.status.success() {
+        anyhow::bail!(
+            "{} failed ({}); build the module with `bash python/build-module.sh --release`",
+            script.display(),
+            out.status
+        );
+    }
+    super::write_stdout(&String::from_utf8_lossy(&out.stdout))?;
+    Ok(ExitCode::SUCCESS)
 }

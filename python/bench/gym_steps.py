@@ -1,0 +1,113 @@
+"""Environment steps a second from Python: the testbed's Gymnasium
+environment (one arm; 64 arms in one vector call) beside Gymnasium's
+MuJoCo Reacher-v5, in one run, medians of --repeats.
+
+    python python/bench/gym_steps.py [--repeats 5] [--steps 200000] [--json]
+    testbed bench --gym        (the same, with target/python-venv's python)
+
+Needs the module built (`bash python/build-module.sh --release` for
+figures that mean anything) and, for the peer, MuJoCo
+(`bash python/setup-venv.sh --peer`).
+"""
+
+import argparse
+import json
+import platform
+import statistics
+import time
+from pathlib import Path
+
+import gymnasium
+import numpy as np
+
+import testbed
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def single(make, steps):
+    env = make()
+    env.reset(seed=0)
+    action = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)
+    step, reset = env.step, env.reset
+    start = time.perf_counter()
+    for _ in range(steps):
+        _, _, term, trunc, _ = step(action)
+        if term or trunc:
+            reset()
+    return steps / (time.perf_counter() - start)
+
+
+def vector(num, steps, **kwargs):
+    venv = gymnasium.make_vec(testbed.ENV_ID, num_envs=num, **kwargs)
+    venv.reset(seed=0)
+    actions = np.zeros((num,) + venv.single_action_space.shape)
+    calls = max(1, steps // num)
+    step = venv.step
+    start = time.perf_counter()
+    for _ in range(calls):
+        step(actions)
+    return calls * num / (time.perf_counter() - start)
+
+
+def reacher():
+    try:
+        import mujoco  # noqa: F401
+    except ImportError:
+        return None
+    return lambda: gymnasium.make("Reacher-v5")
+
+
+def median_of(fn, repeats):
+    runs = [fn() for _ in range(repeats)]
+    return {"median": statistics.median(runs), "runs": runs}
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--steps", type=int, default=200_000, help="steps per measurement")
+    p.add_argument("--json", action="store_true")
+    a = p.parse_args()
+    if a.repeats < 1 or a.steps < 1:
+        p.error("--repeats and --steps must be at least 1")
+    iiwa = str(ROOT / "robots/iiwa14.urdf")
+    figures = {
+        "env_two_link": median_of(lambda: single(lambda: gymnasium.make(testbed.ENV_ID), a.steps), a.repeats),
+        "vec64_two_link": median_of(lambda: vector(64, a.steps), a.repeats),
+        "vec64_iiwa14": median_of(lambda: vector(64, a.steps // 4, robot=iiwa), a.repeats),
+    }
+    peer = reacher()
+    figures["reacher_v5"] = (median_of(lambda: single(peer, a.steps), a.repeats)
+                             if peer else None)
+    result = {
+        "python": platform.python_version(),
+        "gymnasium": gymnasium.__version__,
+        "module_build": testbed._native.__file__,
+        "steps": a.steps,
+        "repeats": a.repeats,
+        "figures": figures,
+    }
+    if a.json:
+        print(json.dumps(result))
+        return
+    rows = [("testbed/ArmTracking-v0, two-link arm, env.step", "env_two_link"),
+            ("Gymnasium MuJoCo Reacher-v5, env.step (peer)", "reacher_v5"),
+            ("vector env, 64 two-link arms, arm-steps", "vec64_two_link"),
+            ("vector env, 64 iiwa14 arms, arm-steps", "vec64_iiwa14")]
+    print(f"steps a second from Python {result['python']}, Gymnasium {result['gymnasium']}: "
+          f"medians of {a.repeats}")
+    for label, key in rows:
+        f = figures[key]
+        if f is None:
+            print(f"  {label:50s} not measured (MuJoCo not installed: bash python/setup-venv.sh --peer)")
+        else:
+            lo, hi = min(f["runs"]), max(f["runs"])
+            print(f"  {label:50s} {f['median']:12,.0f}  ({lo:,.0f}–{hi:,.0f})")
+    if figures["reacher_v5"]:
+        ratio = figures["env_two_link"]["median"] / figures["reacher_v5"]["median"]
+        print(f"  testbed env / Reacher-v5: {ratio:.2f}×")
+
+
+if __name__ == "__main__":
+    main()

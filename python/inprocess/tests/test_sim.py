@@ -1,0 +1,167 @@
+"""`testbed.sim` and `testbed.compare` against the CLI, and robots' dynamics."""
+
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+import testbed
+from helpers import ROOT, assert_bits, cli_sim, joint, run_testbed
+
+# Summary fields that are timings of this machine, not results.
+TIMED = {"wall_time_s", "realtime_factor", "compute_us"}
+
+# CSV stems and the arrays sim returns, same rows.
+STEMS = {"q": "q", "qd": "qd", "qdd": "qdd", "tau": "tau", "qref": "q_d", "kc": "kc",
+         "z1_": "z1", "z2_": "z2", "wa": "wa_norm", "qm": "q_measured",
+         "qdm": "qd_measured", "d": "disturbance"}
+
+
+class SimEqualsCli(unittest.TestCase):
+    def check(self, cli_args, **kwargs):
+        with tempfile.TemporaryDirectory() as tmp:
+            cols, summary = cli_sim(Path(tmp), *cli_args)
+        rows, mine = testbed.sim(**kwargs)
+        n = rows["q"].shape[1]
+        assert_bits(self, rows["t"], cols["t"], "t")
+        for stem, name in STEMS.items():
+            assert_bits(self, rows[name], joint(cols, stem, n), name)
+        self.assertTrue(np.array_equal(rows["effects"], cols["effects"].astype(np.uint32)))
+        for key in summary:
+            if key not in TIMED:
+                self.assertEqual(mine[key], summary[key], key)
+        return rows, mine
+
+    def test_the_paper_scenario(self):
+        rows, summary = self.check(["--duration", "3"], duration=3.0)
+        self.assertEqual(rows["q"].shape, (3000, 2))
+        self.assertEqual(summary["law"]["law"], "nac")
+
+    def test_noise_and_overrides_by_name(self):
+        self.check(["--scenario", "friction_noise", "--duration", "1", "--set", "seed=7",
+                    "--set", "controller.k1=[12.0, 9.0]", "--law", "blf"],
+                   scenario="friction_noise", duration=1.0, law="blf",
+                   set={"seed": 7, "controller.k1": [12.0, 9.0]})
+
+    def test_a_randomised_six_joint_arm(self):
+        self.check(["--scenario", "ur5_randomised", "--duration", "0.5", "--set", "seed=3"],
+                   scenario="ur5_randomised", duration=0.5, set=["seed=3"])
+
+    def test_a_robot_alone_runs_its_default_scenario(self):
+        urdf = ROOT / "robots/iiwa14.urdf"
+        self.check(["--robot", urdf, "--duration", "0.3"], robot=str(urdf), duration=0.3)
+
+
+class Errors(unittest.TestCase):
+    def test_unknown_scenario_names_the_shipped_ones(self):
+        with self.assertRaisesRegex(testbed.TestbedError, "not a shipped scenario.*paper"):
+            testbed.sim("no_such_scenario")
+
+    def test_a_bad_key_is_named(self):
+        with self.assertRaisesRegex(testbed.TestbedError, "controller.beta"):
+            testbed.sim(set={"controller.beta": -1.0}, duration=0.1)
+        with self.assertRaisesRegex(testbed.TestbedError, "no_such_key"):
+            testbed.sim(set={"controller.no_such_key": 1.0}, duration=0.1)
+
+    def test_bad_values_and_laws(self):
+        with self.assertRaisesRegex(ValueError, "unknown law 'nope'"):
+            testbed.sim(law="nope")
+        with self.assertRaises(TypeError):
+            testbed.sim(set={"seed": object()})
+        with self.assertRaisesRegex(testbed.TestbedError, "broken.urdf"):
+            with tempfile.TemporaryDirectory() as tmp:
+                bad = Path(tmp) / "broken.urdf"
+                bad.write_text("<robot name='x'><link name='a'/>")
+                testbed.Robot(str(bad))
+
+
+class CompareEqualsCli(unittest.TestCase):
+    def test_rows_and_scores(self):
+        import json
+        out = run_testbed("compare", "--scenario", "paper", "--duration", "2.5",
+                          "--laws", "nac,pd,ctc", "--json")
+        cli = json.loads(out.stdout)
+        mine = testbed.compare("paper", laws=["nac", "pd", "ctc"], duration=2.5)
+        self.assertEqual([r["name"] for r in mine["laws"]], [r["name"] for r in cli["laws"]])
+        for a, b in zip(mine["laws"], cli["laws"]):
+            for key, value in b["median"].items():
+                if not key.startswith("compute_"):  # this machine's timings
+                    self.assertEqual(a["median"][key], value, f"{a['name']} {key}")
+            self.assertEqual(a["kept_envelope"], b["kept_envelope"], a["name"])
+
+
+class RobotDynamics(unittest.TestCase):
+    def setUp(self):
+        self.robot = testbed.Robot(str(ROOT / "robots/ur5.urdf"))
+        self.q = np.array([0.3, -1.1, 1.4, -0.6, 0.8, 0.2])[: self.robot.dof]
+        self.qd = np.array([0.5, -0.4, 0.9, 0.3, -0.7, 1.1])[: self.robot.dof]
+
+    def test_description(self):
+        r = self.robot
+        self.assertEqual(r.dof, len(r.joint_names))
+        self.assertTrue(np.all(r.lower < r.upper))
+        self.assertTrue(np.all(r.effort > 0))
+
+    def test_mass_matrix_is_symmetric_positive_definite(self):
+        m = self.robot.mass_matrix(self.q)
+        self.assertTrue(np.allclose(m, m.T, atol=1e-12))
+        self.assertTrue(np.all(np.linalg.eigvalsh(m) > 0))
+
+    def test_coriolis_from_the_mass_matrix(self):
+        """C(q, q̇)q̇ from the Christoffel symbols of M (central differences):
+        c_i = Σ_jk (∂M_ij/∂q_k − ½ ∂M_jk/∂q_i) q̇_j q̇_k."""
+        r, q, qd, h = self.robot, self.q, self.qd, 1e-6
+        n = r.dof
+        dm = np.stack([(r.mass_matrix(q + h * e) - r.mass_matrix(q - h * e)) / (2 * h)
+                       for e in np.eye(n)])  # dm[k] = ∂M/∂q_k
+        c = np.einsum("kij,j,k->i", dm, qd, qd) - 0.5 * np.einsum("ijk,j,k->i", dm, qd, qd)
+        self.assertTrue(np.allclose(r.coriolis(q, qd), c, atol=1e-6), (r.coriolis(q, qd), c))
+
+    def test_gravity_equals_newton_euler(self):
+        """G(q) of the engine against the model-based laws' Newton–Euler
+        (arm_model): pd-gravity's model term at zero error and speed."""
+        law = testbed.Law("pd-gravity", robot=str(ROOT / "robots/ur5.urdf"))
+        z = np.zeros(self.robot.dof)
+        law.step(0.0, self.q, z, self.q, z, z, np.ones_like(z), z)
+        g = law.diagnostics["tau_model"]
+        self.assertTrue(np.allclose(self.robot.gravity(self.q), g, rtol=1e-9, atol=1e-9))
+
+    def test_bad_arguments(self):
+        with self.assertRaisesRegex(ValueError, "q: 2 values; this arm needs 6"):
+            self.robot.mass_matrix([0.0, 1.0])
+        with self.assertRaisesRegex(ValueError, r"q\[1\] = NaN"):
+            self.robot.gravity([0.0, float("nan"), 0, 0, 0, 0])
+        with self.assertRaisesRegex(TypeError, "expected 6 numbers"):
+            self.robot.gravity("abcdef")
+
+
+class Laws(unittest.TestCase):
+    def test_the_rust_law_replays_a_run(self):
+        """Law("nac") stepped on a run's states gives the run's torques."""
+        rows, _ = testbed.sim(duration=1.0, set={"plant.saturate": False})
+        law = testbed.Law("nac")
+        rows_ref = rows
+        for k in range(len(rows["t"])):
+            # q̈_d and k̇_c are not in the rows: nac reads them through the
+            # reference sample only in its feed-forward, which the paper's law has not.
+            tau = law.step(rows_ref["t"][k], rows["q_measured"][k], rows["qd_measured"][k],
+                           rows["q_d"][k], rows["qd_d"][k], np.zeros(2), rows["kc"][k],
+                           _kc_dot(rows["t"][k]))
+            assert_bits(self, tau, rows["tau"][k], f"tau at step {k}")
+
+    def test_pd_is_its_formula(self):
+        law = testbed.Law("pd", params={"k1": 4.0, "k2": 3.0})
+        q, qd = np.array([0.2, -0.1]), np.array([0.5, 0.25])
+        tau = law.step(0.0, q, qd, np.zeros(2), np.zeros(2), np.zeros(2), np.ones(2), np.zeros(2))
+        self.assertTrue(np.allclose(tau, -4.0 * 3.0 * q - 3.0 * qd))
+        self.assertEqual(law.params["k1"], 4.0)
+
+
+def _kc_dot(t):
+    """k̇_c of the paper's envelope (scenarios/paper.toml)."""
+    return np.array([0.1 * 0.5 * np.cos(0.5 * t), -0.1 * 0.5 * np.sin(0.5 * t)])
+
+
+if __name__ == "__main__":
+    unittest.main()
