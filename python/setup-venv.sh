@@ -30,7 +30,7 @@ if ! ready; then
     "$venv/bin/python3" -m pip install --quiet --disable-pip-version-check -e "$root/python" >&2
     ready || { echo "setup-venv: $venv was made but cannot import testbed_controller" >&2; exit 1; }
 fi
-if [ -n "$peer" ] && ! "$venv/bin/python3" -c "import mujoco" 2>/dev/null; then
+if [ -n "$peer" ] && ! "$venv/bin/python3" -c "import mujoco, imageio, packaging" 2>/dev/null; then
     "$venv/bin/python3" -m pip install --quiet --disable-pip-version-check -e "$root/python[peer]" >&2
     "$venv/bin/python3" -c "import mujoco" || { echo "setup-venv: MuJoCo did not install in $venv" >&2; exit 1; }
 fi

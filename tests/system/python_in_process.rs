@@ -58,8 +58,15 @@ fn a_learnt_policy_runs_in_realtime_with_a_verdict() {
          random_search(env, p, iterations=2, directions=4, top=2).save({:?})\n",
         policy.display().to_string()
     );
-    let out = Command::new(python()).args(["-c", &train]).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = Command::new(python())
+        .args(["-c", &train])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let cmd = format!(
         "{} -m testbed.policy_node --policy {}",
         python(),
@@ -81,7 +88,11 @@ fn a_learnt_policy_runs_in_realtime_with_a_verdict() {
     assert_eq!(r["timing"]["cycles"], 2000, "{r}");
     assert_eq!(r["run_end"], "finished", "{r}");
     let verdict = r["timing"]["verdict"].as_str().unwrap_or_default();
-    assert_eq!(code == Some(0), verdict == "clean", "{verdict} with exit {code:?}");
+    assert_eq!(
+        code == Some(0),
+        verdict == "clean",
+        "{verdict} with exit {code:?}"
+    );
     assert!(["clean", "degraded"].contains(&verdict), "{r}");
     assert_eq!(r["controller_law"]["name"], "policy", "{r}");
 }

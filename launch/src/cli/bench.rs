@@ -146,7 +146,8 @@ fn gym(python: &str, repeats: usize, json: bool) -> Result<ExitCode> {
     let Some((program, pre)) = words.split_first() else {
         anyhow::bail!("--peer-python: no Python command");
     };
-    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../python/bench/gym_steps.py");
+    let script =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../python/bench/gym_steps.py");
     let mut cmd = std::process::Command::new(program);
     cmd.args(pre)
         .arg(&script)
@@ -154,7 +155,10 @@ fn gym(python: &str, repeats: usize, json: bool) -> Result<ExitCode> {
     if json {
         cmd.arg("--json");
     }
-    eprintln!("testbed bench: Gymnasium environments from Python ({})", script.display());
+    eprintln!(
+        "testbed bench: Gymnasium environments from Python ({})",
+        script.display()
+    );
     let out = cmd
         .stderr(std::process::Stdio::inherit())
         .output()

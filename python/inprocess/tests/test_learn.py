@@ -88,8 +88,14 @@ class Learner(unittest.TestCase):
         names = [row["name"] for row in table["laws"]]
         self.assertEqual(names, ["pd", "policy"])
         policy_row = table["laws"][1]
-        self.assertEqual(len(policy_row["runs"]), 1)
-        self.assertTrue(np.isfinite(policy_row["median"]["iae"]))
+        self.assertEqual(policy_row["external"]["declared"]["name"], "policy")
+        [run] = policy_row["runs"]
+        # Scored like any law: a summary of the whole run, and a failure
+        # named when it has one (trained on 0.5 s, it is run for 2.5 s).
+        self.assertEqual(run["summary"]["steps"], 2500)
+        self.assertTrue(np.isfinite(run["summary"]["metrics"]["iae_after_tc"]))
+        self.assertTrue(run["summary"]["finite"])
+        self.assertIn(run["failure"], (None, "left the envelope after T_c"))
 
 
 if __name__ == "__main__":
