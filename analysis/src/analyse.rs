@@ -345,7 +345,8 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
             plan.robot.model.joint_names(),
             plan.dt(),
             plan.scenario.controller.tc,
-        ),
+        )
+        .with_gravity(&plan.robot.model),
         timing: TimingStats::new(plan.period_ns),
         data_path: DataPath::new(plan.steps, plan.reference_period_ns),
         series: opts.series.then(|| Series::new(n)),

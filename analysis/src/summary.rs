@@ -105,6 +105,11 @@ pub struct ArmMetrics {
     pub effort: f64,
     /// Σ ∫τ² dt over t ≥ T_c.
     pub effort_after_tc: f64,
+    /// Σ ∫(τ − G(q))² dt over t ≥ T_c, with G the URDF's static gravity
+    /// load at the true q: the effort beyond holding the arm still (∫τ²
+    /// after T_c is mostly that hold). None where the summary was made
+    /// without the arm's model.
+    pub effort_beyond_gravity_after_tc: Option<f64>,
     /// Σ ∫|τ q̇| dt over t ≥ T_c: the mechanical energy through the
     /// motors, J (unlike ∫τ², holding a static load costs none).
     pub energy_after_tc: f64,
@@ -172,6 +177,9 @@ pub struct SummaryBuilder {
     saturated: u64,
     dropped: u64,
     held: u64,
+    /// The URDF's Newton–Euler model, for G(q) (see [`SummaryBuilder::with_gravity`]).
+    gravity: Option<Box<arm_model::dynamics::Dynamics>>,
+    effort_beyond_gravity: f64,
 }
 
 impl SummaryBuilder {
@@ -213,7 +221,17 @@ impl SummaryBuilder {
             saturated: 0,
             dropped: 0,
             held: 0,
+            gravity: None,
+            effort_beyond_gravity: 0.0,
         }
+    }
+
+    /// Also integrates the effort beyond the static gravity load of
+    /// `model` (the URDF's, as the controller's designer knows it: no
+    /// payload, standard gravity) after T_c.
+    pub fn with_gravity(mut self, model: &plant_rapier::ArmModel) -> Self {
+        self.gravity = Some(Box::new(arm_model::dynamics::Dynamics::new(model, 1.0)));
+        self
     }
 
     /// Adds one step. NaN anywhere makes `finite` false and, through
@@ -239,6 +257,15 @@ impl SummaryBuilder {
         let after = r.t >= self.tc;
         self.after_tc += u64::from(after);
         self.add_baseline_metrics(r, after);
+        if let (true, Some(d)) = (after, self.gravity.as_mut()) {
+            let g = d.gravity(r.q);
+            self.effort_beyond_gravity += r
+                .tau
+                .iter()
+                .zip(g)
+                .map(|(t, g)| (t - g) * (t - g) * self.dt)
+                .sum::<f64>();
+        }
         for i in 0..self.names.len() {
             let e = (r.q[i] - r.q_d[i]).abs();
             self.max_ratio[i] = nan_max(self.max_ratio[i], r.z1g[i].abs() / r.kc[i]);
@@ -379,6 +406,10 @@ impl SummaryBuilder {
             violation_after_tc_s: self.any_violation_after,
             effort: sum(|j| j.effort_integral),
             effort_after_tc: sum(|j| j.effort_integral_after_tc),
+            effort_beyond_gravity_after_tc: self
+                .gravity
+                .as_ref()
+                .map(|_| self.effort_beyond_gravity),
             energy_after_tc: self.energy_after,
             torque_rate: sum(|j| j.torque_rate_integral),
             peak_abs_torque: joints.iter().map(|j| j.max_abs_torque).fold(0.0, nan_max),

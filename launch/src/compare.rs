@@ -17,7 +17,7 @@ pub use crate::compare_external::{ExternalRow, ExternalSpec};
 use crate::compare_scores::paired;
 pub(crate) use crate::compare_scores::row;
 pub use crate::compare_scores::{
-    BREACHES_ALLOWED, METRICS, Metric, PAIRED_METRICS, Stats, failed_because, stats_of,
+    Envelope, METRICS, Metric, PAIRED_METRICS, Stats, failed_because, holm, scored, stats_of,
 };
 use crate::sim::{self, StepCosts};
 use analysis::law_info::LawInfo;
@@ -104,9 +104,12 @@ pub struct LawRun {
     pub seed: u64,
     /// Why the run stopped early, if it did (the summary covers the steps before).
     pub failure: Option<String>,
-    /// Why the run failed, if it did ([`failed_because`]): a failed run's
-    /// metrics count as the worst, whatever their values.
+    /// Why the run failed, if it did ([`failed_because`]: it could not be
+    /// scored): a failed run's metrics count as the worst, whatever their
+    /// values.
     pub failed: Option<String>,
+    /// Whether it kept |e| < k_c after T_c, left it, or ended before T_c.
+    pub envelope: Envelope,
     /// The run's summary, as `testbed sim --law` prints it.
     pub summary: Summary,
     /// Controller compute per step, µs.
@@ -144,8 +147,14 @@ pub struct LawRow {
     pub ci95: Option<IntervalRanks>,
     /// Per metric, the worst seed's value.
     pub worst: Stats,
-    /// Seeds whose run kept |e| < k_c for every t ≥ T_c, finite.
+    /// Seeds whose run kept |e| < k_c for every t ≥ T_c ([`Envelope`]).
     pub kept_envelope: u64,
+    /// Seeds whose run left it after T_c.
+    pub left_envelope: u64,
+    /// Seeds whose run ended before T_c.
+    pub not_judged: u64,
+    /// Seeds whose run failed ([`failed_because`]).
+    pub failed: u64,
 }
 
 /// The whole comparison.
@@ -172,12 +181,18 @@ pub struct Comparison {
     pub paired: Vec<Paired>,
     /// What this says about the paper's claims ([`crate::compare_findings`]).
     pub findings: Vec<crate::compare_findings::Finding>,
+    /// What limits what the seeds say: identical seeds (nothing random),
+    /// or one draw of random effects.
+    pub warnings: Vec<String>,
+    /// The scenario's random effects (empty: a deterministic scenario).
+    pub random_effects: Vec<String>,
 }
 
 /// A paired test of the first law against another on one metric.
 #[derive(Debug, Clone, Serialize)]
 pub struct Paired {
-    /// The first row of the comparison (`nac` by default).
+    /// The baseline: `nac` when it runs, else the first row, whatever the
+    /// rows' order.
     pub law: String,
     /// The row it is tested against.
     pub versus: String,
@@ -186,6 +201,9 @@ pub struct Paired {
     /// Wilcoxon signed-rank of law − versus, seed by seed: `a_smaller` is
     /// the seeds where `law` did better.
     pub test: SignedRank,
+    /// The test's p-value Holm-corrected over every paired test of the
+    /// comparison (what the findings use).
+    pub p_holm: f64,
 }
 
 /// Which order statistics bound the 95 % interval of the median, and its
@@ -298,7 +316,22 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
         b.finish_and_clear();
     }
     let wall_time_s = start.elapsed().as_secs_f64();
-    let paired = paired(&laws);
+    let random = random_effects(plan);
+    let mut warnings = Vec::new();
+    let identical = opts.seeds > 1 && crate::compare_scores::identical_seeds(&laws);
+    if identical {
+        warnings.push(format!(
+            "the {} seeds gave identical runs (the scenario has nothing random): they are one run, and no paired test is made",
+            opts.seeds
+        ));
+    }
+    if opts.seeds == 1 && !random.is_empty() {
+        warnings.push(format!(
+            "one seed of random effects ({}): one draw, so no difference between laws is reported (use --seeds 5 or more)",
+            random.join(", ")
+        ));
+    }
+    let paired = if identical { Vec::new() } else { paired(&laws) };
     let mut c = Comparison {
         scenario: plan.scenario.name.clone(),
         scenario_source: plan.source.clone(),
@@ -310,9 +343,31 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
         laws,
         paired,
         findings: Vec::new(),
+        warnings,
+        random_effects: random,
     };
     c.findings = crate::compare_findings::findings(&c);
     Ok(c)
+}
+
+/// What a seed changes in `plan` besides nothing: its `[randomise]` table
+/// and the plant's random effects (noise, lost commands).
+pub fn random_effects(plan: &Plan) -> Vec<String> {
+    let s = &plan.undrawn;
+    let p = &s.plant;
+    [
+        (!s.randomise.is_empty(), "a [randomise] table"),
+        (
+            !(p.sensor.q_noise_std.is_zero() && p.sensor.qd_noise_std.is_zero()),
+            "sensor noise",
+        ),
+        (!p.disturbance.noise_std.is_zero(), "disturbance noise"),
+        (p.actuation.drop_probability > 0.0, "dropped commands"),
+    ]
+    .into_iter()
+    .filter(|(on, _)| *on)
+    .map(|(_, what)| what.to_string())
+    .collect()
 }
 
 /// One in-process run, exactly as `testbed sim` makes it.
@@ -330,7 +385,8 @@ pub fn run_until(plan: &Plan, stop: &AtomicBool) -> Option<LawRun> {
 fn run_inner(plan: &Plan, keep_series: bool, stop: &AtomicBool) -> (LawRun, bool) {
     let names = plan.robot.model.joint_names();
     let n = names.len();
-    let mut summary = SummaryBuilder::new(names, plan.dt(), plan.scenario.controller.tc);
+    let mut summary = SummaryBuilder::new(names, plan.dt(), plan.scenario.controller.tc)
+        .with_gravity(&plan.robot.model);
     let mut series = keep_series.then(|| LawSeries {
         e: vec![Vec::new(); n],
         kc: vec![Vec::new(); n],
@@ -355,15 +411,13 @@ fn run_inner(plan: &Plan, keep_series: bool, stop: &AtomicBool) -> (LawRun, bool
         Ok(())
     });
     let failure = result.err().map(|e| e.to_string());
-    let summary = summary.finish();
-    let run = LawRun {
-        seed: plan.scenario.seed,
-        failed: failed_because(failure.as_deref(), &summary),
+    let run = scored(
+        plan.scenario.seed,
         failure,
-        summary,
-        compute_us: costs.controller_us.finish(),
+        summary.finish(),
+        costs.controller_us.finish(),
         series,
-    };
+    );
     (run, stop.load(Ordering::Relaxed))
 }
 

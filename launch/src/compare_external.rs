@@ -9,7 +9,7 @@ use analysis::timing::Percentiles;
 use scenario::Plan;
 use serde::Serialize;
 
-use crate::compare::{CompareError, CompareOptions, LawRow, LawRun, failed_because, plan_for, row};
+use crate::compare::{CompareError, CompareOptions, LawRow, plan_for, row, scored};
 
 /// A user's controller in the table: its row's label and its command.
 #[derive(Debug, Clone, PartialEq)]
@@ -72,28 +72,25 @@ pub(crate) fn external_row(
                     // Per run, not per law: in each run's own summary.
                     diagnostics: Vec::new(),
                 });
-                let summary = o.analysis.summary;
-                LawRun {
+                scored(
                     seed,
-                    failed: failed_because(None, &summary),
-                    failure: None,
-                    summary,
-                    compute_us: o.analysis.timing.controller_compute_us,
-                    series: None,
-                }
+                    None,
+                    o.analysis.summary,
+                    o.analysis.timing.controller_compute_us,
+                    None,
+                )
             }
             Err(e) => {
                 let why = format!("the run failed: {e}");
                 let names = plan.robot.model.joint_names();
                 let empty = SummaryBuilder::new(names, plan.dt(), plan.scenario.controller.tc);
-                LawRun {
+                scored(
                     seed,
-                    failed: Some(why.clone()),
-                    failure: Some(why),
-                    summary: empty.finish(),
-                    compute_us: Percentiles::of(Vec::new()),
-                    series: None,
-                }
+                    Some(why),
+                    empty.finish(),
+                    Percentiles::of(Vec::new()),
+                    None,
+                )
             }
         });
     }

@@ -1,29 +1,42 @@
 //! What a comparison says about the paper's claims, with the numbers, by
-//! stated rules (so that a reader can check each verdict):
+//! stated rules (so that a reader can check each verdict). The facts they
+//! rest on are the same for every law ([`crate::compare_scores`]): a run
+//! *failed* when it could not be scored (stopped, non-finite, faults); it
+//! *kept* the envelope when |e| < k_c at every t ≥ T_c, *left* it
+//! otherwise, and is *not judged* when it ended before T_c.
 //!
-//! 1. *Inside the envelope after T_c*: holds when every `nac` run kept
-//!    |e| < k_c for every t ≥ T_c and none failed.
+//! 1. *Inside the envelope after T_c*: holds when every `nac` run was
+//!    judged, kept the envelope and did not fail; not judged when no run
+//!    reached T_c. The evidence counts every other law's runs by the same
+//!    rule.
 //! 2. *Starting outside*: tested when some `nac` run was outside the
-//!    envelope before T_c (violation before T_c > 0); holds when every
-//!    such run was inside for good by T_c and did not fail.
-//! 3. *Energy after T_c*: `nac`'s median effort ∫τ² after T_c against
-//!    `pd`'s and `blf`'s, and its mechanical energy ∫|τ q̇| against `pd`'s: holds against a law when it is lower by at least
-//!    [`MATTERS`] (or the other's median failed and `nac`'s did not) and,
-//!    with two seeds or more, the paired test agrees (p < [`ALPHA`], `nac`
-//!    better on more seeds).
-//! 4. *What the actor–critic adds*: `nac` against `nac-no-networks` on
-//!    IAE after T_c, by the same rule.
+//!    envelope before T_c; holds when every such run was inside for good by
+//!    T_c and did not fail.
+//! 3. *Keeping it where another law does not* (against each law without a
+//!    barrier that runs: `pd`, `pd-gravity`, `ctc`), seed by seed: holds
+//!    when on some seed `nac` kept the envelope and the other left it, and
+//!    on none the reverse; does not hold when on some seed the other kept it
+//!    and `nac` left it; not tested when no seed separates them.
+//! 4. *Effort after T_c*: `nac`'s median effort beyond the gravity hold,
+//!    ∫(τ − G(q))², against `pd`'s and `blf`'s, and its mechanical energy
+//!    ∫|τ q̇| against `pd`'s; *what the actor–critic adds*: `nac` against
+//!    `nac-no-networks` on IAE after T_c. Each holds when `nac` is lower by
+//!    at least [`MATTERS`] (or the other's median failed and `nac`'s did
+//!    not) and, over two or more seeds that differ, the paired test agrees
+//!    (Holm-corrected p < [`ALPHA`], `nac` better on more seeds). With one
+//!    seed of a scenario with random effects these are not tested: one draw
+//!    says nothing about a difference.
 //!
 //! A claim whose law is not in the comparison is "not tested".
 
 use controller::LawName;
 use serde::Serialize;
 
-use crate::compare::{Comparison, LawRow, Paired};
+use crate::compare::{Comparison, Envelope, LawRow, Paired};
 
 /// A relative difference smaller than this is "no difference".
 pub const MATTERS: f64 = 0.01;
-/// The paired test's level.
+/// The paired test's level (on Holm-corrected p-values).
 pub const ALPHA: f64 = 0.05;
 
 /// A claim's verdict.
@@ -36,6 +49,8 @@ pub enum Verdict {
     DoesNotHold,
     /// The comparison lacks a law or a situation the claim needs.
     NotTested,
+    /// Every run ended before T_c: the constraint was never in force.
+    NotJudged,
 }
 
 impl std::fmt::Display for Verdict {
@@ -44,6 +59,7 @@ impl std::fmt::Display for Verdict {
             Self::Holds => "holds",
             Self::DoesNotHold => "does not hold",
             Self::NotTested => "not tested",
+            Self::NotJudged => "not judged",
         })
     }
 }
@@ -69,19 +85,23 @@ pub fn findings(c: &Comparison) -> Vec<Finding> {
         };
         return CLAIMS.iter().map(|c| none(c)).collect();
     };
-    let mut out = vec![inside(nac), outside(c, nac)];
-    for other in [LawName::Pd, LawName::Blf] {
-        out.push(better(c, nac, other, "effort_after_tc", CLAIMS[2]));
+    let mut out = vec![inside(c, nac), outside(c, nac)];
+    for other in [LawName::Pd, LawName::PdGravity, LawName::Ctc] {
+        out.push(separates(c, nac, other));
     }
-    out.push(better(c, nac, LawName::NacNoNetworks, "iae", CLAIMS[3]));
-    out.push(better(c, nac, LawName::Pd, "energy_after_tc", CLAIMS[2]));
+    for other in [LawName::Pd, LawName::Blf] {
+        out.push(better(c, nac, other, "effort_beyond_gravity", CLAIMS[3]));
+    }
+    out.push(better(c, nac, LawName::Pd, "energy_after_tc", CLAIMS[3]));
+    out.push(better(c, nac, LawName::NacNoNetworks, "iae", CLAIMS[4]));
     out
 }
 
-const CLAIMS: [&str; 4] = [
+const CLAIMS: [&str; 5] = [
     "nac keeps |e| < k_c after T_c",
     "nac may start outside the envelope and is inside by T_c",
-    "nac uses less energy after T_c",
+    "nac keeps the envelope on seeds where a law without a barrier leaves it",
+    "nac uses less effort after T_c",
     "the actor-critic lowers the error after T_c",
 ];
 
@@ -91,24 +111,56 @@ fn row(c: &Comparison, law: LawName) -> Option<&LawRow> {
         .find(|r| r.law.law == law && r.external.is_none())
 }
 
-fn inside(nac: &LawRow) -> Finding {
-    let n = nac.runs.len();
-    let failed = nac.runs.iter().filter(|r| r.failed.is_some()).count();
-    let ok = nac.kept_envelope as usize == n && failed == 0;
-    Finding {
-        claim: CLAIMS[0].into(),
-        verdict: if ok {
-            Verdict::Holds
-        } else {
-            Verdict::DoesNotHold
-        },
-        evidence: format!(
-            "kept on {} of {n} seeds ({failed} failed); median min margin k_c - |e| after T_c {}, median max |e| {}",
-            nac.kept_envelope,
+/// "kept K, left L, not judged J, failed F of N".
+fn counts(r: &LawRow) -> String {
+    format!(
+        "kept {}, left {}, not judged {}, failed {} of {}",
+        r.kept_envelope,
+        r.left_envelope,
+        r.not_judged,
+        r.failed,
+        r.runs.len()
+    )
+}
+
+fn inside(c: &Comparison, nac: &LawRow) -> Finding {
+    let n = nac.runs.len() as u64;
+    let verdict = if nac.not_judged == n {
+        Verdict::NotJudged
+    } else if nac.kept_envelope == n && nac.failed == 0 {
+        Verdict::Holds
+    } else {
+        Verdict::DoesNotHold
+    };
+    let others: Vec<String> = c
+        .laws
+        .iter()
+        .filter(|r| !std::ptr::eq(*r, nac))
+        .map(|r| format!("{}: {}", r.name, counts(r)))
+        .collect();
+    let margin = if nac.kept_envelope + nac.left_envelope > 0 {
+        format!(
+            "; median min margin k_c - |e| after T_c {}, median max |e| {}",
             num(nac.median.get("min_margin")),
             num(nac.median.get("max_abs_error")),
-        ),
+        )
+    } else {
+        format!("; every run ended before T_c = {} s", tc(nac))
+    };
+    let others = if others.is_empty() {
+        String::new()
+    } else {
+        format!("; by the same rule, {}", others.join("; "))
+    };
+    Finding {
+        claim: CLAIMS[0].into(),
+        verdict,
+        evidence: format!("nac: {}{margin}{others}", counts(nac)),
     }
+}
+
+fn tc(r: &LawRow) -> f64 {
+    r.runs.first().map_or(f64::NAN, |x| x.summary.tc_s)
 }
 
 fn outside(c: &Comparison, nac: &LawRow) -> Finding {
@@ -120,7 +172,7 @@ fn outside(c: &Comparison, nac: &LawRow) -> Finding {
             m.violation_s - m.violation_after_tc_s > 0.0
         })
         .collect();
-    let tc = nac.runs.first().map_or(f64::NAN, |r| r.summary.tc_s);
+    let tc = tc(nac);
     let entered = early
         .iter()
         .filter(|r| r.failed.is_none())
@@ -132,16 +184,20 @@ fn outside(c: &Comparison, nac: &LawRow) -> Finding {
         })
         .count();
     let shift = row(c, LawName::NacNoShift).map_or(String::new(), |r| {
-        let failed = r.runs.iter().filter(|x| x.failed.is_some()).count();
-        let mut breaches: Vec<u64> = r.runs.iter().map(|x| x.summary.barrier_breached_steps).collect();
+        let mut breaches: Vec<u64> = r
+            .runs
+            .iter()
+            .map(|x| x.summary.barrier_breached_steps)
+            .collect();
         breaches.sort_unstable();
         format!(
-            "; with the constraint on from t = 0 (nac-no-shift): median {} barrier breaches, {failed} of {} seeds failed",
+            "; with the constraint on from t = 0 (nac-no-shift): median {} barrier breaches, {}",
             breaches.get(breaches.len() / 2).copied().unwrap_or(0),
-            r.runs.len()
+            counts(r)
         )
     });
     let verdict = match (early.len(), entered == early.len()) {
+        _ if nac.not_judged == nac.runs.len() as u64 => Verdict::NotJudged,
         (0, _) => Verdict::NotTested,
         (_, true) => Verdict::Holds,
         (_, false) => Verdict::DoesNotHold,
@@ -158,8 +214,43 @@ fn outside(c: &Comparison, nac: &LawRow) -> Finding {
     }
 }
 
+/// `nac` against `other`, seed by seed, on keeping the envelope (claim 3).
+fn separates(c: &Comparison, nac: &LawRow, other: LawName) -> Finding {
+    let claim = format!("{} (vs {other})", CLAIMS[2]);
+    let Some(o) = row(c, other) else {
+        return Finding {
+            claim,
+            verdict: Verdict::NotTested,
+            evidence: format!("{other} is not in the comparison"),
+        };
+    };
+    let pairs = nac.runs.iter().zip(&o.runs);
+    let nac_only = pairs
+        .clone()
+        .filter(|(a, b)| a.envelope == Envelope::Kept && b.envelope == Envelope::Left)
+        .count();
+    let other_only = pairs
+        .filter(|(a, b)| a.envelope == Envelope::Left && b.envelope == Envelope::Kept)
+        .count();
+    let verdict = match (nac_only, other_only) {
+        _ if nac.not_judged == nac.runs.len() as u64 => Verdict::NotJudged,
+        (_, 1..) => Verdict::DoesNotHold,
+        (1.., 0) => Verdict::Holds,
+        (0, 0) => Verdict::NotTested,
+    };
+    Finding {
+        claim,
+        verdict,
+        evidence: format!(
+            "nac kept it and {other} left it on {nac_only} seeds, the reverse on {other_only}; nac: {}; {other}: {}",
+            counts(nac),
+            counts(o)
+        ),
+    }
+}
+
 /// `nac` against `other` on `metric` (smaller is better), by the rule of
-/// the module's claims 3 and 4.
+/// the module's claim 4.
 fn better(c: &Comparison, nac: &LawRow, other: LawName, metric: &str, claim: &str) -> Finding {
     let claim = format!("{claim} (vs {other}, {metric})");
     let Some(o) = row(c, other) else {
@@ -169,13 +260,49 @@ fn better(c: &Comparison, nac: &LawRow, other: LawName, metric: &str, claim: &st
             evidence: format!("{other} is not in the comparison"),
         };
     };
+    if nac.not_judged == nac.runs.len() as u64 {
+        return Finding {
+            claim,
+            verdict: Verdict::NotJudged,
+            evidence: format!("every run ended before T_c = {} s", tc(nac)),
+        };
+    }
     let (a, b) = (
         nac.median.get(metric).unwrap_or(f64::NAN),
         o.median.get(metric).unwrap_or(f64::NAN),
     );
     let rel = (a - b) / b.abs();
+    let medians = format!(
+        "median nac {} vs {other} {} ({})",
+        num(Some(a)),
+        num(Some(b)),
+        if rel.is_finite() {
+            format!("{:+.2} %", 100.0 * rel)
+        } else {
+            "a failed median".into()
+        }
+    );
+    let raw = if metric == "effort_beyond_gravity" {
+        format!(
+            "; raw ∫τ² after T_c: nac {} vs {other} {}",
+            num(nac.median.get("effort_after_tc")),
+            num(o.median.get("effort_after_tc"))
+        )
+    } else {
+        String::new()
+    };
+    if c.seeds == 1 && !c.random_effects.is_empty() {
+        return Finding {
+            claim,
+            verdict: Verdict::NotTested,
+            evidence: format!(
+                "{medians}{raw}; one draw of random effects ({}): no difference is reported from one seed",
+                c.random_effects.join(", ")
+            ),
+        };
+    }
     let test = paired(c, other, metric);
-    let agrees = test.is_none_or(|p| p.test.p_value < ALPHA && p.test.a_smaller > p.test.b_smaller);
+    let agrees = test.is_none_or(|p| p.p_holm < ALPHA && p.test.a_smaller > p.test.b_smaller);
     // A failed median is the worst value: below it is lower.
     let lower = a.is_finite() && (!b.is_finite() || rel <= -MATTERS);
     let verdict = match (lower && agrees, a.is_finite() || b.is_finite()) {
@@ -183,25 +310,21 @@ fn better(c: &Comparison, nac: &LawRow, other: LawName, metric: &str, claim: &st
         (false, true) => Verdict::DoesNotHold,
         (false, false) => Verdict::NotTested,
     };
-    let p = test.map_or(String::from("one seed, no paired test"), |p| {
-        format!(
-            "nac better on {} of {} seeds, worse on {}, Wilcoxon p = {:.2e}",
-            p.test.a_smaller, p.test.pairs, p.test.b_smaller, p.test.p_value
-        )
-    });
+    let p = match test {
+        Some(p) => format!(
+            "nac better on {} of {} seeds, worse on {}, Wilcoxon p = {:.2e} (Holm {:.2e})",
+            p.test.a_smaller, p.test.pairs, p.test.b_smaller, p.test.p_value, p.p_holm
+        ),
+        None if c.seeds > 1 => format!(
+            "{} identical seeds (nothing random): one run, no paired test",
+            c.seeds
+        ),
+        None => "one seed, no paired test".into(),
+    };
     Finding {
         claim,
         verdict,
-        evidence: format!(
-            "median nac {} vs {other} {} ({}); {p}",
-            num(Some(a)),
-            num(Some(b)),
-            if rel.is_finite() {
-                format!("{:+.2} %", 100.0 * rel)
-            } else {
-                "a failed median".into()
-            }
-        ),
+        evidence: format!("{medians}{raw}; {p}"),
     }
 }
 
@@ -250,15 +373,46 @@ mod tests {
     fn the_paper_scenario_starts_outside_and_keeps_the_envelope() {
         let c = run(vec![LawName::Nac, LawName::Pd]);
         let f = findings(&c);
-        assert_eq!(f.len(), 6);
-        assert!(f[5].claim.contains("energy_after_tc"), "{:?}", f[5]);
+        assert_eq!(f.len(), 9);
+        assert!(f[7].claim.contains("energy_after_tc"), "{:?}", f[7]);
         assert_eq!(f[0].verdict, Verdict::Holds, "{:?}", f[0]);
+        assert!(f[0].evidence.contains("pd: kept 1, left 0"), "{:?}", f[0]);
         assert_eq!(f[1].verdict, Verdict::Holds, "{:?}", f[1]);
         assert!(f[1].evidence.contains("outside before T_c = 2 s on 1 of 1"));
-        // blf and nac-no-networks were not run.
-        assert_eq!(f[3].verdict, Verdict::NotTested);
-        assert_eq!(f[4].verdict, Verdict::NotTested);
-        assert!(f[2].evidence.contains("vs pd"), "{:?}", f[2]);
+        // Both keep it: no seed separates them.
+        assert_eq!(f[2].verdict, Verdict::NotTested, "{:?}", f[2]);
+        // pd-gravity, ctc, blf and nac-no-networks were not run.
+        for k in [3, 4, 6, 8] {
+            assert_eq!(f[k].verdict, Verdict::NotTested, "{:?}", f[k]);
+        }
+        assert!(f[5].evidence.contains("vs pd"), "{:?}", f[5]);
+        assert!(f[5].evidence.contains("raw ∫τ² after T_c"), "{:?}", f[5]);
+    }
+
+    #[test]
+    fn runs_shorter_than_tc_are_not_judged() {
+        let plan = scenario::load(
+            None,
+            &scenario::Overrides {
+                duration_s: Some(1.0),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let opts = CompareOptions {
+            external: Vec::new(),
+            runs_dir: std::path::PathBuf::from("runs"),
+            progress: false,
+            laws: vec![LawName::Nac, LawName::Pd],
+            seeds: 1,
+            threads: Some(1),
+            series: false,
+            tuning: None,
+        };
+        let f = findings(&compare(&plan, &opts).unwrap());
+        for k in [0, 1, 2, 5, 7] {
+            assert_eq!(f[k].verdict, Verdict::NotJudged, "{:?}", f[k]);
+        }
     }
 
     #[test]

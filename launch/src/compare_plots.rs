@@ -221,8 +221,9 @@ fn bar_panel<DB: DrawingBackend>(
 }
 
 /// Writes `compare_tradeoff` (PNG and SVG): IAE after T_c against effort
-/// after T_c, log-log, one polyline per law through its gain scales;
-/// filled markers are the law's Pareto front, failed scales are left out
+/// beyond the gravity hold after T_c, log-log, one polyline per law through
+/// its gain scales; filled markers are the law's Pareto front, a cross over
+/// a marker a point whose torques saturated, failed scales are left out
 /// and counted in the legend.
 pub fn write_tradeoff(
     dir: &Path,
@@ -257,7 +258,7 @@ fn draw_tradeoff<DB: DrawingBackend>(
     root.fill(&WHITE).map_err(err)?;
     let scales: Vec<String> = t.scales.iter().map(|s| format!("{s}")).collect();
     let title = format!(
-        "Trade-off per law ({scenario}): K1, K2 times {} (filled: the law's Pareto front)",
+        "Trade-off per law ({scenario}): K1, K2 times {} (filled: the law's Pareto front; ×: saturated)",
         scales.join(", ")
     );
     let root = root.titled(&title, (FAMILY, 18)).map_err(err)?;
@@ -266,7 +267,7 @@ fn draw_tradeoff<DB: DrawingBackend>(
         &left,
         t,
         (|p: &P| p.effort, |p: &P| p.on_front),
-        "effort ∫τ² dt after T_c [N² m² s]",
+        "effort beyond gravity ∫(τ − G(q))² dt after T_c [N² m² s]",
     )?;
     tradeoff_panel(
         &right,
@@ -345,6 +346,14 @@ fn tradeoff_panel<DB: DrawingBackend>(
                 };
                 Some(Circle::new(xy(p)?, 5, style))
             }))
+            .map_err(err)?;
+        // Saturated points: limited by the motors, not by the gains.
+        chart
+            .draw_series(
+                mine.iter()
+                    .filter(|p| p.saturated_s > 0.0)
+                    .filter_map(|p| Some(Cross::new(xy(p)?, 9, BLACK.stroke_width(2)))),
+            )
             .map_err(err)?;
     }
     chart

@@ -1,7 +1,12 @@
 //! How `testbed compare` scores a law: the metrics of BASELINES.md and
-//! which way each is worse, why a run failed (a failed run scores as the
-//! worst, never the best), a law's row over its seeds (median, IQR, 95 %
-//! interval, worst) and the paired test of the first law against each other.
+//! which way each is worse; three facts about each run, by one rule for
+//! every law: whether it failed (could not be scored: it stopped early,
+//! went non-finite or faulted; a failed run scores as the worst, never the
+//! best), whether it kept |e| < k_c after T_c (kept, left, or not judged
+//! when it ended before T_c), and how often the law's guard acted
+//! (breaches, a metric); a law's row over its seeds (median, IQR, 95 %
+//! interval, worst); and the paired tests of a baseline (nac when it runs,
+//! else the first law) against each other law, Holm-corrected.
 
 use analysis::law_info::LawInfo;
 use analysis::stats::{median_interval, quantile, signed_rank};
@@ -10,9 +15,14 @@ use serde::Serialize;
 
 use crate::compare::{IntervalRanks, LawRow, LawRun, Paired};
 
-/// The metrics of the paired tests: error, peak error, effort, energy.
-pub const PAIRED_METRICS: [&str; 4] =
-    ["iae", "max_abs_error", "effort_after_tc", "energy_after_tc"];
+/// The metrics of the paired tests: error, peak error, effort beyond the
+/// gravity hold, energy.
+pub const PAIRED_METRICS: [&str; 4] = [
+    "iae",
+    "max_abs_error",
+    "effort_beyond_gravity",
+    "energy_after_tc",
+];
 
 /// One value per metric of [`METRICS`], in order (JSON: an object; an
 /// infinite value, i.e. a missing one counted as the worst, is null).
@@ -72,6 +82,9 @@ pub const METRICS: &[Metric] = &[
     m("effort_after_tc", "N² m² s", true, |r| {
         Some(r.summary.metrics.effort_after_tc)
     }),
+    m("effort_beyond_gravity", "N² m² s", true, |r| {
+        r.summary.metrics.effort_beyond_gravity_after_tc
+    }),
     m("energy_after_tc", "J", true, |r| {
         Some(r.summary.metrics.energy_after_tc)
     }),
@@ -126,14 +139,11 @@ fn value(metric: &Metric, run: &LawRun) -> f64 {
     (metric.get)(run).filter(|x| !x.is_nan()).unwrap_or(bad)
 }
 
-/// Barrier breaches a run may have and still count: a few steps of the
-/// guard acting are the law at work; more is a law fighting its barrier.
-pub const BREACHES_ALLOWED: u64 = 100;
-
-/// Why a run failed, if it did: it stopped early, went non-finite or
-/// faulted, breached its barrier more than [`BREACHES_ALLOWED`] steps, or
-/// left the envelope after T_c. (A run that ends before T_c is not judged
-/// on the constraint.)
+/// Why a run failed, if it did: it could not be scored, because it
+/// stopped early, or went non-finite, or the law faulted (published zero
+/// torque). The same rule for every law: guard breaches and leaving the
+/// envelope are facts of their own ([`Envelope`], the `breaches` metric),
+/// never a failure.
 pub fn failed_because(failure: Option<&str>, s: &Summary) -> Option<String> {
     let mut why = Vec::new();
     if let Some(f) = failure {
@@ -145,14 +155,61 @@ pub fn failed_because(failure: Option<&str>, s: &Summary) -> Option<String> {
             s.fault_steps
         ));
     }
-    if s.barrier_breached_steps > BREACHES_ALLOWED {
-        why.push(format!("{} barrier breaches", s.barrier_breached_steps));
-    }
-    let judged = s.joints.iter().any(|j| j.min_margin_after_tc.is_some());
-    if judged && !s.constraint_satisfied_after_tc {
-        why.push("left the envelope after T_c".into());
-    }
     (!why.is_empty()).then(|| why.join("; "))
+}
+
+/// Whether a run kept |e_i| < k_c,i for every joint and every t ≥ T_c.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Envelope {
+    /// Inside at every step from T_c on.
+    Kept,
+    /// At or outside it at some step from T_c on (a non-finite error counts
+    /// as outside).
+    Left,
+    /// The run ended before T_c: nothing to judge.
+    NotJudged,
+}
+
+impl Envelope {
+    /// The run's envelope fact, from its summary.
+    pub fn of(s: &Summary) -> Self {
+        let judged = s.joints.iter().any(|j| j.min_margin_after_tc.is_some());
+        match (judged, s.constraint_satisfied_after_tc) {
+            (false, _) => Self::NotJudged,
+            (true, true) => Self::Kept,
+            (true, false) => Self::Left,
+        }
+    }
+
+    /// As the table and the CSV write it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Kept => "kept",
+            Self::Left => "left",
+            Self::NotJudged => "not-judged",
+        }
+    }
+}
+
+/// A run scored: its failure (if any) and its envelope fact, from its
+/// summary.
+pub fn scored(
+    seed: u64,
+    failure: Option<String>,
+    summary: Summary,
+    compute_us: analysis::timing::Percentiles,
+    series: Option<crate::compare::LawSeries>,
+) -> LawRun {
+    LawRun {
+        seed,
+        failed: failed_because(failure.as_deref(), &summary),
+        envelope: Envelope::of(&summary),
+        failure,
+        summary,
+        compute_us,
+        series,
+    }
 }
 
 pub(crate) fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
@@ -181,11 +238,13 @@ pub(crate) fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
             r.push((metric.name, x));
         }
     }
-    let kept = runs
-        .iter()
-        .filter(|r| r.failed.is_none())
-        .filter(|r| r.summary.constraint_satisfied_after_tc)
-        .count() as u64;
+    let count = |e: Envelope| runs.iter().filter(|r| r.envelope == e).count() as u64;
+    let (kept, left, not_judged) = (
+        count(Envelope::Kept),
+        count(Envelope::Left),
+        count(Envelope::NotJudged),
+    );
+    let failed = runs.iter().filter(|r| r.failed.is_some()).count() as u64;
     let [median, q1, q3, ci95_low, ci95_high, worst] = rows.map(Stats);
     LawRow {
         name: law.law.to_string(),
@@ -200,15 +259,28 @@ pub(crate) fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
         ci95,
         worst,
         kept_envelope: kept,
+        left_envelope: left,
+        not_judged,
+        failed,
     }
 }
 
-/// The first law against every other, per [`PAIRED_METRICS`], seed by
-/// seed (seeds are the same runs' draws for every law).
+/// The row the paired tests compare every other law with: `nac` (the
+/// testbed's own) when it runs, else the first row.
+pub(crate) fn baseline(laws: &[LawRow]) -> Option<usize> {
+    laws.iter()
+        .position(|r| r.law.law == controller::LawName::Nac && r.external.is_none())
+        .or((!laws.is_empty()).then_some(0))
+}
+
+/// The baseline against every other law, per [`PAIRED_METRICS`], seed by
+/// seed (seeds are the same runs' draws for every law), with the p-values
+/// Holm-corrected over all of them.
 pub(crate) fn paired(laws: &[LawRow]) -> Vec<Paired> {
-    let Some((first, others)) = laws.split_first() else {
+    let Some(b) = baseline(laws) else {
         return Vec::new();
     };
+    let first = &laws[b];
     if first.runs.len() < 2 {
         return Vec::new();
     }
@@ -219,17 +291,60 @@ pub(crate) fn paired(laws: &[LawRow]) -> Vec<Paired> {
             .map(|r| metric.map_or(f64::NAN, |m| value(m, r)))
             .collect()
     };
-    others
+    let mut tests: Vec<Paired> = laws
         .iter()
-        .flat_map(|other| {
-            PAIRED_METRICS.iter().map(move |&metric| Paired {
-                law: first.name.clone(),
-                versus: other.name.clone(),
-                metric,
-                test: signed_rank(&values(first, metric), &values(other, metric)),
+        .enumerate()
+        .filter(|(k, _)| *k != b)
+        .flat_map(|(_, other)| {
+            PAIRED_METRICS.iter().map(move |&metric| {
+                let test = signed_rank(&values(first, metric), &values(other, metric));
+                Paired {
+                    law: first.name.clone(),
+                    versus: other.name.clone(),
+                    metric,
+                    p_holm: test.p_value,
+                    test,
+                }
             })
         })
-        .collect()
+        .collect();
+    let adjusted = holm(&tests.iter().map(|t| t.test.p_value).collect::<Vec<_>>());
+    for (t, p) in tests.iter_mut().zip(adjusted) {
+        t.p_holm = p;
+    }
+    tests
+}
+
+/// Holm's step-down correction of `p` (family-wise error over all of
+/// them): the k-th smallest becomes max over j ≤ k of min(1, (m − j + 1) p_(j)).
+pub fn holm(p: &[f64]) -> Vec<f64> {
+    let m = p.len();
+    let mut order: Vec<usize> = (0..m).collect();
+    order.sort_by(|&a, &b| p[a].total_cmp(&p[b]));
+    let mut out = vec![f64::NAN; m];
+    let mut running = 0.0_f64;
+    for (j, &i) in order.iter().enumerate() {
+        running = running.max(((m - j) as f64 * p[i]).min(1.0));
+        out[i] = running;
+    }
+    out
+}
+
+/// Whether every seed gave the same run for every law (a scenario with
+/// nothing random): then N seeds are one run, and no test is made. Compute
+/// times, which are this machine's, are left out.
+pub(crate) fn identical_seeds(laws: &[LawRow]) -> bool {
+    let same = |a: &LawRun, b: &LawRun| {
+        let (a, b) = (stats_of(a), stats_of(b));
+        a.0.iter()
+            .zip(&b.0)
+            .filter(|((k, _), _)| !k.starts_with("compute_"))
+            .all(|((_, x), (_, y))| x.to_bits() == y.to_bits())
+    };
+    laws.iter().all(|row| match row.runs.split_first() {
+        Some((first, rest)) => !rest.is_empty() && rest.iter().all(|r| same(first, r)),
+        None => false,
+    })
 }
 
 /// The median of sorted values (mean of the middle two for an even count).
@@ -247,6 +362,18 @@ fn median_of(v: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn holm_scales_by_rank_and_stays_monotone() {
+        let p = holm(&[0.01, 0.04, 0.03, 0.005]);
+        // Sorted 0.005, 0.01, 0.03, 0.04 times 4, 3, 2, 1: 0.02, 0.03, 0.06, 0.06.
+        let want = [0.03, 0.06, 0.06, 0.02];
+        for (a, b) in p.iter().zip(want) {
+            assert!((a - b).abs() < 1e-12, "{p:?}");
+        }
+        assert_eq!(holm(&[0.9, 0.8]), vec![1.0, 1.0]);
+        assert!(holm(&[]).is_empty());
+    }
 
     #[test]
     fn median_and_worst_treat_missing_values_as_worst() {

@@ -1,5 +1,6 @@
 //! `compare --gain-scales`: every law over a range of gain scales, as
-//! tracking error (IAE after T_c) against effort (∫τ² after T_c) and
+//! tracking error (IAE after T_c) against effort beyond the gravity hold
+//! (∫(τ − G(q))² after T_c; ∫τ² is mostly that hold) and
 //! against mechanical energy (∫|τ q̇| after T_c), so that a reader sees each
 //! law's whole trade-off, not one tuning's point.
 //!
@@ -21,8 +22,14 @@ pub struct TradeoffPoint {
     pub scale: f64,
     /// Median IAE after T_c (sum over joints), rad s; null if failed.
     pub iae: Option<f64>,
-    /// Median effort ∫τ² dt after T_c, N² m² s; null if failed.
+    /// Median effort beyond the gravity hold, ∫(τ − G(q))² dt after T_c,
+    /// N² m² s; null if failed.
     pub effort: Option<f64>,
+    /// Median raw effort ∫τ² dt after T_c, N² m² s; null if failed.
+    pub effort_raw: Option<f64>,
+    /// Median time some torque was clipped at its limit, s: a point
+    /// with saturation is limited by the motors, not by its gains.
+    pub saturated_s: f64,
     /// Median mechanical energy ∫|τ q̇| dt after T_c, J; null if failed.
     pub energy: Option<f64>,
     /// Seeds whose run failed.
@@ -119,7 +126,9 @@ fn point(law: controller::LawName, scale: f64, row: &compare::LawRow) -> Tradeof
         law,
         scale,
         iae: finite(row.median.get("iae")),
-        effort: finite(row.median.get("effort_after_tc")),
+        effort: finite(row.median.get("effort_beyond_gravity")),
+        effort_raw: finite(row.median.get("effort_after_tc")),
+        saturated_s: row.median.get("saturated_s").unwrap_or(f64::NAN),
         energy: finite(row.median.get("energy_after_tc")),
         failed: row.runs.iter().filter(|r| r.failed.is_some()).count() as u64,
         on_front: false,
@@ -165,6 +174,8 @@ mod tests {
             scale: 1.0,
             iae: Some(iae),
             effort: Some(effort),
+            effort_raw: Some(effort),
+            saturated_s: 0.0,
             energy: Some(1.0 / effort),
             failed: 0,
             on_front: false,

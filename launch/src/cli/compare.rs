@@ -126,6 +126,9 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     for f in &failed {
         eprintln!("testbed: warning: {f}");
     }
+    for w in &result.warnings {
+        eprintln!("testbed: warning: {w}");
+    }
     Ok(ExitCode::SUCCESS)
 }
 
@@ -148,23 +151,26 @@ fn tradeoff(args: &CompareArgs, plan: &scenario::Plan, opts: &CompareOptions) ->
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "trade-off on {} ({}): K1 and K2 times each scale; medians over {} seed(s); * = on the law's Pareto front (IAE against effort, against energy)\n",
+        "trade-off on {} ({}): K1 and K2 times each scale; medians over {} seed(s); eff-G: effort beyond the gravity hold; \
+         sat: median time saturated (a point with sat > 0 is limited by the motors); * = on the law's Pareto front \
+         (IAE against eff-G, against energy)\n",
         plan.scenario.name, plan.source, opts.seeds
     );
     let _ = writeln!(
         out,
-        "{:<16} {:>7} {:>12} {:>14} {:>12} {:>7} {:>6}",
-        "law", "scale", "IAE>Tc", "effort>Tc", "energy>Tc", "failed", "front"
+        "{:<16} {:>7} {:>12} {:>14} {:>12} {:>7} {:>6} {:>6}",
+        "law", "scale", "IAE>Tc", "eff-G>Tc", "energy>Tc", "sat[s]", "failed", "front"
     );
     for p in &t.points {
         let _ = writeln!(
             out,
-            "{:<16} {:>7} {:>12} {:>14} {:>12} {:>7} {:>6}",
+            "{:<16} {:>7} {:>12} {:>14} {:>12} {:>7} {:>6} {:>6}",
             p.law.to_string(),
             p.scale,
             cell(p.iae.or(Some(f64::INFINITY)), 4),
             cell(p.effort.or(Some(f64::INFINITY)), 1),
             cell(p.energy.or(Some(f64::INFINITY)), 2),
+            cell(Some(p.saturated_s), 3),
             p.failed,
             format!(
                 "{}{}",
@@ -178,7 +184,7 @@ fn tradeoff(args: &CompareArgs, plan: &scenario::Plan, opts: &CompareOptions) ->
 }
 
 /// Columns of the table: (metric, heading, decimals).
-const COLUMNS: [(&str, &str, usize); 13] = [
+const COLUMNS: [(&str, &str, usize); 14] = [
     ("iae", "IAE", 4),
     ("ise", "ISE", 6),
     ("itae", "ITAE", 3),
@@ -187,6 +193,7 @@ const COLUMNS: [(&str, &str, usize); 13] = [
     ("violation_s", "viol[s]", 3),
     ("violation_after_tc_s", "viol>Tc", 3),
     ("effort_after_tc", "eff>Tc", 1),
+    ("effort_beyond_gravity", "eff-G>Tc", 1),
     ("torque_rate", "int dtau^2", 0),
     ("saturated_s", "sat[s]", 3),
     ("breaches", "breach", 0),
@@ -218,7 +225,11 @@ pub(crate) fn table(c: &Comparison) -> String {
         out,
         "metrics after T_c unless marked; sums over joints; model: URDF = the law uses the URDF's M, C, G\n"
     );
-    let _ = write!(out, "{:<16} {:<5} {:>6}", "law", "model", "kept");
+    let _ = write!(
+        out,
+        "{:<16} {:<5} {:>6} {:>5} {:>6}",
+        "law", "model", "kept", "left", "failed"
+    );
     for (_, h, _) in COLUMNS {
         let _ = write!(out, " {h:>10}");
     }
@@ -240,8 +251,16 @@ pub(crate) fn table(c: &Comparison) -> String {
                 (None, true) => "URDF",
                 (None, false) => "free",
             };
-            let kept = format!("{}/{}", row.kept_envelope, row.runs.len());
-            let _ = write!(out, "{name:<16} {model:<5} {kept:>6}");
+            let (kept, left, failed) = if which == "worst" {
+                (String::new(), String::new(), String::new())
+            } else {
+                (
+                    format!("{}/{}", row.kept_envelope, row.runs.len()),
+                    row.left_envelope.to_string(),
+                    row.failed.to_string(),
+                )
+            };
+            let _ = write!(out, "{name:<16} {model:<5} {kept:>6} {left:>5} {failed:>6}");
             for (key, _, prec) in COLUMNS {
                 let _ = write!(out, " {:>10}", cell(s.get(key), prec));
             }
@@ -250,8 +269,11 @@ pub(crate) fn table(c: &Comparison) -> String {
     }
     let _ = writeln!(
         out,
-        "\nkept: runs with |e| < k_c for every t >= T_c; enter: when every joint was inside for good; \
-         breach: steps the barrier's guard or the funnel's clamp acted"
+        "\nkept / left: runs with |e| < k_c at every t >= T_c / not (runs that end before T_c are \
+         not judged); failed: runs that stopped, went non-finite or faulted (one rule for every law); \
+         enter: when every joint was inside for good; eff-G: effort beyond the URDF's gravity hold, \
+         int (tau - G(q))^2; breach: steps the barrier's guard or the funnel's clamp acted (a fact, \
+         not a failure)"
     );
     for row in &c.laws {
         if let Some(e) = &row.external {
@@ -269,6 +291,9 @@ pub(crate) fn table(c: &Comparison) -> String {
     if c.seeds > 1 {
         out.push_str(&spread(c));
         out.push_str(&paired(c));
+    }
+    for w in &c.warnings {
+        let _ = writeln!(out, "note: {w}");
     }
     let failed: Vec<String> = c
         .laws
@@ -360,27 +385,32 @@ fn paired(c: &Comparison) -> String {
     };
     let _ = writeln!(
         out,
-        "\npaired on the same seeds, {} against each law: Wilcoxon signed-rank, two-sided \
-         (better/worse/ties: seeds where {} did better, worse, the same; diff: median of {} - law)",
-        first.law, first.law, first.law
+        "\npaired on the same seeds, baseline {} against each law: Wilcoxon signed-rank, two-sided \
+         (better/worse/ties: seeds where {} did better, worse, the same; diff: median of {} - law; \
+         p Holm: corrected over all {} tests)",
+        first.law,
+        first.law,
+        first.law,
+        c.paired.len()
     );
     let _ = writeln!(
         out,
-        "{:<16} {:<16} {:>6} {:>6} {:>5} {:>12} {:>10}",
-        "law", "metric", "better", "worse", "ties", "diff", "p"
+        "{:<16} {:<22} {:>6} {:>6} {:>5} {:>12} {:>10} {:>10}",
+        "law", "metric", "better", "worse", "ties", "diff", "p", "p Holm"
     );
     for p in &c.paired {
         let t = &p.test;
         let _ = writeln!(
             out,
-            "{:<16} {:<16} {:>6} {:>6} {:>5} {:>12} {:>10.2e}",
+            "{:<16} {:<22} {:>6} {:>6} {:>5} {:>12} {:>10.2e} {:>10.2e}",
             p.versus.to_string(),
             p.metric,
             t.a_smaller,
             t.b_smaller,
             t.ties,
             signed(t.median_difference),
-            t.p_value
+            t.p_value,
+            p.p_holm
         );
     }
     out
@@ -394,12 +424,14 @@ fn signed(x: f64) -> String {
     }
 }
 
-/// One row per law and seed: `law,model_based,seed,failed,` then every metric.
+/// One row per law and seed: `law,model_based,seed,failed,failure,
+/// kept_envelope,envelope,` then every metric (`failure`: why it failed,
+/// quoted; `envelope`: kept, left or not-judged).
 fn write_csv(w: &mut impl std::io::Write, c: &Comparison) -> std::io::Result<()> {
     let names: Vec<&str> = METRICS.iter().map(|m| m.name).collect();
     writeln!(
         w,
-        "law,model_based,seed,failed,kept_envelope,{}",
+        "law,model_based,seed,failed,failure,kept_envelope,envelope,{}",
         names.join(",")
     )?;
     for row in &c.laws {
@@ -416,15 +448,19 @@ fn write_csv(w: &mut impl std::io::Write, c: &Comparison) -> std::io::Result<()>
                     }
                 })
                 .collect();
-            let kept = run.failed.is_none() && run.summary.constraint_satisfied_after_tc;
+            let failure = run
+                .failed
+                .as_deref()
+                .map_or_else(String::new, |f| format!("\"{}\"", f.replace('"', "\"\"")));
             writeln!(
                 w,
-                "{},{},{},{},{},{}",
+                "{},{},{},{},{failure},{},{},{}",
                 row.name,
                 row.law.model_based,
                 run.seed,
                 run.failed.is_some(),
-                kept,
+                run.envelope == compare::Envelope::Kept,
+                run.envelope.as_str(),
                 values.join(",")
             )?;
         }

@@ -33,7 +33,8 @@ pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
         plan.robot.model.joint_names(),
         plan.dt(),
         plan.scenario.controller.tc,
-    );
+    )
+    .with_gravity(&plan.robot.model);
     let mut series = plots
         .as_ref()
         .map(|_| analysis::Series::new(plan.robot.model.dof()));

@@ -108,7 +108,8 @@ pub fn sim<'py>(
                 plan.robot.model.joint_names(),
                 plan.dt(),
                 plan.scenario.controller.tc,
-            );
+            )
+            .with_gravity(&plan.robot.model);
             let mut costs = launch::sim::StepCosts::default();
             let start = Instant::now();
             launch::sim::run_measured(&plan, Some(&mut costs), |r| {
