@@ -222,11 +222,59 @@ def findings_page() -> str:
     return "\n".join(lines)
 
 
+# Sweep files whose report is a page: the parameters the paper leaves open
+# and PPC's funnel floor, where the barrier acts (#37 item 6).
+SWEEPS = ["nac_open_parameters", "ppc_rho"]
+SWEEP_METRICS = [("iae", "IAE", 4), ("max_abs_error", "max \\|e\\|", 3),
+                 ("breaches", "breaches", 4), ("effort_beyond_gravity", "effort beyond gravity", 4),
+                 ("energy_after_tc", "energy", 4)]
+
+
+def sweeps_page() -> str:
+    import tempfile
+
+    lines = header(
+        "Sweeps over the parameters the paper leaves open",
+        "testbed sweep run sweeps/NAME.toml --out DIR && testbed sweep report DIR --json",
+    )
+    lines += [
+        "Each cell is the median over its seeds (worst for max |e|); `kept` is the",
+        "share of its judged runs that kept |e| < k_c at every t ≥ T_c. The sweep files say what",
+        "runs: the randomised paper scenario with the gains at a quarter",
+        "(K1 = K2 = 3.75), where the barrier acts.",
+        "",
+    ]
+    for name in SWEEPS:
+        with tempfile.TemporaryDirectory() as tmp:
+            out = Path(tmp) / name
+            cmd = testbed() + ["sweep", "run", f"sweeps/{name}.toml", "--out", str(out)]
+            run = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+            if run.returncode != 0:
+                sys.exit(f"regenerate: {' '.join(cmd)} failed:\n{run.stderr}")
+            report = run_json(["sweep", "report", str(out)])
+        keys = report["axes"]
+        lines += [f"## [`sweeps/{name}.toml`](../../sweeps/{name}.toml)", ""]
+        head = [k.split(".")[-1] for k in keys] + ["law", "kept"] + [h for _, h, _ in SWEEP_METRICS]
+        lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        for c in report["cells"]:
+            m = {x["metric"]: x for x in c["metrics"]}
+            rate = c["success_rate"]
+            kept = "not judged" if rate is None else f"{100 * rate:.0f} %"
+            row = [g(c["cell"][k]) for k in keys] + [c["law"], kept]
+            for key, _, digits in SWEEP_METRICS:
+                which = "worst" if key == "max_abs_error" else "median"
+                row.append(g(m[key][which], digits))
+            lines.append("| " + " | ".join(row) + " |")
+        lines.append("")
+    return "\n".join(lines)
+
+
 PAGES = {
     "scenarios.md": scenarios_page,
     "arms.md": arms_page,
     "compare.md": compare_page,
     "findings.md": findings_page,
+    "sweeps.md": sweeps_page,
 }
 
 
