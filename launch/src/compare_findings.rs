@@ -348,10 +348,15 @@ mod tests {
     use crate::compare::{CompareOptions, compare};
 
     fn run(laws: Vec<LawName>) -> Comparison {
+        run_for(4.0, laws)
+    }
+
+    /// The paper scenario for `duration` s, one seed, `laws`.
+    fn run_for(duration: f64, laws: Vec<LawName>) -> Comparison {
         let plan = scenario::load(
             None,
             &scenario::Overrides {
-                duration_s: Some(4.0),
+                duration_s: Some(duration),
                 ..Default::default()
             },
         )
@@ -391,25 +396,7 @@ mod tests {
 
     #[test]
     fn runs_shorter_than_tc_are_not_judged() {
-        let plan = scenario::load(
-            None,
-            &scenario::Overrides {
-                duration_s: Some(1.0),
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        let opts = CompareOptions {
-            external: Vec::new(),
-            runs_dir: std::path::PathBuf::from("runs"),
-            progress: false,
-            laws: vec![LawName::Nac, LawName::Pd],
-            seeds: 1,
-            threads: Some(1),
-            series: false,
-            tuning: None,
-        };
-        let f = findings(&compare(&plan, &opts).unwrap());
+        let f = findings(&run_for(1.0, vec![LawName::Nac, LawName::Pd]));
         for k in [0, 1, 2, 5, 7] {
             assert_eq!(f[k].verdict, Verdict::NotJudged, "{:?}", f[k]);
         }

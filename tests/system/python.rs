@@ -14,18 +14,7 @@ use crate::util::{fails, json, ok, repo_root, shm_files, testbed};
 /// the other test processes doing the same).
 fn python() -> &'static str {
     static PYTHON: OnceLock<String> = OnceLock::new();
-    PYTHON.get_or_init(|| {
-        let out = Command::new("bash")
-            .arg(repo_root().join("python/setup-venv.sh"))
-            .output()
-            .expect("run python/setup-venv.sh");
-        assert!(
-            out.status.success(),
-            "python/setup-venv.sh failed:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stdout).trim().to_string()
-    })
+    PYTHON.get_or_init(|| crate::util::venv_python("python/setup-venv.sh"))
 }
 
 fn example(name: &str) -> String {

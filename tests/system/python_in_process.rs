@@ -12,18 +12,7 @@ use crate::util::{json, repo_root, testbed};
 /// (python/build-module.sh; it locks against other test processes).
 fn python() -> &'static str {
     static PYTHON: OnceLock<String> = OnceLock::new();
-    PYTHON.get_or_init(|| {
-        let out = Command::new("bash")
-            .arg(repo_root().join("python/build-module.sh"))
-            .output()
-            .expect("run python/build-module.sh");
-        assert!(
-            out.status.success(),
-            "python/build-module.sh failed:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stdout).trim().to_string()
-    })
+    PYTHON.get_or_init(|| crate::util::venv_python("python/build-module.sh"))
 }
 
 #[test]

@@ -186,3 +186,19 @@ pub fn csv_of(args: &[&str], dir: &Path, name: &str) -> Vec<u8> {
     ok(testbed().args(args).arg("--csv").arg(&path));
     std::fs::read(&path).unwrap()
 }
+
+/// Runs `script` (python/setup-venv.sh or python/build-module.sh: each
+/// locks against other test processes running it) and returns the Python
+/// it prints.
+pub fn venv_python(script: &str) -> String {
+    let out = Command::new("bash")
+        .arg(repo_root().join(script))
+        .output()
+        .unwrap_or_else(|e| panic!("run {script}: {e}"));
+    assert!(
+        out.status.success(),
+        "{script} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).trim().to_string()
+}
