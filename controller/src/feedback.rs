@@ -1,6 +1,7 @@
-//! The unconstrained reference laws of BASELINES.md: `pd`, and the
-//! model-based `pd-gravity` and `ctc`, with gains matched to the paper's
-//! K1, K2 so that a difference in a comparison comes from the structure.
+//! The unconstrained reference laws of BASELINES.md: `pd`, sliding mode
+//! `smc`, and the model-based `pd-gravity` and `ctc`, with gains matched to
+//! the paper's K1, K2 so that a difference in a comparison comes from the
+//! structure.
 
 use arm_model::ArmModel;
 use arm_model::dynamics::Dynamics;
@@ -9,7 +10,7 @@ use crate::law_table::FeedbackKind;
 use crate::nac::{begin_plain_step, end_plain_step};
 use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Tuning};
 
-/// `pd`, `pd-gravity` or `ctc` for n joints.
+/// `pd`, `smc`, `pd-gravity` or `ctc` for n joints.
 #[derive(Debug, Clone)]
 pub struct Feedback {
     kind: FeedbackKind,
@@ -23,6 +24,8 @@ pub struct Feedback {
     model: Option<Dynamics>,
     /// Scratch: q̈_d − K_d' ė − K_p' e for `ctc`.
     v: Vec<f64>,
+    /// `smc`'s switching gain k_s and boundary layer φ.
+    smc: (f64, f64),
 }
 
 impl Feedback {
@@ -64,6 +67,7 @@ impl Feedback {
             ctc_gains,
             model,
             v: vec![0.0; dof],
+            smc: (params.smc_gain, params.smc_boundary),
         })
     }
 
@@ -97,6 +101,14 @@ impl Feedback {
                 (FeedbackKind::Ctc, None) => self.v[i] = 0.0,
                 (FeedbackKind::Pd | FeedbackKind::PdGravity, _) => {
                     out.tau_feedback[i] = -k1 * k2 * e - k2 * ed
+                }
+                // s = ė + K1 e; τ = −K2 s − k_s sat(s / φ) (BASELINES §2).
+                (FeedbackKind::Smc, _) => {
+                    let (ks, phi) = self.smc;
+                    let s = ed + k1 * e;
+                    out.alpha[i] = input.qd_d[i] - k1 * e;
+                    out.z2[i] = s;
+                    out.tau_feedback[i] = -k2 * s - ks * (s / phi).clamp(-1.0, 1.0)
                 }
             }
         }
@@ -142,7 +154,8 @@ impl Feedback {
                 out.tau_feedback.iter_mut().for_each(|x| *x = 0.0);
             }
             // `new` refuses a model-based law without a model.
-            (FeedbackKind::Pd, _) | (FeedbackKind::PdGravity | FeedbackKind::Ctc, None) => {
+            (FeedbackKind::Pd | FeedbackKind::Smc, _)
+            | (FeedbackKind::PdGravity | FeedbackKind::Ctc, None) => {
                 out.tau_model.iter_mut().for_each(|x| *x = 0.0)
             }
         }

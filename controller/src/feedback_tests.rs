@@ -162,3 +162,33 @@ fn matched_ctc_on_one_joint_is_pd_with_gravity() {
     );
     assert!((one(LawName::Ctc, Tuning::AsGiven) - pd_g).abs() > 0.1);
 }
+
+// s = ė + K1 e = [0.5 + 2·0.3, −1.5 + 4·(−0.6)] = [1.1, −3.9], both past
+// the boundary layer (φ = 0.05): τ = −K2 s − k_s sign(s) = [−3.3 − 2, 11.7 + 2].
+#[test]
+fn smc_by_hand_outside_the_boundary_layer() {
+    let d = step(LawName::Smc, None);
+    assert!((d.tau[0] - (-5.3)).abs() < 1e-12, "{:?}", d.tau);
+    assert!((d.tau[1] - 13.7).abs() < 1e-12, "{:?}", d.tau);
+    assert!((d.z2[0] - 1.1).abs() < 1e-12 && (d.z2[1] + 3.9).abs() < 1e-12);
+    assert_eq!(d.tau_model, vec![0.0, 0.0]);
+}
+
+// Inside the layer the switch is linear: s = 0.02 → k_s s / φ = 2 · 0.4.
+#[test]
+fn smc_by_hand_inside_the_boundary_layer() {
+    let mut f = new_feedback(&params(LawName::Smc), 2, None).unwrap();
+    let mut d = Diagnostics::new(2);
+    // e = 0.01, ė = 0: s = K1 e = [0.02, 0.04].
+    let q = [Q_D[0] + 0.01, Q_D[1] + 0.01];
+    let input = ControllerInput {
+        q: &q,
+        qd: &QD_D,
+        ..input()
+    };
+    f.step(&input, &mut d);
+    let want = [-3.0 * 0.02 - 2.0 * 0.4, -3.0 * 0.04 - 2.0 * 0.8];
+    for i in 0..2 {
+        assert!((d.tau[i] - want[i]).abs() < 1e-12, "{:?} vs {want:?}", d.tau);
+    }
+}

@@ -40,6 +40,8 @@ law_names! {
     Ctc,
     /// Low-complexity prescribed performance control.
     Ppc,
+    /// Sliding mode control with a boundary layer (model-free).
+    Smc,
 }
 
 /// Which parts of the paper's law run (its ablations and `blf` switch
@@ -65,6 +67,8 @@ pub enum FeedbackKind {
     PdGravity,
     /// `ctc` (model-based).
     Ctc,
+    /// `smc`: sliding mode with a boundary layer (model-free).
+    Smc,
 }
 
 /// How a law is built and stepped. Every choice between laws goes through
@@ -188,6 +192,11 @@ impl LawName {
                 name: "ppc",
                 kind: LawKind::Ppc,
                 keys: &["rho2_inf", "tuning"],
+            },
+            LawName::Smc => LawDecl {
+                name: "smc",
+                kind: LawKind::Feedback(FeedbackKind::Smc),
+                keys: &["smc_gain", "smc_boundary"],
             },
         }
     }

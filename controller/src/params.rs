@@ -118,6 +118,14 @@ pub struct ControllerParams {
     /// smallest power of two that keeps every shipped two-link scenario
     /// inside both funnels; 2 breaches under the 3 ms actuation delay).
     pub rho2_inf: f64,
+    /// `smc`: the switching gain k_s, N m (default: 2: the size of an
+    /// unmodelled torque the law rejects inside its boundary layer, e.g.
+    /// the paper arm's payload and friction).
+    pub smc_gain: f64,
+    /// `smc`: the boundary layer's width φ on s = ė + K1 e, rad/s (default:
+    /// 0.05: the switch is linear for |s| < φ, which keeps it from
+    /// chattering at a 1 ms period).
+    pub smc_boundary: f64,
     /// `ctc`, `ppc`: how K1, K2 become the law's gains (default:
     /// "as-given"; "matched" matches `pd`'s error dynamics). Unwritten at
     /// its default so that existing scenarios keep their identity.
@@ -152,6 +160,8 @@ impl Default for ControllerParams {
             breach_epsilon: 1e-6,
             model_scale: 1.0,
             rho2_inf: 4.0,
+            smc_gain: 2.0,
+            smc_boundary: 0.05,
             tuning: Tuning::AsGiven,
         }
     }
@@ -194,6 +204,8 @@ impl ControllerParams {
             ("breach_epsilon", self.breach_epsilon, OpenUnit),
             ("model_scale", self.model_scale, Positive),
             ("rho2_inf", self.rho2_inf, Positive),
+            ("smc_gain", self.smc_gain, NonNegative),
+            ("smc_boundary", self.smc_boundary, Positive),
         ];
         for (key, value, bound) in checks {
             let (ok, need) = match bound {
@@ -264,6 +276,8 @@ impl ControllerParams {
             ("breach_epsilon", self.breach_epsilon != d.breach_epsilon),
             ("model_scale", self.model_scale != d.model_scale),
             ("rho2_inf", self.rho2_inf != d.rho2_inf),
+            ("smc_gain", self.smc_gain != d.smc_gain),
+            ("smc_boundary", self.smc_boundary != d.smc_boundary),
             ("tuning", self.tuning != d.tuning),
         ];
         changed
@@ -324,6 +338,8 @@ impl ControllerParams {
             breach_epsilon,
             model_scale,
             rho2_inf,
+            smc_gain,
+            smc_boundary,
             tuning
         );
         p

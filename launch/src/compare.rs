@@ -26,8 +26,9 @@ use analysis::summary::{Summary, SummaryBuilder};
 use analysis::timing::Percentiles;
 
 /// The laws `compare` runs when none are named: the paper's law, its
-/// ablations, the classic barrier law, PD, computed torque and PPC.
-pub const DEFAULT_LAWS: [LawName; 8] = [
+/// ablations, the classic barrier law, PD, computed torque, PPC and
+/// sliding mode.
+pub const DEFAULT_LAWS: [LawName; 9] = [
     LawName::Nac,
     LawName::NacNoShift,
     LawName::NacNoCritic,
@@ -36,7 +37,12 @@ pub const DEFAULT_LAWS: [LawName; 8] = [
     LawName::Pd,
     LawName::Ctc,
     LawName::Ppc,
+    LawName::Smc,
 ];
+
+/// The most seeds per law `compare` runs (each run's summary is kept);
+/// more is a sweep's job.
+pub const MAX_SEEDS: u64 = 10_000;
 
 /// Why a comparison could not be made.
 #[derive(Debug, thiserror::Error)]

@@ -13,7 +13,6 @@ use super::args::{CompareArgs, ScenarioArgs};
 
 /// Seeds per law `compare` takes: a table of medians and intervals needs
 /// far fewer; a larger study is a sweep, which streams its results.
-const MAX_SEEDS: u64 = 10_000;
 
 pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     if args.seeds == 0 {
@@ -21,10 +20,11 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     }
     // Checked before anything is allocated: each run keeps its summary
     // (and its series with --plots).
-    if args.seeds > MAX_SEEDS {
+    if args.seeds > compare::MAX_SEEDS {
         bail!(
-            "--seeds {}: at most {MAX_SEEDS} seeds per law (use a sweep for more)",
-            args.seeds
+            "--seeds {}: at most {} seeds per law (use a sweep for more)",
+            args.seeds,
+            compare::MAX_SEEDS
         );
     }
     if args.threads == Some(0) {

@@ -49,7 +49,8 @@ pub fn read_into(what: &str, x: &Bound<'_, PyAny>, out: &mut [f64]) -> PyResult<
             .for_each(|(o, v)| *o = f64::from(*v));
         return Ok(());
     }
-    let v: Vec<f64> = x.extract().map_err(|_| {
+    let text = x.is_instance_of::<pyo3::types::PyBytes>() || x.is_instance_of::<PyString>();
+    let v: Vec<f64> = (!text).then(|| x.extract().ok()).flatten().ok_or_else(|| {
         let ty = x
             .get_type()
             .name()
@@ -105,7 +106,7 @@ pub fn overrides_set(set: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, to
             let key: String = k
                 .extract()
                 .map_err(|_| PyTypeError::new_err(format!("set: key {k} is not a string")))?;
-            let value = to_toml(&key, &v)?;
+            let value = to_toml(&key, &v, 0)?;
             // Through `--set`'s own reader: the same key checks.
             let parsed = scenario::parse_set(&format!("{key}={value}"))
                 .map_err(|e| PyValueError::new_err(format!("set: {e}")))?;
@@ -124,8 +125,16 @@ pub fn overrides_set(set: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, to
         .collect()
 }
 
+/// How deep a `set=` value may nest (a scenario's deepest is 3).
+const MAX_SET_DEPTH: usize = 16;
+
 /// A Python value as a TOML value, for `set=`.
-fn to_toml(key: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+fn to_toml(key: &str, v: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::Value> {
+    if depth > MAX_SET_DEPTH {
+        return Err(PyValueError::new_err(format!(
+            "set: {key}: nested more than {MAX_SET_DEPTH} deep (a list or dict that contains itself?)"
+        )));
+    }
     if let Ok(b) = v.extract::<bool>() {
         return Ok(toml::Value::Boolean(b));
     }
@@ -142,7 +151,7 @@ fn to_toml(key: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
         let mut t = toml::Table::new();
         for (k, x) in d.iter() {
             let k: String = k.extract()?;
-            t.insert(k.clone(), to_toml(&format!("{key}.{k}"), &x)?);
+            t.insert(k.clone(), to_toml(&format!("{key}.{k}"), &x, depth + 1)?);
         }
         return Ok(toml::Value::Table(t));
     }
@@ -158,11 +167,11 @@ fn to_toml(key: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
         if let Ok(list) = items.cast::<PyList>() {
             return list
                 .iter()
-                .map(|x| to_toml(key, &x))
+                .map(|x| to_toml(key, &x, depth + 1))
                 .collect::<PyResult<Vec<_>>>()
                 .map(toml::Value::Array);
         }
-        return to_toml(key, &items);
+        return to_toml(key, &items, depth + 1);
     }
     Err(PyTypeError::new_err(format!(
         "set: {key}: a {} is not a scenario value (a number, string, bool, list or dict)",

@@ -204,8 +204,16 @@ impl Robot {
         self.plant
             .set_state(&qv, &qdv)
             .map_err(|e| PyValueError::new_err(format!("{}: {e}", self.label)))?;
-        self.plant
+        let (m, h) = self
+            .plant
             .inertia_and_bias()
-            .map_err(|e| PyValueError::new_err(format!("{}: {e}", self.label)))
+            .map_err(|e| PyValueError::new_err(format!("{}: {e}", self.label)))?;
+        if m.iter().chain(&h).any(|x| !x.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "{}: the dynamics are not finite at q = {qv:?}, qd = {qdv:?} (too large?)",
+                self.label
+            )));
+        }
+        Ok((m, h))
     }
 }

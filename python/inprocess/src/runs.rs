@@ -101,6 +101,8 @@ pub fn sim<'py>(
     .load()?;
     no_external(&plan)?;
     let n = plan.robot.model.dof();
+    check_rows_fit(&plan)?;
+    let mut interrupted: Option<PyErr> = None;
     let (columns, report) = py
         .detach(|| {
             let mut columns = Columns::new(n, plan.steps as usize);
@@ -113,6 +115,16 @@ pub fn sim<'py>(
             let mut costs = launch::sim::StepCosts::default();
             let start = Instant::now();
             launch::sim::run_measured(&plan, Some(&mut costs), |r| {
+                // Ctrl-C reaches Python only between steps: look every 4096.
+                if columns.t.len() % 4096 == 4095
+                    && let Err(e) = Python::attach(|py| py.check_signals())
+                {
+                    interrupted = Some(e);
+                    return Err(std::io::Error::new(
+                        std::io::ErrorKind::Interrupted,
+                        "interrupted",
+                    ));
+                }
                 summary.add(r);
                 columns.add(r);
                 Ok(())
@@ -123,7 +135,7 @@ pub fn sim<'py>(
                 Report::from_sim(&plan, summary.finish(), wall, costs.controller_us.finish());
             Ok::<_, String>((columns, report))
         })
-        .map_err(err)?;
+        .map_err(|e| interrupted.take().unwrap_or_else(|| err(e)))?;
     Ok((columns.into_dict(py)?, json_to_py(py, &report)?))
 }
 
@@ -161,6 +173,15 @@ pub fn compare<'py>(
     if seeds == 0 || threads == Some(0) {
         return Err(err("compare needs at least one seed and one thread"));
     }
+    if seeds > launch::compare::MAX_SEEDS {
+        return Err(err(format!(
+            "seeds={seeds}: at most {} seeds per law (use a sweep for more)",
+            launch::compare::MAX_SEEDS
+        )));
+    }
+    // More threads than four per CPU only queue (the CLI's cap too).
+    let cap = 4 * launch::node::placement::cpu_count();
+    let threads = threads.map(|t| t.min(cap));
     let opts = CompareOptions {
         laws,
         seeds,
@@ -196,6 +217,26 @@ pub fn scenario_toml<'py>(
     }
     .load()?;
     plan.effective_toml().map_err(err)
+}
+
+/// The most memory `sim` may hold in rows, bytes.
+const MAX_ROWS_BYTES: f64 = 4.0 * 1024.0 * 1024.0 * 1024.0;
+
+/// Refuses a run whose rows would not fit in [`MAX_ROWS_BYTES`].
+fn check_rows_fit(plan: &scenario::Plan) -> PyResult<()> {
+    let n = plan.robot.model.dof();
+    let bytes = plan.steps as f64 * (JOINT_FIELDS.len() * n + 2) as f64 * 8.0;
+    if bytes > MAX_ROWS_BYTES {
+        return Err(err(format!(
+            "{}: {} steps of {n} joints would be {:.1} GB of rows (at most {:.1} GB): \
+             shorten the duration, or run `testbed sim --csv` to stream them",
+            plan.source,
+            plan.steps,
+            bytes / 1e9,
+            MAX_ROWS_BYTES / 1e9
+        )));
+    }
+    Ok(())
 }
 
 /// A scenario with an `[external]` table is for an external controller.

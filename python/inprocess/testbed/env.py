@@ -11,6 +11,8 @@ broken (Safety-Gymnasium's convention). The loop runs in Rust
 
 from __future__ import annotations
 
+import operator
+
 import numpy as np
 import gymnasium
 from gymnasium import spaces
@@ -113,7 +115,7 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
     def __init__(self, num_envs: int = 1, scenario=None, *, render_mode=None, **kwargs):
         if render_mode is not None:
             raise ValueError("ArmTrackingVecEnv has no render mode")
-        self._core = VecEnvCore(int(num_envs), scenario, **kwargs)
+        self._core = VecEnvCore(operator.index(num_envs), scenario, **kwargs)
         self.num_envs = self._core.num_envs
         self.single_observation_space, self.single_action_space = _spaces(self._core)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
@@ -126,16 +128,16 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         return self._core
 
     def reset(self, *, seed=None, options=None):
-        super().reset(seed=seed)
         if options:
             raise ValueError(f"reset: options {sorted(options)} are not taken; pass seed= only")
-        if seed is None:
-            seed = _seed_from(self.np_random)
-        elif not isinstance(seed, (int, np.integer)):
-            seeds = list(seed)
-            if seeds != [seeds[0] + i for i in range(self.num_envs)]:
+        if seed is not None and not isinstance(seed, (int, np.integer)):
+            seeds = [operator.index(s) for s in seed]
+            if not seeds or seeds != [seeds[0] + i for i in range(self.num_envs)]:
                 raise ValueError("reset: seed must be an int s (arm i gets s + i), or [s, s+1, …]")
             seed = seeds[0]
+        super().reset(seed=seed)
+        if seed is None:
+            seed = _seed_from(self.np_random)
         obs = self._core.reset(int(seed))
         return obs, {}
 

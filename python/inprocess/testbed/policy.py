@@ -40,9 +40,37 @@ class LinearPolicy:
             if missing:
                 raise ValueError(f"{path}: not a testbed policy file (no {', '.join(sorted(missing))})")
             weights, bias, env = f["weights"], f["bias"], json.loads(str(f["env"]))
-        if weights.ndim != 2 or bias.shape != (weights.shape[0],):
-            raise ValueError(f"{path}: weights {weights.shape} and bias {bias.shape} do not fit")
-        return cls(weights.astype(np.float64), bias.astype(np.float64), env)
+        policy = cls(weights, bias, env)
+        policy.check(str(path))
+        return policy
+
+    def check(self, where: str = "policy") -> None:
+        """Refuses weights that do not fit the environment they name, or
+        are not finite real numbers (ValueError naming the field)."""
+        env = self.env
+        if not isinstance(env, dict):
+            raise ValueError(f"{where}: env is {type(env).__name__}, not a table of the environment")
+        for key in ("dof", "obs_dim", "steps", "torque_scale"):
+            if key not in env:
+                raise ValueError(f"{where}: env.{key} is missing (save with testbed.policy.env_record)")
+        dof, obs_dim, steps = env["dof"], env["obs_dim"], env["steps"]
+        if not all(isinstance(x, int) and x >= 1 for x in (dof, obs_dim, steps)):
+            raise ValueError(f"{where}: env.dof, env.obs_dim and env.steps must be integers ≥ 1")
+        if obs_dim != 7 * dof + 1:
+            raise ValueError(f"{where}: env.obs_dim = {obs_dim}; an arm of {dof} joints has {7 * dof + 1}")
+        scale = np.asarray(env["torque_scale"])
+        if scale.shape != (dof,) or not np.issubdtype(scale.dtype, np.number):
+            raise ValueError(f"{where}: env.torque_scale must be {dof} numbers")
+        w, b = np.asarray(self.weights), np.asarray(self.bias)
+        if w.shape != (dof, obs_dim) or b.shape != (dof,):
+            raise ValueError(f"{where}: weights {w.shape} and bias {b.shape}; "
+                             f"this environment needs ({dof}, {obs_dim}) and ({dof},)")
+        for name, x in (("weights", w), ("bias", b), ("env.torque_scale", scale)):
+            if not np.issubdtype(x.dtype, np.floating) and not np.issubdtype(x.dtype, np.integer):
+                raise ValueError(f"{where}: {name} has dtype {x.dtype}, not real numbers")
+            if not np.all(np.isfinite(x)):
+                raise ValueError(f"{where}: {name} has a value that is not finite")
+        self.weights, self.bias = w.astype(np.float64), b.astype(np.float64)
 
 
 def env_record(env) -> dict:

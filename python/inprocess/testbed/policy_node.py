@@ -19,7 +19,7 @@ import numpy as np
 
 import testbed_controller as tc
 
-from ._native import Law
+from ._native import LAWS, Law
 from .policy import LinearPolicy
 
 
@@ -27,15 +27,15 @@ class PolicyController(tc.Controller):
     name = "policy"
 
     def __init__(self, policy: LinearPolicy):
+        policy.check()
         self.policy = policy
         env = policy.env
-        for key in ("dof", "obs_dim", "steps", "torque_scale"):
-            if key not in env:
-                raise ValueError(f"the policy file has no env.{key}: save it with testbed.policy.env_record")
         self.n = int(env["dof"])
         self.scale = np.asarray(env["torque_scale"], dtype=np.float64)
         self.steps = int(env["steps"])
         self.base_law = env.get("base_law")
+        if self.base_law is not None and self.base_law not in LAWS:
+            raise ValueError(f"env.base_law = {self.base_law!r} is not a law ({', '.join(LAWS)})")
         self.span = float(env.get("residual_scale", 0.2)) if self.base_law else 1.0
         self.law = None
         self.obs = np.empty(7 * self.n + 1)
@@ -71,7 +71,13 @@ def main(argv=None) -> None:
     p = argparse.ArgumentParser(description="A trained testbed policy as the controller node.")
     p.add_argument("--policy", required=True, help="the policy file (LinearPolicy.save)")
     args, rest = p.parse_known_args(sys.argv[1:] if argv is None else argv)
-    tc.run(PolicyController(LinearPolicy.load(args.policy)), rest)
+    try:
+        controller = PolicyController(LinearPolicy.load(args.policy))
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        # One line naming the file, not a traceback (zipfile and json
+        # errors are ValueErrors or OSErrors).
+        raise SystemExit(f"testbed.policy_node: {args.policy}: {e}") from None
+    tc.run(controller, rest)
 
 
 if __name__ == "__main__":

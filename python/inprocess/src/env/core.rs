@@ -394,6 +394,10 @@ impl SeedStream {
     }
 }
 
+/// The most arms one vector of environments steps (each holds its
+/// plant, reference and buffers: tens of kB).
+pub const MAX_ENVS: usize = 1 << 16;
+
 /// Many arms of one scenario, stepped in one call, each resetting itself
 /// on the step after its episode ended (Gymnasium's "next step" autoreset).
 pub struct ArmEnvs {
@@ -406,8 +410,10 @@ pub struct ArmEnvs {
 impl ArmEnvs {
     /// `count` copies of the environment of `plan`.
     pub fn new(plan: Plan, opts: EnvOptions, count: usize) -> Result<Self, EnvError> {
-        if count == 0 {
-            return Err(EnvError::Option("num_envs must be at least 1".into()));
+        if !(1..=MAX_ENVS).contains(&count) {
+            return Err(EnvError::Option(format!(
+                "num_envs = {count} is invalid: it must be from 1 to {MAX_ENVS}"
+            )));
         }
         let first = ArmEnv::new(plan, opts)?;
         let obs_dim = first.obs_dim();

@@ -53,11 +53,13 @@ fn load(
 }
 
 /// One arm's episodes (see `testbed.ArmTrackingEnv` for the contract).
-#[pyclass(module = "testbed", unsendable)]
+#[pyclass(module = "testbed")]
 pub struct EnvCore {
     env: ArmEnv,
     action: Vec<f64>,
     obs: Vec<f64>,
+    /// The episode ended (terminated or truncated): step refuses until reset.
+    ended: bool,
 }
 
 #[pymethods]
@@ -94,12 +96,14 @@ impl EnvCore {
             action: vec![0.0; env.dof()],
             obs: vec![0.0; env.obs_dim()],
             env,
+            ended: false,
         })
     }
 
     /// Starts an episode drawn with `seed`; returns its first observation.
     fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.env.reset(seed, &mut self.obs).map_err(err)?;
+        self.ended = false;
         Ok(array(py, &self.obs))
     }
 
@@ -116,9 +120,15 @@ impl EnvCore {
         bool,
         Bound<'py, PyDict>,
     )> {
+        if self.ended {
+            return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "step() after the episode ended: call reset() first",
+            ));
+        }
         read_into("action", action, &mut self.action)?;
         check_finite(&self.action, None)?;
         let o = self.env.step(&self.action, &mut self.obs);
+        self.ended = o.terminated || o.truncated;
         let info = PyDict::new(py);
         info.set_item(pyo3::intern!(py, "cost"), o.cost)?;
         Ok((
@@ -214,7 +224,7 @@ impl EnvCore {
 }
 
 /// Many arms stepped in one call (see `testbed.ArmTrackingVecEnv`).
-#[pyclass(module = "testbed", unsendable)]
+#[pyclass(module = "testbed")]
 pub struct VecEnvCore {
     envs: ArmEnvs,
     n: usize,

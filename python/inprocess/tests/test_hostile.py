@@ -1,0 +1,140 @@
+"""What an adversary tried (a review of the module): threads, self-nesting
+`set=` values, huge sizes, bytes for arrays, stepping past the end, and
+hostile policy files. Each gives a Python exception naming the cause."""
+
+import subprocess
+import sys
+import tempfile
+import threading
+import unittest
+from pathlib import Path
+
+import gymnasium
+import numpy as np
+
+import testbed
+from testbed.policy import LinearPolicy
+
+ENV = testbed.ENV_ID
+
+
+class Boundary(unittest.TestCase):
+    def test_an_env_made_in_one_thread_steps_in_another(self):
+        env = gymnasium.make(ENV, duration=0.01)
+        env.reset(seed=0)
+        out = []
+        t = threading.Thread(target=lambda: out.append(env.step(np.zeros(2, np.float32))))
+        t.start()
+        t.join()
+        self.assertEqual(len(out), 1)
+        venv = testbed.VecEnvCore(2)
+        venv.reset(0)
+        t = threading.Thread(target=lambda: out.append(venv.step(np.zeros((2, 2)))))
+        t.start()
+        t.join()
+        self.assertEqual(len(out), 2)
+
+    def test_a_set_value_that_contains_itself(self):
+        loop = []
+        loop.append(loop)
+        with self.assertRaisesRegex(ValueError, "nested more than 16 deep"):
+            testbed.sim(set={"controller.k1": loop})
+        d = {}
+        d["a"] = d
+        with self.assertRaisesRegex(ValueError, "nested more than 16 deep"):
+            testbed.sim(set={"controller": d})
+
+    def test_huge_sizes_are_refused_before_anything_is_allocated(self):
+        for n in (0, 2**62):
+            with self.assertRaisesRegex(testbed.TestbedError, "num_envs = .* must be from 1 to 65536"):
+                testbed.VecEnvCore(n)
+        with self.assertRaises(TypeError):
+            gymnasium.make_vec(ENV, num_envs=2.7)
+        with self.assertRaisesRegex(testbed.TestbedError, "GB of rows"):
+            testbed.sim(duration=1e5)
+        with self.assertRaisesRegex(testbed.TestbedError, "at most 10000 seeds"):
+            testbed.compare(seeds=2**63, duration=0.01)
+        # A thread count past four per CPU is cut, as the CLI cuts it.
+        table = testbed.compare(laws=["pd"], duration=0.01, threads=10**6)
+        self.assertLessEqual(table["threads"], 4 * 1024)
+
+    def test_bytes_and_strings_are_not_numbers(self):
+        env = gymnasium.make(ENV)
+        env.reset(seed=0)
+        for bad in (b"ab", "ab"):
+            with self.assertRaisesRegex(TypeError, "expected 2 numbers"):
+                env.step(bad)
+        with self.assertRaisesRegex(TypeError, "expected 2 numbers"):
+            testbed.Robot().gravity(b"\0\0")
+
+    def test_the_raw_core_stops_at_the_episodes_end(self):
+        core = testbed.EnvCore(duration=0.002)
+        core.reset(0)
+        core.step(np.zeros(2))
+        *_, truncated, _ = core.step(np.zeros(2))
+        self.assertTrue(truncated)
+        with self.assertRaisesRegex(RuntimeError, "call reset"):
+            core.step(np.zeros(2))
+        core.reset(1)
+        core.step(np.zeros(2))
+
+    def test_dynamics_that_overflow_raise(self):
+        with self.assertRaisesRegex(ValueError, "not finite"):
+            testbed.Robot().coriolis([0.1, 0.2], [1e300, 1e300])
+
+    def test_a_vector_reset_takes_a_list_of_seeds(self):
+        venv = gymnasium.make_vec(ENV, num_envs=3)
+        a, _ = venv.reset(seed=[5, 6, 7])
+        b, _ = venv.reset(seed=5)
+        self.assertTrue(np.array_equal(a, b))
+        with self.assertRaisesRegex(ValueError, "seed must be"):
+            venv.reset(seed=[5, 9, 7])
+
+
+class PolicyFiles(unittest.TestCase):
+    def node(self, path):
+        return subprocess.run([sys.executable, "-m", "testbed.policy_node", "--policy", str(path),
+                               "--describe"], capture_output=True, text=True, timeout=120)
+
+    def test_hostile_policy_files_fail_in_one_line(self):
+        env = {"dof": 2, "obs_dim": 15, "steps": 100, "torque_scale": [1.0, 1.0]}
+        cases = {
+            "shape.npz": dict(weights=np.zeros((2, 3)), bias=np.zeros(2), env=str(env).replace("'", '"')),
+            "rows.npz": dict(weights=np.zeros((3, 15)), bias=np.zeros(3), env=str(env).replace("'", '"')),
+            "nan.npz": dict(weights=np.full((2, 15), np.nan), bias=np.zeros(2),
+                            env=str(env).replace("'", '"')),
+            "steps.npz": dict(weights=np.zeros((2, 15)), bias=np.zeros(2),
+                              env=str({**env, "steps": 0}).replace("'", '"')),
+            "law.npz": dict(weights=np.zeros((2, 15)), bias=np.zeros(2),
+                            env=str({**env, "base_law": "rm -rf"}).replace("'", '"')),
+            "string.npz": dict(weights=np.zeros((2, 15)), bias=np.zeros(2), env='"dof obs_dim"'),
+            "pickle.npz": dict(weights=np.array([object()], dtype=object), bias=np.zeros(2),
+                               env="{}"),
+        }
+        with tempfile.TemporaryDirectory() as tmp:
+            garbage = Path(tmp) / "garbage.npz"
+            garbage.write_bytes(b"not a zip file")
+            paths = [garbage]
+            for name, arrays in cases.items():
+                path = Path(tmp) / name
+                np.savez(path, **arrays)
+                paths.append(path)
+            for path in paths:
+                out = self.node(path)
+                self.assertNotEqual(out.returncode, 0, path.name)
+                self.assertIn(f"testbed.policy_node: {path}:", out.stderr, path.name)
+                self.assertNotIn("Traceback", out.stderr, f"{path.name}: {out.stderr}")
+
+    def test_a_good_policy_file_describes_itself(self):
+        p = LinearPolicy.zeros(2, 15, {"dof": 2, "obs_dim": 15, "steps": 100,
+                                        "torque_scale": [1.0, 1.0], "base_law": "pd"})
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "ok.npz"
+            p.save(path)
+            out = self.node(path)
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertIn('"name": "policy"', out.stdout)
+
+
+if __name__ == "__main__":
+    unittest.main()
