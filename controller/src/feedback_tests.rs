@@ -189,6 +189,10 @@ fn smc_by_hand_inside_the_boundary_layer() {
     f.step(&input, &mut d);
     let want = [-3.0 * 0.02 - 2.0 * 0.4, -3.0 * 0.04 - 2.0 * 0.8];
     for i in 0..2 {
-        assert!((d.tau[i] - want[i]).abs() < 1e-12, "{:?} vs {want:?}", d.tau);
+        assert!(
+            (d.tau[i] - want[i]).abs() < 1e-12,
+            "{:?} vs {want:?}",
+            d.tau
+        );
     }
 }

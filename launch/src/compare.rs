@@ -40,8 +40,9 @@ pub const DEFAULT_LAWS: [LawName; 9] = [
     LawName::Smc,
 ];
 
-/// The most seeds per law `compare` runs (each run's summary is kept);
-/// more is a sweep's job.
+/// The most seeds per law `compare` runs: each run's summary is kept, and a
+/// table of medians and intervals needs far fewer; a larger study is a
+/// sweep, which streams its results.
 pub const MAX_SEEDS: u64 = 10_000;
 
 /// Why a comparison could not be made.

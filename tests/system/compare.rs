@@ -2,7 +2,7 @@
 
 use crate::util::{assert_same_csv, fails, json, ok, testbed};
 
-const LAWS: [&str; 9] = [
+const LAWS: [&str; 10] = [
     "nac",
     "nac-no-shift",
     "nac-no-critic",
@@ -12,6 +12,7 @@ const LAWS: [&str; 9] = [
     "pd-gravity",
     "ctc",
     "ppc",
+    "smc",
 ];
 
 /// The summary's own keys (a report flattens them beside its own).

@@ -11,9 +11,6 @@ use launch::compare::{self, CompareOptions, Comparison, METRICS};
 
 use super::args::{CompareArgs, ScenarioArgs};
 
-/// Seeds per law `compare` takes: a table of medians and intervals needs
-/// far fewer; a larger study is a sweep, which streams its results.
-
 pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     if args.seeds == 0 {
         bail!("--seeds 0: compare needs at least one seed");

@@ -150,6 +150,21 @@ class Laws(unittest.TestCase):
                            _kc_dot(rows["t"][k]))
             assert_bits(self, tau, rows["tau"][k], f"tau at step {k}")
 
+    def test_smc_is_its_formula(self):
+        """The sliding-mode law recomputed in numpy from a run's measured
+        states (BASELINES §2), independently of the Rust code."""
+        k1, k2, ks, phi = 15.0, 15.0, 2.0, 0.05
+        rows, _ = testbed.sim(law="smc", duration=3.0, set={"plant.sensor.q_noise_std": 1e-4})
+        e = rows["q_measured"] - rows["q_d"]
+        ed = rows["qd_measured"] - rows["qd_d"]
+        s = ed + k1 * e
+        tau = -k2 * s - ks * np.clip(s / phi, -1.0, 1.0)
+        self.assertTrue(np.allclose(tau, rows["tau"], rtol=1e-12, atol=1e-12),
+                        np.abs(tau - rows["tau"]).max())
+        # Both of the law's regimes were exercised: the linear layer and the switch.
+        inside = np.abs(s) < phi
+        self.assertTrue(inside.any() and not inside.all())
+
     def test_pd_is_its_formula(self):
         law = testbed.Law("pd", params={"k1": 4.0, "k2": 3.0})
         q, qd = np.array([0.2, -0.1]), np.array([0.5, 0.25])
