@@ -26,6 +26,8 @@ pub struct Feedback {
     v: Vec<f64>,
     /// `smc`'s switching gain k_s and boundary layer φ.
     smc: (f64, f64),
+    /// `cbf-ctc`: T_c (the filter acts from then on) and the rate λ.
+    cbf: (f64, f64),
 }
 
 impl Feedback {
@@ -68,6 +70,7 @@ impl Feedback {
             model,
             v: vec![0.0; dof],
             smc: (params.smc_gain, params.smc_boundary),
+            cbf: (params.tc, params.cbf_rate),
         })
     }
 
@@ -76,7 +79,8 @@ impl Feedback {
         if !begin_plain_step(input, self.n, out) {
             return;
         }
-        if self.kind == FeedbackKind::Ctc && self.ctc_gains.is_none() {
+        let computed_torque = matches!(self.kind, FeedbackKind::Ctc | FeedbackKind::CbfCtc);
+        if computed_torque && self.ctc_gains.is_none() {
             self.ctc_gains = Some(self.matched_ctc_gains(input.q_d));
         }
         for i in 0..self.n {
@@ -94,11 +98,11 @@ impl Feedback {
             // K_p = K1 K2, K_d = K2 (pd); ctc's K_p', K_d' from `ctc_gains`.
             let (k1, k2) = (self.k1[i], self.k2[i]);
             match (self.kind, &self.ctc_gains) {
-                (FeedbackKind::Ctc, Some((kp, kd))) => {
+                (FeedbackKind::Ctc | FeedbackKind::CbfCtc, Some((kp, kd))) => {
                     self.v[i] = input.qdd_d[i] - kd[i] * ed - kp[i] * e
                 }
                 // Unreachable: the gains are set above.
-                (FeedbackKind::Ctc, None) => self.v[i] = 0.0,
+                (FeedbackKind::Ctc | FeedbackKind::CbfCtc, None) => self.v[i] = 0.0,
                 (FeedbackKind::Pd | FeedbackKind::PdGravity, _) => {
                     out.tau_feedback[i] = -k1 * k2 * e - k2 * ed
                 }
@@ -112,8 +116,39 @@ impl Feedback {
                 }
             }
         }
+        if self.kind == FeedbackKind::CbfCtc && input.t >= self.cbf.0 {
+            self.cbf_filter(input);
+        }
         self.model_terms(input, out);
         end_plain_step(out);
+    }
+
+    /// The CBF–QP safety filter (BASELINES §3) on `ctc`'s commanded
+    /// accelerations: with u_i = v_i − q̈_d,i = ë_i and h_i = k_c,i² − e_i²,
+    /// min Σ (u_i − u_nom,i)² subject to ḧ_i + 2λ ḣ_i + λ² h_i ≥ 0, i.e.
+    /// 2 e_i u_i ≤ b_i = 2k̇_c,i² − 2ė_i² + 2λ ḣ_i + λ² h_i (k̈_c taken as 0:
+    /// the reference sample carries k_c and k̇_c only). The QP separates per
+    /// joint, so its solution is the nominal u clipped at b_i / (2 e_i); at
+    /// e_i = 0 the constraint does not involve u_i and u_i stays nominal.
+    fn cbf_filter(&mut self, input: &ControllerInput<'_>) {
+        let lambda = self.cbf.1;
+        for i in 0..self.n {
+            let e = input.q[i] - input.q_d[i];
+            let ed = input.qd[i] - input.qd_d[i];
+            let (k, kd) = (input.kc[i], input.kc_dot[i]);
+            let h = k * k - e * e;
+            let hd = 2.0 * k * kd - 2.0 * e * ed;
+            let b = 2.0 * kd * kd - 2.0 * ed * ed + 2.0 * lambda * hd + lambda * lambda * h;
+            let u_nom = self.v[i] - input.qdd_d[i];
+            let u = if e > 0.0 {
+                u_nom.min(b / (2.0 * e))
+            } else if e < 0.0 {
+                u_nom.max(b / (2.0 * e))
+            } else {
+                u_nom
+            };
+            self.v[i] = input.qdd_d[i] + u;
+        }
     }
 
     /// Matched `ctc` gains: `pd`'s joint i obeys m_i ë + K2 ė + K1 K2 e ≈ 0,
@@ -148,14 +183,14 @@ impl Feedback {
             (FeedbackKind::PdGravity, Some(m)) => {
                 out.tau_model.copy_from_slice(m.gravity(input.q));
             }
-            (FeedbackKind::Ctc, Some(m)) => {
+            (FeedbackKind::Ctc | FeedbackKind::CbfCtc, Some(m)) => {
                 out.tau_model
                     .copy_from_slice(m.inverse(input.q, input.qd, &self.v));
                 out.tau_feedback.iter_mut().for_each(|x| *x = 0.0);
             }
             // `new` refuses a model-based law without a model.
             (FeedbackKind::Pd | FeedbackKind::Smc, _)
-            | (FeedbackKind::PdGravity | FeedbackKind::Ctc, None) => {
+            | (FeedbackKind::PdGravity | FeedbackKind::Ctc | FeedbackKind::CbfCtc, None) => {
                 out.tau_model.iter_mut().for_each(|x| *x = 0.0)
             }
         }

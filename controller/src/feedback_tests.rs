@@ -196,3 +196,33 @@ fn smc_by_hand_inside_the_boundary_layer() {
         );
     }
 }
+
+// cbf-ctc from T_c on (T_c = 0.5, t = 1), λ = 20, k_c = 0.5, k̇_c = 0;
+// ctc's as-given gains K_p' = K1 K2 = [6, 12], K_d' = K1 + K2 = [5, 7].
+// Joint 1: e = 0.3 inside: u_nom = −5·0.5 − 6·0.3 = −4.3, bound
+// b/(2e) = (−0.5 − 12 + 64)/0.6 = 85.83: the filter leaves it.
+// Joint 2: e = −0.6 outside: u_nom = 10.5 + 7.2 = 17.7, b = −4.5 − 72 − 44
+// = −120.5, bound −120.5/−1.2 = 100.4167 > u_nom: u is raised to it.
+#[test]
+fn cbf_ctc_by_hand_filters_only_the_joint_that_needs_it() {
+    let model = ArmModel::from_urdf_str(TWO_LINK_URDF).unwrap();
+    let p = ControllerParams {
+        tc: 0.5,
+        ..params(LawName::CbfCtc)
+    };
+    let mut f = new_feedback(&p, 2, Some(&model)).unwrap();
+    let mut d = Diagnostics::new(2);
+    f.step(&input(), &mut d);
+    let v = [QDD_D[0] - 4.3, QDD_D[1] + 120.5 / 1.2];
+    let want = Dynamics::new(&model, 1.0).inverse(&Q, &QD, &v).to_vec();
+    for i in 0..2 {
+        assert!((d.tau[i] - want[i]).abs() < 1e-9, "{:?} vs {want:?}", d.tau);
+    }
+    // Before T_c it is ctc.
+    let mut ctc = new_feedback(&params(LawName::Ctc), 2, Some(&model)).unwrap();
+    let mut cbf = new_feedback(&params(LawName::CbfCtc), 2, Some(&model)).unwrap();
+    let (mut a, mut b) = (Diagnostics::new(2), Diagnostics::new(2));
+    ctc.step(&input(), &mut a);
+    cbf.step(&input(), &mut b);
+    assert_eq!(a.tau, b.tau);
+}

@@ -42,6 +42,8 @@ law_names! {
     Ppc,
     /// Sliding mode control with a boundary layer (model-free).
     Smc,
+    /// Computed torque through a CBF–QP safety filter on |e| < k_c (model-based).
+    CbfCtc,
 }
 
 /// Which parts of the paper's law run (its ablations and `blf` switch
@@ -69,6 +71,9 @@ pub enum FeedbackKind {
     Ctc,
     /// `smc`: sliding mode with a boundary layer (model-free).
     Smc,
+    /// `cbf-ctc`: `ctc` through a control-barrier-function filter
+    /// (model-based).
+    CbfCtc,
 }
 
 /// How a law is built and stepped. Every choice between laws goes through
@@ -198,6 +203,11 @@ impl LawName {
                 kind: LawKind::Feedback(FeedbackKind::Smc),
                 keys: &["smc_gain", "smc_boundary"],
             },
+            LawName::CbfCtc => LawDecl {
+                name: "cbf-ctc",
+                kind: LawKind::Feedback(FeedbackKind::CbfCtc),
+                keys: &["model_scale", "tuning", "cbf_rate"],
+            },
         }
     }
 
@@ -215,7 +225,7 @@ impl LawName {
     pub fn model_based(self) -> bool {
         matches!(
             self.kind(),
-            LawKind::Feedback(FeedbackKind::PdGravity | FeedbackKind::Ctc)
+            LawKind::Feedback(FeedbackKind::PdGravity | FeedbackKind::Ctc | FeedbackKind::CbfCtc)
         )
     }
 

@@ -126,6 +126,9 @@ pub struct ControllerParams {
     /// 0.05: the switch is linear for |s| < φ, which keeps it from
     /// chattering at a 1 ms period).
     pub smc_boundary: f64,
+    /// `cbf-ctc`: the filter's rate λ, 1/s: h = k_c² − e² obeys
+    /// ḧ + 2λ ḣ + λ² h ≥ 0, a double pole at −λ (default: 20).
+    pub cbf_rate: f64,
     /// `ctc`, `ppc`: how K1, K2 become the law's gains (default:
     /// "as-given"; "matched" matches `pd`'s error dynamics). Unwritten at
     /// its default so that existing scenarios keep their identity.
@@ -162,6 +165,7 @@ impl Default for ControllerParams {
             rho2_inf: 4.0,
             smc_gain: 2.0,
             smc_boundary: 0.05,
+            cbf_rate: 20.0,
             tuning: Tuning::AsGiven,
         }
     }
@@ -206,6 +210,7 @@ impl ControllerParams {
             ("rho2_inf", self.rho2_inf, Positive),
             ("smc_gain", self.smc_gain, NonNegative),
             ("smc_boundary", self.smc_boundary, Positive),
+            ("cbf_rate", self.cbf_rate, Positive),
         ];
         for (key, value, bound) in checks {
             let (ok, need) = match bound {
@@ -278,6 +283,7 @@ impl ControllerParams {
             ("rho2_inf", self.rho2_inf != d.rho2_inf),
             ("smc_gain", self.smc_gain != d.smc_gain),
             ("smc_boundary", self.smc_boundary != d.smc_boundary),
+            ("cbf_rate", self.cbf_rate != d.cbf_rate),
             ("tuning", self.tuning != d.tuning),
         ];
         changed
@@ -340,6 +346,7 @@ impl ControllerParams {
             rho2_inf,
             smc_gain,
             smc_boundary,
+            cbf_rate,
             tuning
         );
         p

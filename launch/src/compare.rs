@@ -26,9 +26,9 @@ use analysis::summary::{Summary, SummaryBuilder};
 use analysis::timing::Percentiles;
 
 /// The laws `compare` runs when none are named: the paper's law, its
-/// ablations, the classic barrier law, PD, computed torque, PPC and
-/// sliding mode.
-pub const DEFAULT_LAWS: [LawName; 9] = [
+/// ablations, the classic barrier law, PD, computed torque, PPC, sliding
+/// mode and computed torque through a CBF filter.
+pub const DEFAULT_LAWS: [LawName; 10] = [
     LawName::Nac,
     LawName::NacNoShift,
     LawName::NacNoCritic,
@@ -38,6 +38,7 @@ pub const DEFAULT_LAWS: [LawName; 9] = [
     LawName::Ctc,
     LawName::Ppc,
     LawName::Smc,
+    LawName::CbfCtc,
 ];
 
 /// The most seeds per law `compare` runs: each run's summary is kept, and a

@@ -2,7 +2,7 @@
 
 use crate::util::{assert_same_csv, fails, json, ok, testbed};
 
-const LAWS: [&str; 10] = [
+const LAWS: [&str; 11] = [
     "nac",
     "nac-no-shift",
     "nac-no-critic",
@@ -13,6 +13,7 @@ const LAWS: [&str; 10] = [
     "ctc",
     "ppc",
     "smc",
+    "cbf-ctc",
 ];
 
 /// The summary's own keys (a report flattens them beside its own).

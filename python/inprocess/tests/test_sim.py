@@ -165,6 +165,39 @@ class Laws(unittest.TestCase):
         inside = np.abs(s) < phi
         self.assertTrue(inside.any() and not inside.all())
 
+    def test_cbf_ctc_is_its_formula(self):
+        """The CBF–QP filter over computed torque recomputed in numpy
+        (BASELINES §3) with the engine's M and h = C q̇ + G, on a run whose
+        envelope is tight enough for the filter to act."""
+        # A fast filter (λ = 60) against ctc's poles at −15: it binds
+        # while the error, outside the envelope at T_c, comes back.
+        kc, tc, lam = 0.05, 0.1, 60.0
+        rows, _ = testbed.sim(law="cbf-ctc", duration=2.0, set={
+            "controller.law": "cbf-ctc", "controller.tc": tc, "controller.cbf_rate": lam,
+            "plant.saturate": False,
+            "envelope.joints": [{"offset": kc}, {"offset": kc}]})
+        robot = testbed.Robot()
+        t = rows["t"]
+        qdd_d = np.stack([-4.0 * np.sin(2.0 * t), -np.cos(t)], axis=1)  # scenarios/paper.toml
+        kp, kd = 15.0 * 15.0, 15.0 + 15.0
+        acted = 0
+        for k in range(len(t)):
+            q, qd = rows["q_measured"][k], rows["qd_measured"][k]
+            e, ed = q - rows["q_d"][k], qd - rows["qd_d"][k]
+            u = -kd * ed - kp * e
+            if t[k] >= tc:
+                h, hd = kc * kc - e * e, -2.0 * e * ed
+                b = -2.0 * ed * ed + 2.0 * lam * hd + lam * lam * h
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    bound = b / (2.0 * e)
+                filtered = np.where(e > 0, np.minimum(u, bound), np.where(e < 0, np.maximum(u, bound), u))
+                acted += int(np.any(filtered != u))
+                u = filtered
+            tau = robot.mass_matrix(q) @ (qdd_d[k] + u) + robot.bias(q, qd)
+            self.assertTrue(np.allclose(tau, rows["tau"][k], rtol=1e-9, atol=1e-9),
+                            (k, tau, rows["tau"][k]))
+        self.assertGreater(acted, 0, "the filter acted on some step")
+
     def test_pd_is_its_formula(self):
         law = testbed.Law("pd", params={"k1": 4.0, "k2": 3.0})
         q, qd = np.array([0.2, -0.1]), np.array([0.5, 0.25])
