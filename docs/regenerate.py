@@ -131,7 +131,7 @@ def compare_page() -> str:
         "after T_c unless marked. Per scenario two tables: the laws' textbook",
         "gains (`as-given`) and the matching rule of",
         "[baselines.md §6](../baselines.md#6-the-matching-rule) (`--tuning matched`:",
-        "every law with `pd`'s error dynamics; it changes `ctc` and `ppc`).",
+        "every law with `pd`'s error dynamics; it changes `ctc`, `cbf-ctc` and `ppc`).",
         "",
     ]
     for name in COMPARED:

@@ -117,7 +117,8 @@ impl Feedback {
             }
         }
         if self.kind == FeedbackKind::CbfCtc && input.t >= self.cbf.0 {
-            self.cbf_filter(input);
+            // The filter clipping is the law's guard acting: a breach step.
+            out.barrier_breached = self.cbf_filter(input);
         }
         self.model_terms(input, out);
         end_plain_step(out);
@@ -130,8 +131,10 @@ impl Feedback {
     /// the reference sample carries k_c and k̇_c only). The QP separates per
     /// joint, so its solution is the nominal u clipped at b_i / (2 e_i); at
     /// e_i = 0 the constraint does not involve u_i and u_i stays nominal.
-    fn cbf_filter(&mut self, input: &ControllerInput<'_>) {
+    /// Returns whether it clipped any joint.
+    fn cbf_filter(&mut self, input: &ControllerInput<'_>) -> bool {
         let lambda = self.cbf.1;
+        let mut clipped = false;
         for i in 0..self.n {
             let e = input.q[i] - input.q_d[i];
             let ed = input.qd[i] - input.qd_d[i];
@@ -147,8 +150,10 @@ impl Feedback {
             } else {
                 u_nom
             };
+            clipped |= u != u_nom;
             self.v[i] = input.qdd_d[i] + u;
         }
+        clipped
     }
 
     /// Matched `ctc` gains: `pd`'s joint i obeys m_i ë + K2 ė + K1 K2 e ≈ 0,

@@ -218,6 +218,10 @@ fn cbf_ctc_by_hand_filters_only_the_joint_that_needs_it() {
     for i in 0..2 {
         assert!((d.tau[i] - want[i]).abs() < 1e-9, "{:?} vs {want:?}", d.tau);
     }
+    assert!(
+        d.barrier_breached,
+        "the filter clipped joint 2: a breach step"
+    );
     // Before T_c it is ctc.
     let mut ctc = new_feedback(&params(LawName::Ctc), 2, Some(&model)).unwrap();
     let mut cbf = new_feedback(&params(LawName::CbfCtc), 2, Some(&model)).unwrap();

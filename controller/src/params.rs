@@ -40,11 +40,11 @@ pub enum RbfLayout {
     PerInput,
 }
 
-/// How `ctc` and `ppc` turn K1, K2 into their own gains (BASELINES.md §6).
+/// How `ctc`, `cbf-ctc` and `ppc` turn K1, K2 into their own gains (BASELINES.md §6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Tuning {
-    /// The textbook mapping: `ctc` poles at −K1, −K2; `ppc` k1 = K1, k2 = K2.
+    /// The textbook mapping: `ctc` and `cbf-ctc` poles at −K1, −K2; `ppc` k1 = K1, k2 = K2.
     #[default]
     AsGiven,
     /// The matching rule: each law's error dynamics near e = 0 are `pd`'s
@@ -129,7 +129,7 @@ pub struct ControllerParams {
     /// `cbf-ctc`: the filter's rate λ, 1/s: h = k_c² − e² obeys
     /// ḧ + 2λ ḣ + λ² h ≥ 0, a double pole at −λ (default: 20).
     pub cbf_rate: f64,
-    /// `ctc`, `ppc`: how K1, K2 become the law's gains (default:
+    /// `ctc`, `cbf-ctc`, `ppc`: how K1, K2 become the law's gains (default:
     /// "as-given"; "matched" matches `pd`'s error dynamics). Unwritten at
     /// its default so that existing scenarios keep their identity.
     #[serde(skip_serializing_if = "is_default")]

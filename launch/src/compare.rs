@@ -184,7 +184,7 @@ pub struct Comparison {
     pub wall_time_s: f64,
     /// One row per law.
     pub laws: Vec<LawRow>,
-    /// The first law against each other law on the same seeds (with two
+    /// The baseline (nac, else the first law) against each other law on the same seeds (with two
     /// seeds or more).
     pub paired: Vec<Paired>,
     /// What this says about the paper's claims ([`crate::compare_findings`]).
@@ -196,7 +196,7 @@ pub struct Comparison {
     pub random_effects: Vec<String>,
 }
 
-/// A paired test of the first law against another on one metric.
+/// A paired test of the baseline (nac, else the first law) against another on one metric.
 #[derive(Debug, Clone, Serialize)]
 pub struct Paired {
     /// The baseline: `nac` when it runs, else the first row, whatever the

@@ -254,7 +254,8 @@ pub fn execute(spec: &RunSpec, stop: &AtomicBool) -> Option<ResultLine> {
         cell: cell_json(&spec.cell),
         status: status.into(),
         reason,
-        kept_envelope: status == "ok" && run.summary.constraint_satisfied_after_tc,
+        // The comparison's rule: the envelope fact, whatever the status.
+        kept_envelope: run.envelope == compare::Envelope::Kept,
         metrics,
         summary: serde_json::to_value(&run.summary).unwrap_or(serde_json::Value::Null),
     })

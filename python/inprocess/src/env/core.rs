@@ -214,7 +214,13 @@ impl ArmEnv {
         ep.r = reference_at(&mut ep.reference, &ep.state);
         self.observe(obs);
         let finite = stepped.is_ok() && obs.iter().all(|v| v.is_finite());
-        self.outcome(finite)
+        let out = self.outcome(finite);
+        // An envelope at zero makes e/k_c infinite: that state is no better.
+        if out.reward.is_finite() {
+            out
+        } else {
+            self.outcome(false)
+        }
     }
 
     fn outcome(&self, finite: bool) -> Outcome {

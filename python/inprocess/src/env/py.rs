@@ -230,6 +230,9 @@ pub struct VecEnvCore {
     n: usize,
     obs: Vec<f64>,
     out: Vec<Outcome>,
+    /// The actions, copied out of the caller's array before the GIL is
+    /// released (another thread may write that array meanwhile).
+    actions: Vec<f64>,
 }
 
 #[pymethods]
@@ -267,6 +270,7 @@ impl VecEnvCore {
         Ok(Self {
             obs: vec![0.0; num_envs * envs.obs_dim()],
             out: vec![Outcome::default(); num_envs],
+            actions: vec![0.0; num_envs * n],
             envs,
             n,
         })
@@ -313,7 +317,8 @@ impl VecEnvCore {
             .as_slice()
             .map_err(|_| PyValueError::new_err("actions: must be C-contiguous"))?;
         check_finite(a, Some(self.n))?;
-        let (envs, obs, out) = (&mut self.envs, &mut self.obs, &mut self.out);
+        self.actions.copy_from_slice(a);
+        let (envs, obs, out, a) = (&mut self.envs, &mut self.obs, &mut self.out, &self.actions);
         py.detach(|| envs.step(a, obs, out)).map_err(err)?;
         let pick = |f: fn(&Outcome) -> f64| -> Vec<f64> { self.out.iter().map(f).collect() };
         let flag = |f: fn(&Outcome) -> bool| -> Vec<bool> { self.out.iter().map(f).collect() };
