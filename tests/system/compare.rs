@@ -62,7 +62,7 @@ fn every_law_in_lockstep_equals_its_sim_bit_for_bit() {
         }
         assert_eq!(run["law"]["law"], law);
         assert_eq!(sim["law"]["law"], law);
-        let model_based = matches!(law, "pd-gravity" | "ctc");
+        let model_based = matches!(law, "pd-gravity" | "ctc" | "cbf-ctc");
         assert_eq!(run["law"]["model_based"], model_based, "{law}");
     }
 }
