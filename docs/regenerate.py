@@ -40,7 +40,7 @@ SCENARIOS = [
     "iiwa_csv",
 ]
 ARMS = ["two_link", "three_link_planar", "ur5", "iiwa14", "panda", "xarm7", "so101", "z1"]
-LAWS = "nac,nac-no-shift,nac-no-critic,nac-no-networks,blf,pd,pd-gravity,ctc,ppc,smc,cbf-ctc"
+LAWS = "nac,nac-no-shift,nac-no-critic,nac-no-networks,blf,pd,pd-gravity,ctc,ppc,smc,cbf-ctc,mpc"
 COMPARED = ["paper", "payload_pickup", "actuation_delay", "paper_per_input"]
 
 
@@ -131,7 +131,7 @@ def compare_page() -> str:
         "after T_c unless marked. Per scenario two tables: the laws' textbook",
         "gains (`as-given`) and the matching rule of",
         "[baselines.md §6](../baselines.md#6-the-matching-rule) (`--tuning matched`:",
-        "every law with `pd`'s error dynamics; it changes `ctc`, `cbf-ctc` and `ppc`).",
+        "every law with `pd`'s error dynamics; it changes `ctc`, `cbf-ctc`, `mpc` and `ppc`).",
         "",
     ]
     for name in COMPARED:
@@ -183,7 +183,7 @@ FINDINGS = [
     ("paper_randomised", 20, ["controller.k1=3.75", "controller.k2=3.75"]),
     ("ur5_randomised", 20, []),
 ]
-FINDINGS_LAWS = "nac,nac-no-shift,nac-no-networks,blf,pd,pd-gravity,ctc"
+FINDINGS_LAWS = "nac,nac-no-shift,nac-no-networks,blf,pd,pd-gravity,ctc,smc,cbf-ctc,mpc"
 
 
 def findings_page() -> str:

@@ -20,7 +20,7 @@ pub const FAMILY: &str = "sans-serif";
 /// More points than a figure can show only make SVGs large.
 const MAX_POINTS: usize = 4000;
 /// The palette, one colour per joint or law.
-pub const COLORS: [RGBColor; 9] = [
+pub const COLORS: [RGBColor; 11] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -30,6 +30,8 @@ pub const COLORS: [RGBColor; 9] = [
     RGBColor(227, 119, 194),
     RGBColor(127, 127, 127),
     RGBColor(188, 189, 34),
+    RGBColor(0, 0, 0),
+    RGBColor(174, 199, 232),
 ];
 
 /// One curve.

@@ -9,7 +9,7 @@ use crate::ppc::Ppc;
 use crate::{Controller, ControllerError, ControllerInput, ControllerParams, Diagnostics};
 
 /// One of the laws of BASELINES.md, ready to step.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub enum Law {
     /// `nac`, its ablations and `blf`: the paper's law with parts switched off.
     Nac(Box<Controller>),

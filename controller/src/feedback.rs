@@ -7,11 +7,12 @@ use arm_model::ArmModel;
 use arm_model::dynamics::Dynamics;
 
 use crate::law_table::FeedbackKind;
+use crate::mpc::{ErrorMpc, MpcInput, Weights};
 use crate::nac::{begin_plain_step, end_plain_step};
 use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Tuning};
 
-/// `pd`, `smc`, `pd-gravity` or `ctc` for n joints.
-#[derive(Debug, Clone)]
+/// `pd`, `smc`, `pd-gravity`, `ctc`, `cbf-ctc` or `mpc` for n joints.
+#[derive(Debug)]
 pub struct Feedback {
     kind: FeedbackKind,
     n: usize,
@@ -28,6 +29,13 @@ pub struct Feedback {
     smc: (f64, f64),
     /// `cbf-ctc`: T_c (the filter acts from then on) and the rate λ.
     cbf: (f64, f64),
+    /// `mpc`: T_c, the horizon N and step h; its QP, built at the first
+    /// step from `ctc_gains`.
+    mpc: (f64, usize, f64),
+    qp: Option<Box<ErrorMpc>>,
+    /// Scratch for `mpc`: e and ė.
+    e: Vec<f64>,
+    ed: Vec<f64>,
 }
 
 impl Feedback {
@@ -71,6 +79,10 @@ impl Feedback {
             v: vec![0.0; dof],
             smc: (params.smc_gain, params.smc_boundary),
             cbf: (params.tc, params.cbf_rate),
+            mpc: (params.tc, params.mpc_horizon, params.mpc_step),
+            qp: None,
+            e: vec![0.0; dof],
+            ed: vec![0.0; dof],
         })
     }
 
@@ -79,7 +91,10 @@ impl Feedback {
         if !begin_plain_step(input, self.n, out) {
             return;
         }
-        let computed_torque = matches!(self.kind, FeedbackKind::Ctc | FeedbackKind::CbfCtc);
+        let computed_torque = matches!(
+            self.kind,
+            FeedbackKind::Ctc | FeedbackKind::CbfCtc | FeedbackKind::Mpc
+        );
         if computed_torque && self.ctc_gains.is_none() {
             self.ctc_gains = Some(self.matched_ctc_gains(input.q_d));
         }
@@ -103,6 +118,8 @@ impl Feedback {
                 }
                 // Unreachable: the gains are set above.
                 (FeedbackKind::Ctc | FeedbackKind::CbfCtc, None) => self.v[i] = 0.0,
+                // v comes from the QP below.
+                (FeedbackKind::Mpc, _) => (self.e[i], self.ed[i]) = (e, ed),
                 (FeedbackKind::Pd | FeedbackKind::PdGravity, _) => {
                     out.tau_feedback[i] = -k1 * k2 * e - k2 * ed
                 }
@@ -119,6 +136,13 @@ impl Feedback {
         if self.kind == FeedbackKind::CbfCtc && input.t >= self.cbf.0 {
             // The filter clipping is the law's guard acting: a breach step.
             out.barrier_breached = self.cbf_filter(input);
+        }
+        if self.kind == FeedbackKind::Mpc {
+            match self.mpc_inputs(input) {
+                Some(breached) => out.barrier_breached = breached,
+                // No finite torque: the step's end publishes the fault.
+                None => self.v.iter_mut().for_each(|v| *v = f64::NAN),
+            }
         }
         self.model_terms(input, out);
         end_plain_step(out);
@@ -156,6 +180,36 @@ impl Feedback {
         clipped
     }
 
+    /// `mpc` (BASELINES §4): v = q̈_d + u with u the QP's first input per
+    /// joint; the QP is built at the first step, when `ctc`'s gains (and
+    /// so its weights) are known. Returns whether the envelope could not
+    /// be held, or None if the QP cannot be built (a Riccati equation that
+    /// does not settle: the law cannot give a finite torque).
+    fn mpc_inputs(&mut self, input: &ControllerInput<'_>) -> Option<bool> {
+        if self.qp.is_none() {
+            let (kp, kd) = self.ctc_gains.as_ref()?;
+            let weights: Vec<Weights> = kp
+                .iter()
+                .zip(kd)
+                .map(|(&p, &d)| Weights::matching(p, d))
+                .collect();
+            let (tc, horizon, h) = self.mpc;
+            self.qp = Some(Box::new(ErrorMpc::new(&weights, horizon, h, tc).ok()?));
+        }
+        let qp = self.qp.as_mut()?;
+        let (u, breached) = qp.solve(&MpcInput {
+            t: input.t,
+            e: &self.e,
+            ed: &self.ed,
+            kc: input.kc,
+            kc_dot: input.kc_dot,
+        });
+        for ((v, a), u) in self.v.iter_mut().zip(input.qdd_d).zip(u) {
+            *v = a + u;
+        }
+        Some(breached)
+    }
+
     /// Matched `ctc` gains: `pd`'s joint i obeys m_i ë + K2 ė + K1 K2 e ≈ 0,
     /// so K_p' = K1 K2 / m_i and K_d' = K2 / m_i give the same poles, with
     /// m_i = 1 / (M⁻¹)_ii (the joint's effective inertia) at `q`, from the
@@ -188,16 +242,20 @@ impl Feedback {
             (FeedbackKind::PdGravity, Some(m)) => {
                 out.tau_model.copy_from_slice(m.gravity(input.q));
             }
-            (FeedbackKind::Ctc | FeedbackKind::CbfCtc, Some(m)) => {
+            (FeedbackKind::Ctc | FeedbackKind::CbfCtc | FeedbackKind::Mpc, Some(m)) => {
                 out.tau_model
                     .copy_from_slice(m.inverse(input.q, input.qd, &self.v));
                 out.tau_feedback.iter_mut().for_each(|x| *x = 0.0);
             }
             // `new` refuses a model-based law without a model.
             (FeedbackKind::Pd | FeedbackKind::Smc, _)
-            | (FeedbackKind::PdGravity | FeedbackKind::Ctc | FeedbackKind::CbfCtc, None) => {
-                out.tau_model.iter_mut().for_each(|x| *x = 0.0)
-            }
+            | (
+                FeedbackKind::PdGravity
+                | FeedbackKind::Ctc
+                | FeedbackKind::CbfCtc
+                | FeedbackKind::Mpc,
+                None,
+            ) => out.tau_model.iter_mut().for_each(|x| *x = 0.0),
         }
         for i in 0..n {
             out.tau[i] = out.tau_model[i] + out.tau_feedback[i];

@@ -44,6 +44,8 @@ law_names! {
     Smc,
     /// Computed torque through a CBF–QP safety filter on |e| < k_c (model-based).
     CbfCtc,
+    /// Constrained linear MPC on the error dynamics, |e| ≤ k_c (model-based).
+    Mpc,
 }
 
 /// Which parts of the paper's law run (its ablations and `blf` switch
@@ -74,6 +76,9 @@ pub enum FeedbackKind {
     /// `cbf-ctc`: `ctc` through a control-barrier-function filter
     /// (model-based).
     CbfCtc,
+    /// `mpc`: computed torque whose error input comes from a constrained
+    /// linear MPC (model-based).
+    Mpc,
 }
 
 /// How a law is built and stepped. Every choice between laws goes through
@@ -208,6 +213,11 @@ impl LawName {
                 kind: LawKind::Feedback(FeedbackKind::CbfCtc),
                 keys: &["model_scale", "tuning", "cbf_rate"],
             },
+            LawName::Mpc => LawDecl {
+                name: "mpc",
+                kind: LawKind::Feedback(FeedbackKind::Mpc),
+                keys: &["model_scale", "tuning", "mpc_horizon", "mpc_step"],
+            },
         }
     }
 
@@ -225,7 +235,12 @@ impl LawName {
     pub fn model_based(self) -> bool {
         matches!(
             self.kind(),
-            LawKind::Feedback(FeedbackKind::PdGravity | FeedbackKind::Ctc | FeedbackKind::CbfCtc)
+            LawKind::Feedback(
+                FeedbackKind::PdGravity
+                    | FeedbackKind::Ctc
+                    | FeedbackKind::CbfCtc
+                    | FeedbackKind::Mpc
+            )
         )
     }
 

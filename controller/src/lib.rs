@@ -38,6 +38,7 @@ mod feedback;
 mod gain;
 mod law_table;
 mod machine;
+mod mpc;
 mod nac;
 pub mod node;
 mod params;
@@ -52,7 +53,9 @@ pub use gain::Gain;
 pub use law_table::{BarrierParts, FeedbackKind, LawDecl, LawKind, LawName};
 pub use machine::ControllerMachine;
 pub use nac::{Controller, ControllerInput, barrier_lyapunov};
-pub use params::{BarrierMode, ControllerParams, Integrator, MAX_NEURONS, RbfLayout, Tuning};
+pub use params::{
+    BarrierMode, ControllerParams, Integrator, MAX_MPC_HORIZON, MAX_NEURONS, RbfLayout, Tuning,
+};
 pub use ppc::{Ppc, XI_LIMIT};
 pub use rbf::Rbf;
 pub use shifting::shifting;

@@ -9,7 +9,7 @@ use arm_model::ArmModel;
 use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Fault, Law};
 
 /// The law behind wire messages.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct ControllerMachine {
     law: Law,
     diag: Diagnostics,

@@ -40,11 +40,11 @@ pub enum RbfLayout {
     PerInput,
 }
 
-/// How `ctc`, `cbf-ctc` and `ppc` turn K1, K2 into their own gains (BASELINES.md §6).
+/// How `ctc`, `cbf-ctc`, `mpc` and `ppc` turn K1, K2 into their own gains (BASELINES.md §6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Tuning {
-    /// The textbook mapping: `ctc` and `cbf-ctc` poles at −K1, −K2; `ppc` k1 = K1, k2 = K2.
+    /// The textbook mapping: `ctc`, `cbf-ctc` and `mpc` poles at −K1, −K2; `ppc` k1 = K1, k2 = K2.
     #[default]
     AsGiven,
     /// The matching rule: each law's error dynamics near e = 0 are `pd`'s
@@ -129,7 +129,15 @@ pub struct ControllerParams {
     /// `cbf-ctc`: the filter's rate λ, 1/s: h = k_c² − e² obeys
     /// ḧ + 2λ ḣ + λ² h ≥ 0, a double pole at −λ (default: 20).
     pub cbf_rate: f64,
-    /// `ctc`, `cbf-ctc`, `ppc`: how K1, K2 become the law's gains (default:
+    /// `mpc`: prediction steps N (default: 10; with `mpc_step` a 0.1 s
+    /// look-ahead for the envelope, 1.5 time constants of the default
+    /// gains' error dynamics; beyond it the terminal cost is the infinite
+    /// horizon's, so N sets only how far ahead the envelope is seen).
+    pub mpc_horizon: usize,
+    /// `mpc`: the prediction step h, s (default: 0.01: ten control periods
+    /// at 1 kHz; the QP is still solved every period).
+    pub mpc_step: f64,
+    /// `ctc`, `cbf-ctc`, `mpc`, `ppc`: how K1, K2 become the law's gains (default:
     /// "as-given"; "matched" matches `pd`'s error dynamics). Unwritten at
     /// its default so that existing scenarios keep their identity.
     #[serde(skip_serializing_if = "is_default")]
@@ -166,6 +174,8 @@ impl Default for ControllerParams {
             smc_gain: 2.0,
             smc_boundary: 0.05,
             cbf_rate: 20.0,
+            mpc_horizon: 10,
+            mpc_step: 0.01,
             tuning: Tuning::AsGiven,
         }
     }
@@ -175,6 +185,10 @@ impl Default for ControllerParams {
 /// allocated (the paper uses 10; the per-input layout has this many per
 /// input, 4n inputs for the actor).
 pub const MAX_NEURONS: usize = 1000;
+
+/// The longest `mpc` horizon, in prediction steps: the QP grows with it
+/// and must be solved within a control period.
+pub const MAX_MPC_HORIZON: usize = 200;
 
 /// What a value must satisfy; written so that NaN fails every check.
 enum Bound {
@@ -211,6 +225,7 @@ impl ControllerParams {
             ("smc_gain", self.smc_gain, NonNegative),
             ("smc_boundary", self.smc_boundary, Positive),
             ("cbf_rate", self.cbf_rate, Positive),
+            ("mpc_step", self.mpc_step, Positive),
         ];
         for (key, value, bound) in checks {
             let (ok, need) = match bound {
@@ -238,6 +253,13 @@ impl ControllerParams {
                 key: "controller.neurons".into(),
                 value: self.neurons.to_string(),
                 need: format!("from 1 to {MAX_NEURONS}"),
+            });
+        }
+        if !(1..=MAX_MPC_HORIZON).contains(&self.mpc_horizon) {
+            return Err(ControllerError::InvalidParameter {
+                key: "controller.mpc_horizon".into(),
+                value: self.mpc_horizon.to_string(),
+                need: format!("from 1 to {MAX_MPC_HORIZON}"),
             });
         }
         self.check_keys_belong()?;
@@ -284,6 +306,8 @@ impl ControllerParams {
             ("smc_gain", self.smc_gain != d.smc_gain),
             ("smc_boundary", self.smc_boundary != d.smc_boundary),
             ("cbf_rate", self.cbf_rate != d.cbf_rate),
+            ("mpc_horizon", self.mpc_horizon != d.mpc_horizon),
+            ("mpc_step", self.mpc_step != d.mpc_step),
             ("tuning", self.tuning != d.tuning),
         ];
         changed
@@ -347,6 +371,8 @@ impl ControllerParams {
             smc_gain,
             smc_boundary,
             cbf_rate,
+            mpc_horizon,
+            mpc_step,
             tuning
         );
         p

@@ -27,8 +27,8 @@ use analysis::timing::Percentiles;
 
 /// The laws `compare` runs when none are named: the paper's law, its
 /// ablations, the classic barrier law, PD, computed torque, PPC, sliding
-/// mode and computed torque through a CBF filter.
-pub const DEFAULT_LAWS: [LawName; 10] = [
+/// mode, computed torque through a CBF filter and the constrained MPC.
+pub const DEFAULT_LAWS: [LawName; 11] = [
     LawName::Nac,
     LawName::NacNoShift,
     LawName::NacNoCritic,
@@ -39,6 +39,7 @@ pub const DEFAULT_LAWS: [LawName; 10] = [
     LawName::Ppc,
     LawName::Smc,
     LawName::CbfCtc,
+    LawName::Mpc,
 ];
 
 /// The most seeds per law `compare` runs: each run's summary is kept, and a

@@ -13,7 +13,9 @@
 //!    envelope before T_c; holds when every such run was inside for good by
 //!    T_c and did not fail.
 //! 3. *Keeping it where another law does not* (against each law without a
-//!    barrier that runs: `pd`, `pd-gravity`, `ctc`), seed by seed: holds
+//!    barrier that runs: `pd`, `pd-gravity`, `ctc`; and, as its own claim,
+//!    against the baselines a reviewer asks for: `smc`, and the
+//!    constrained model-based `cbf-ctc` and `mpc`), seed by seed: holds
 //!    when on some seed `nac` kept the envelope and the other left it, and
 //!    on none the reverse; does not hold when on some seed the other kept it
 //!    and `nac` left it; not tested when no seed separates them.
@@ -87,22 +89,26 @@ pub fn findings(c: &Comparison) -> Vec<Finding> {
     };
     let mut out = vec![inside(c, nac), outside(c, nac)];
     for other in [LawName::Pd, LawName::PdGravity, LawName::Ctc] {
-        out.push(separates(c, nac, other));
+        out.push(separates(c, nac, other, CLAIMS[2]));
     }
     for other in [LawName::Pd, LawName::Blf] {
         out.push(better(c, nac, other, "effort_beyond_gravity", CLAIMS[3]));
     }
     out.push(better(c, nac, LawName::Pd, "energy_after_tc", CLAIMS[3]));
     out.push(better(c, nac, LawName::NacNoNetworks, "iae", CLAIMS[4]));
+    for other in [LawName::Smc, LawName::CbfCtc, LawName::Mpc] {
+        out.push(separates(c, nac, other, CLAIMS[5]));
+    }
     out
 }
 
-const CLAIMS: [&str; 5] = [
+const CLAIMS: [&str; 6] = [
     "nac keeps |e| < k_c after T_c",
     "nac may start outside the envelope and is inside by T_c",
     "nac keeps the envelope on seeds where a law without a barrier leaves it",
     "nac uses less effort after T_c",
     "the actor-critic lowers the error after T_c",
+    "nac keeps the envelope on seeds where a reviewer's baseline leaves it",
 ];
 
 fn row(c: &Comparison, law: LawName) -> Option<&LawRow> {
@@ -215,8 +221,8 @@ fn outside(c: &Comparison, nac: &LawRow) -> Finding {
 }
 
 /// `nac` against `other`, seed by seed, on keeping the envelope (claim 3).
-fn separates(c: &Comparison, nac: &LawRow, other: LawName) -> Finding {
-    let claim = format!("{} (vs {other})", CLAIMS[2]);
+fn separates(c: &Comparison, nac: &LawRow, other: LawName, claim: &str) -> Finding {
+    let claim = format!("{claim} (vs {other})");
     let Some(o) = row(c, other) else {
         return Finding {
             claim,
@@ -378,7 +384,7 @@ mod tests {
     fn the_paper_scenario_starts_outside_and_keeps_the_envelope() {
         let c = run(vec![LawName::Nac, LawName::Pd]);
         let f = findings(&c);
-        assert_eq!(f.len(), 9);
+        assert_eq!(f.len(), 12);
         assert!(f[7].claim.contains("energy_after_tc"), "{:?}", f[7]);
         assert_eq!(f[0].verdict, Verdict::Holds, "{:?}", f[0]);
         assert!(f[0].evidence.contains("pd: kept 1, left 0"), "{:?}", f[0]);
@@ -386,8 +392,9 @@ mod tests {
         assert!(f[1].evidence.contains("outside before T_c = 2 s on 1 of 1"));
         // Both keep it: no seed separates them.
         assert_eq!(f[2].verdict, Verdict::NotTested, "{:?}", f[2]);
-        // pd-gravity, ctc, blf and nac-no-networks were not run.
-        for k in [3, 4, 6, 8] {
+        // pd-gravity, ctc, blf, nac-no-networks, smc, cbf-ctc and mpc
+        // were not run.
+        for k in [3, 4, 6, 8, 9, 10, 11] {
             assert_eq!(f[k].verdict, Verdict::NotTested, "{:?}", f[k]);
         }
         assert!(f[5].evidence.contains("vs pd"), "{:?}", f[5]);

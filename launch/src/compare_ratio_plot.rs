@@ -1,6 +1,6 @@
 //! `compare_error_ratio`: |e_i| / k_c,i after T_c, one small panel per law
 //! on one shared scale, so that errors of 0.03 rad are visible (on the ±k_c
-//! scale they are a flat line) and ten laws do not overlap. The envelope
+//! scale they are a flat line) and eleven laws do not overlap. The envelope
 //! is the line at 1; a failed law's title says so.
 
 use std::path::Path;

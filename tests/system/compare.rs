@@ -2,7 +2,7 @@
 
 use crate::util::{assert_same_csv, fails, json, ok, testbed};
 
-const LAWS: [&str; 11] = [
+const LAWS: [&str; 12] = [
     "nac",
     "nac-no-shift",
     "nac-no-critic",
@@ -14,6 +14,7 @@ const LAWS: [&str; 11] = [
     "ppc",
     "smc",
     "cbf-ctc",
+    "mpc",
 ];
 
 /// The summary's own keys (a report flattens them beside its own).
@@ -62,7 +63,7 @@ fn every_law_in_lockstep_equals_its_sim_bit_for_bit() {
         }
         assert_eq!(run["law"]["law"], law);
         assert_eq!(sim["law"]["law"], law);
-        let model_based = matches!(law, "pd-gravity" | "ctc" | "cbf-ctc");
+        let model_based = matches!(law, "pd-gravity" | "ctc" | "cbf-ctc" | "mpc");
         assert_eq!(run["law"]["model_based"], model_based, "{law}");
     }
 }

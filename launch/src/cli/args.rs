@@ -291,7 +291,7 @@ pub(crate) struct CompareArgs {
     /// Write the comparison figures (PNG and SVG) here.
     #[arg(long, value_name = "DIR")]
     pub(crate) plots: Option<PathBuf>,
-    /// How ctc, cbf-ctc and ppc turn K1, K2 into their gains: `matched` gives every
+    /// How ctc, cbf-ctc, mpc and ppc turn K1, K2 into their gains: `matched` gives every
     /// law pd's error dynamics near e = 0 (docs/baselines.md §6)
     /// [default: the scenario's, as-given unless it says otherwise].
     #[arg(long, value_name = "RULE", value_parser = ["as-given", "matched"])]

@@ -1,5 +1,6 @@
 """`testbed.sim` and `testbed.compare` against the CLI, and robots' dynamics."""
 
+import itertools
 import tempfile
 import unittest
 from pathlib import Path
@@ -198,12 +199,101 @@ class Laws(unittest.TestCase):
                             (k, tau, rows["tau"][k]))
         self.assertGreater(acted, 0, "the filter acted on some step")
 
+    def test_mpc_is_its_qp(self):
+        """`mpc` (BASELINES §3) re-derived in numpy from a whole run: each
+        joint's QP posed in the original variables and condensed (the law
+        poses it scaled and sparse), solved exactly by active-set
+        enumeration (the law uses clarabel's interior point), then
+        τ = M (q̈_d + u₀) + C q̇ + G with the engine's M and h."""
+        kc, tc, horizon, h = 0.02, 0.1, 4, 0.01
+        rows, _ = testbed.sim(law="mpc", duration=1.5, set={
+            "controller.law": "mpc", "controller.tc": tc, "controller.mpc_horizon": horizon,
+            "plant.saturate": False,
+            "envelope.joints": [{"offset": kc}, {"offset": kc}]})
+        robot = testbed.Robot()
+        t = rows["t"]
+        qdd_d = np.stack([-4.0 * np.sin(2.0 * t), -np.cos(t)], axis=1)  # scenarios/paper.toml
+        kp, kd = 15.0 * 15.0, 15.0 + 15.0
+        qp = _CondensedMpc(kp, kd, h, horizon)
+        active = 0
+        for k in range(0, len(t), 3):
+            q, qd = rows["q_measured"][k], rows["qd_measured"][k]
+            e, ed = q - rows["q_d"][k], qd - rows["qd_d"][k]
+            u = np.zeros(2)
+            for i in range(2):
+                bounds = [kc if t[k] + j * h >= tc else None for j in range(1, horizon + 1)]
+                u[i], n_active = qp.solve(e[i], ed[i], bounds)
+                active += n_active > 0
+            tau = robot.mass_matrix(q) @ (qdd_d[k] + u) + robot.bias(q, qd)
+            self.assertTrue(np.allclose(tau, rows["tau"][k], rtol=1e-4, atol=1e-4),
+                            (k, tau, rows["tau"][k]))
+        self.assertGreater(active, 10, "the envelope constrained some steps")
+
     def test_pd_is_its_formula(self):
         law = testbed.Law("pd", params={"k1": 4.0, "k2": 3.0})
         q, qd = np.array([0.2, -0.1]), np.array([0.5, 0.25])
         tau = law.step(0.0, q, qd, np.zeros(2), np.zeros(2), np.zeros(2), np.ones(2), np.zeros(2))
         self.assertTrue(np.allclose(tau, -4.0 * 3.0 * q - 3.0 * qd))
         self.assertEqual(law.params["k1"], 4.0)
+
+
+class _CondensedMpc:
+    """One joint's MPC QP of BASELINES §3 in the original variables:
+    minimise ½ Σ_{j<N} x_jᵀ Q x_j h + ½ x_Nᵀ P x_N + ½ Σ u_k² h over
+    u₀…u_{N−1}, x_j = A^j x₀ + Σ A^{j−1−k} B u_k, |e_j| ≤ k_j."""
+
+    def __init__(self, kp, kd, h, horizon):
+        self.h, self.n = h, horizon
+        a = np.array([[1.0, h], [0.0, 1.0]])
+        b = np.array([[0.5 * h * h], [h]])
+        q = np.diag([kp * kp, max(kd * kd - 2.0 * kp, 0.0)]) * h
+        r = np.array([[h]])
+        p = q.copy()
+        for _ in range(100000):  # the discrete Riccati equation
+            gain = np.linalg.solve(r + b.T @ p @ b, b.T @ p @ a)
+            nxt = q + a.T @ p @ a - a.T @ p @ b @ gain
+            if np.max(np.abs(nxt - p)) <= 1e-14 * np.max(np.abs(nxt)):
+                p = nxt
+                break
+            p = nxt
+        phi = np.vstack([np.linalg.matrix_power(a, j) for j in range(1, horizon + 1)])
+        gamma = np.zeros((2 * horizon, horizon))
+        for j in range(1, horizon + 1):
+            for k in range(j):
+                gamma[2 * (j - 1):2 * j, k] = (np.linalg.matrix_power(a, j - 1 - k) @ b)[:, 0]
+        qbar = np.zeros((2 * horizon, 2 * horizon))
+        for j in range(1, horizon):
+            qbar[2 * (j - 1):2 * j, 2 * (j - 1):2 * j] = q
+        qbar[-2:, -2:] = p
+        self.hess = gamma.T @ qbar @ gamma + h * np.eye(horizon)
+        self.lin = gamma.T @ qbar @ phi
+        self.pos, self.phi_e = gamma[0::2, :], phi[0::2, :]
+
+    def solve(self, e, ed, bounds):
+        """u₀ and the number of active constraints: the KKT point of the
+        smallest active set that is feasible with multipliers ≥ 0 (unique:
+        the QP is strictly convex)."""
+        x0 = np.array([e, ed])
+        f = self.lin @ x0
+        rows, rhs = [], []
+        for j, k in enumerate(bounds):
+            if k is not None:
+                free = self.phi_e[j] @ x0
+                rows += [self.pos[j], -self.pos[j]]
+                rhs += [k - free, k + free]
+        g, w = np.array(rows).reshape(-1, self.n), np.array(rhs)
+        for size in range(len(rhs) + 1):
+            for subset in itertools.combinations(range(len(rhs)), size):
+                ga = g[list(subset)]
+                kkt = np.block([[self.hess, ga.T], [ga, np.zeros((size, size))]])
+                try:
+                    sol = np.linalg.solve(kkt, np.concatenate([-f, w[list(subset)]]))
+                except np.linalg.LinAlgError:
+                    continue
+                u, lam = sol[:self.n], sol[self.n:]
+                if np.all(lam >= -1e-9) and np.all(g @ u <= w + 1e-9):
+                    return u[0], size
+        raise AssertionError("no KKT point found")
 
 
 def _kc_dot(t):
