@@ -189,7 +189,7 @@ fn plan_from(contents: &LogContents) -> Result<(Plan, Mode), AnalysisError> {
     let toml = get("scenario_toml")?;
     let label = format!("{} (testbed.run scenario_toml)", path.display());
     let mut scenario =
-        Scenario::from_toml_str(toml, &label).map_err(|e| meta_err(path, e.to_string()))?;
+        Scenario::from_log_toml(toml, &label).map_err(|e| meta_err(path, e.to_string()))?;
     // The robot is the attached URDF, wherever the original file was.
     scenario.robot = None;
     let robot = match &contents.urdf {

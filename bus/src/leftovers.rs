@@ -20,17 +20,44 @@ fn folders() -> Vec<PathBuf> {
         .collect()
 }
 
+/// How long the scan of /proc may take before the run's files are kept.
+const SCAN_LIMIT: std::time::Duration = std::time::Duration::from_secs(2);
+
 /// Whether a process alive now was started with `--prefix <prefix>`.
+/// Reading a process's `/proc/<pid>/cmdline` takes its memory lock, which
+/// a real-time hog on its CPU can keep for as long as it runs: the scan
+/// runs beside the caller and, past [`SCAN_LIMIT`], counts as "in use"
+/// (the files stay; nothing waits on it).
 fn prefix_in_use(prefix: &RunPrefix) -> bool {
-    let Ok(entries) = std::fs::read_dir("/proc") else {
-        return true;
-    };
-    entries.flatten().any(|e| {
-        let cmdline = std::fs::read(e.path().join("cmdline")).unwrap_or_default();
-        cmdline
-            .split(|b| *b == 0)
-            .any(|arg| arg == prefix.as_str().as_bytes())
+    let wanted = prefix.as_str().as_bytes().to_vec();
+    within(SCAN_LIMIT, true, move || {
+        let Ok(entries) = std::fs::read_dir("/proc") else {
+            return true;
+        };
+        entries.flatten().any(|e| {
+            let cmdline = std::fs::read(e.path().join("cmdline")).unwrap_or_default();
+            cmdline.split(|b| *b == 0).any(|arg| arg == wanted)
+        })
     })
+}
+
+/// `f()` if it returns within `limit`, else `otherwise` (the thread running
+/// `f` is left to end on its own).
+fn within<T: Send + 'static>(
+    limit: std::time::Duration,
+    otherwise: T,
+    f: impl FnOnce() -> T + Send + 'static,
+) -> T {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let spawned = std::thread::Builder::new()
+        .name("leftover-scan".into())
+        .spawn(move || {
+            let _ = tx.send(f());
+        });
+    match spawned {
+        Ok(_) => rx.recv_timeout(limit).unwrap_or(otherwise),
+        Err(_) => otherwise,
+    }
 }
 
 /// The files below `dir` (one level of folders deep, as iceoryx2 keeps
@@ -104,5 +131,25 @@ impl RunPrefix {
             }
         }
         removed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// #39 row 9: a scan that never returns (a cmdline read blocked by a
+    /// real-time hog) is given up after the limit, keeping the files.
+    #[test]
+    fn a_scan_that_hangs_is_given_up() {
+        let (_keep, blocked) = std::sync::mpsc::channel::<()>();
+        let start = std::time::Instant::now();
+        let r = within(std::time::Duration::from_millis(50), true, move || {
+            let _ = blocked.recv();
+            false
+        });
+        assert!(r, "a hung scan counts as in use");
+        assert!(start.elapsed() < std::time::Duration::from_secs(30));
+        assert!(!within(SCAN_LIMIT, true, || false));
     }
 }

@@ -41,6 +41,14 @@ fn run(
     out: &Path,
     compression: logger::LogCompression,
 ) -> Result<(), logger::LogError> {
+    // A scratch file of this benchmark: each run replaces it (the logger
+    // itself never overwrites a log).
+    if out.is_file() {
+        std::fs::remove_file(out).map_err(|cause| logger::LogError::Io {
+            path: out.display().to_string(),
+            cause,
+        })?;
+    }
     let mut log = LogWriter::create_with(out, &RunMetadata::default(), "", compression)?;
     for k in 0..steps {
         let t = k as f64 * 1e-3;

@@ -87,6 +87,7 @@ struct Channel {
     schema_id: u16,
     topic: String,
     encoding: String,
+    metadata: BTreeMap<String, String>,
     messages: u64,
 }
 
@@ -192,12 +193,13 @@ impl McapOut {
         Ok(id)
     }
 
-    /// Adds a channel (ids from 0).
+    /// Adds a channel (ids from 0) with its metadata.
     pub(crate) fn add_channel(
         &mut self,
         schema_id: u16,
         topic: &str,
         encoding: &str,
+        metadata: &BTreeMap<String, String>,
     ) -> std::io::Result<u16> {
         let id = self.channels.len() as u16;
         let mut b = Body::default();
@@ -205,13 +207,14 @@ impl McapOut {
             .u16(schema_id)
             .str(topic)
             .str(encoding)
-            .map(&BTreeMap::new());
+            .map(metadata);
         self.record(OP_CHANNEL, &b.0)?;
         self.channels.push(Channel {
             id,
             schema_id,
             topic: topic.into(),
             encoding: encoding.into(),
+            metadata: metadata.clone(),
             messages: 0,
         });
         self.index.push(Vec::new());
@@ -431,7 +434,7 @@ impl McapOut {
                     .u16(c.schema_id)
                     .str(&c.topic)
                     .str(&c.encoding)
-                    .map(&BTreeMap::new());
+                    .map(&c.metadata);
                 b
             })
             .collect();

@@ -54,6 +54,36 @@ const HEADER_DEPS: [(&str, &str); 2] = [
     ("builtin_interfaces/Time", TIME),
 ];
 
+/// The QoS a rosbag2 recording gives each topic, as its channel's
+/// `offered_qos_profiles` (YAML, Humble's numeric form, which Jazzy reads
+/// too): reliable, volatile, automatic liveliness, no deadline, lifespan
+/// or lease (the largest durations, rmw's "infinite"). `ros2 bag play`
+/// re-offers each topic with it.
+pub const OFFERED_QOS_PROFILES: &str = "- history: 3
+  depth: 0
+  reliability: 1
+  durability: 2
+  deadline:
+    sec: 2147483647
+    nsec: 4294967295
+  lifespan:
+    sec: 2147483647
+    nsec: 4294967295
+  liveliness: 1
+  liveliness_lease_duration:
+    sec: 2147483647
+    nsec: 4294967295
+  avoid_ros_namespace_conventions: false
+";
+
+/// A channel's metadata as rosbag2 writes it.
+pub fn channel_metadata() -> std::collections::BTreeMap<String, String> {
+    std::collections::BTreeMap::from([(
+        "offered_qos_profiles".to_string(),
+        OFFERED_QOS_PROFILES.to_string(),
+    )])
+}
+
 /// The `testbed_msgs/msg/<Name>` name of a wire message.
 pub fn type_name<M: LogMessage>() -> String {
     format!("{PACKAGE}/msg/{}", msg_name::<M>())
@@ -326,8 +356,10 @@ pub fn tf_message<'a>(
 /// `visualization_msgs/msg/MarkerArray`.
 pub const MARKER_ARRAY: &str = "visualization_msgs/msg/MarkerArray";
 
-/// The schema of [`MARKER_ARRAY`] (the marker of ROS 2 Foxy and Galactic:
-/// no texture fields).
+/// The schema of [`MARKER_ARRAY`]: the marker of ROS 2 Humble and later
+/// (with the texture, UV and mesh-file fields that Foxy's lacks, whose
+/// layout Humble's subscribers cannot read), from
+/// `visualization_msgs/msg/Marker.msg` of ros2/common_interfaces 4.2.
 pub fn marker_array_schema() -> String {
     with_deps(
         "visualization_msgs/Marker[] markers\n",
@@ -340,7 +372,19 @@ pub fn marker_array_schema() -> String {
                  geometry_msgs/Pose pose\ngeometry_msgs/Vector3 scale\nstd_msgs/ColorRGBA color\n\
                  builtin_interfaces/Duration lifetime\nbool frame_locked\n\
                  geometry_msgs/Point[] points\nstd_msgs/ColorRGBA[] colors\n\
-                 string text\nstring mesh_resource\nbool mesh_use_embedded_materials\n",
+                 string texture_resource\nsensor_msgs/CompressedImage texture\n\
+                 visualization_msgs/UVCoordinate[] uv_coordinates\n\
+                 string text\nstring mesh_resource\nvisualization_msgs/MeshFile mesh_file\n\
+                 bool mesh_use_embedded_materials\n",
+            ),
+            (
+                "sensor_msgs/CompressedImage",
+                "std_msgs/Header header\nstring format\nuint8[] data\n",
+            ),
+            ("visualization_msgs/UVCoordinate", "float32 u\nfloat32 v\n"),
+            (
+                "visualization_msgs/MeshFile",
+                "string filename\nuint8[] data\n",
             ),
             (
                 "geometry_msgs/Pose",
@@ -397,8 +441,18 @@ pub fn marker_array(out: &mut Vec<u8>, t_ns: u64, markers: &[Marker]) {
         w.u8(1);
         w.len(0);
         w.len(0);
+        // texture_resource, texture (a CompressedImage: header, format,
+        // data), uv_coordinates: none.
+        w.string("");
+        w.header(0, "");
+        w.string("");
+        w.len(0);
+        w.len(0);
         w.string("");
         w.string("");
+        // mesh_file: filename, data.
+        w.string("");
+        w.len(0);
         w.u8(0);
     }
 }

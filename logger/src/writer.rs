@@ -139,7 +139,7 @@ impl LogWriter {
         compression: LogCompression,
     ) -> Result<Self, LogError> {
         let p = path.display().to_string();
-        let file = File::create(path).map_err(|cause| LogError::Io {
+        let file = open_new(path).map_err(|cause| LogError::Io {
             path: p.clone(),
             cause,
         })?;
@@ -214,7 +214,12 @@ impl LogWriter {
             .map_err(self.err())?;
         let id = self
             .writer
-            .add_channel(schema_id, spec.topic, MESSAGE_ENCODING)
+            .add_channel(
+                schema_id,
+                spec.topic,
+                MESSAGE_ENCODING,
+                &crate::ros2::channel_metadata(),
+            )
             .map_err(self.err())?;
         self.channels.push((spec.topic, id, 0));
         Ok(id)
@@ -291,10 +296,50 @@ impl LogWriter {
     }
 }
 
+/// Opens `path` for a new log: never an existing file (a finished run's
+/// log must not be truncated by a logger started again with its config),
+/// but a device such as /dev/null or /dev/full is written as it is.
+fn open_new(path: &Path) -> std::io::Result<File> {
+    match std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(path)
+    {
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+            let regular = std::fs::metadata(path).is_ok_and(|m| m.is_file());
+            if regular {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::AlreadyExists,
+                    "the file exists: a log is never overwritten (remove it or name another)",
+                ));
+            }
+            std::fs::OpenOptions::new().write(true).open(path)
+        }
+        other => other,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+
+    /// #39 row 3: an existing log is never opened for writing.
+    #[test]
+    fn an_existing_log_is_left_alone() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("run.mcap");
+        std::fs::write(&path, b"a finished run").unwrap();
+        let err = LogWriter::create(&path, &RunMetadata::default(), "<robot/>")
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            err.contains("run.mcap") && err.contains("never overwritten"),
+            "{err}"
+        );
+        assert_eq!(std::fs::read(&path).unwrap(), b"a finished run");
+    }
 
     /// A full disk (#18 row 12): the error says so and names the file,
     /// whether it strikes a record written at once or a compressed chunk.

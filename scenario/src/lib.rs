@@ -225,6 +225,40 @@ impl Scenario {
         Ok(s)
     }
 
+    /// Parses the TOML a log keeps: never reads a file it names (a log is
+    /// data from anyone; its scenario carries its trajectory samples), and
+    /// a trajectory named by file without its samples is an error.
+    pub fn from_log_toml(text: &str, file: &str) -> Result<Self, ScenarioError> {
+        let s: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Toml {
+            file: file.to_string(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        for (key, named, samples) in [
+            (
+                "reference.file",
+                &s.reference.file,
+                s.reference.samples.is_some(),
+            ),
+            (
+                "envelope.file",
+                &s.envelope.file,
+                s.envelope.samples.is_some(),
+            ),
+        ] {
+            if named.is_some() && !samples {
+                return Err(ScenarioError::Toml {
+                    file: file.to_string(),
+                    message: format!(
+                        "{key} names a file but the scenario has none of its samples: \
+                         a log's scenario must carry them (replay never reads files a log names)"
+                    ),
+                });
+            }
+        }
+        s.validate(file)?;
+        Ok(s)
+    }
+
     /// Reads `reference.file` and `envelope.file` (relative to `base`) into
     /// their `samples`, unless they hold samples already.
     pub fn read_trajectory_files(&mut self, base: &Path, file: &str) -> Result<(), ScenarioError> {
@@ -345,6 +379,20 @@ impl Scenario {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// #39 row 4: a log's scenario that names a file is never read from it.
+    #[test]
+    fn a_logs_scenario_never_reads_the_files_it_names() {
+        for key in ["reference", "envelope"] {
+            let text = format!("[{key}]\nfile = \"/etc/passwd\"\n");
+            let e = Scenario::from_log_toml(&text, "log.mcap")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(&format!("{key}.file names a file")), "{e}");
+            assert!(!e.contains("root:"), "{e}");
+        }
+        assert!(Scenario::from_log_toml(PAPER_TOML, "log.mcap").is_ok());
+    }
 
     #[test]
     fn shipped_paper_toml_is_the_default() {

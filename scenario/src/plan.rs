@@ -149,6 +149,22 @@ fn apply_set(
     Ok((text, format!("{source} with {}", said.join(" "))))
 }
 
+/// `text` with its `[controller]` table replaced by `params`.
+fn with_controller(
+    text: &str,
+    source: &str,
+    params: &controller::ControllerParams,
+) -> Result<String, ScenarioError> {
+    let err = |message: String| ScenarioError::Toml {
+        file: source.to_string(),
+        message,
+    };
+    let mut root: toml::Table = toml::from_str(text).map_err(|e| err(e.to_string()))?;
+    let table = toml::Value::try_from(params).map_err(|e| err(e.to_string()))?;
+    root.insert("controller".into(), table);
+    toml::to_string(&root).map_err(|e| err(e.to_string()))
+}
+
 /// Loads a scenario file (or the built-in paper scenario when `path` is
 /// None), applies `overrides`, loads its robot, and checks that they fit.
 pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, ScenarioError> {
@@ -194,6 +210,12 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
     let (mut scenario, toml_text, source) = if overrides.set.is_empty() {
         (scenario, toml_text, source)
     } else {
+        // `--law X --set controller.<X's key>=…`: the law is chosen before
+        // the keys are set, so that X's own keys are X's to set.
+        let toml_text = match overrides.law {
+            Some(law) => with_controller(&toml_text, &source, &scenario.controller.for_law(law))?,
+            None => toml_text,
+        };
         let (text, said) = apply_set(&toml_text, &source, &overrides.set)?;
         // Relative paths in the file stay relative to it.
         let mut s: Scenario = toml::from_str(&text).map_err(|e| ScenarioError::Toml {
@@ -374,4 +396,49 @@ pub fn plan(
         reference_period_ns,
         steps,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn overrides(law: Option<&str>, set: &[&str]) -> Overrides {
+        Overrides {
+            duration_s: None,
+            rate_hz: None,
+            robot: None,
+            law: law.map(|l| l.parse().unwrap()),
+            set: set.iter().map(|s| parse_set(s).unwrap()).collect(),
+        }
+    }
+
+    /// #39 row 15: `--law X --set controller.<X's key>` sets X's key.
+    #[test]
+    fn a_law_chosen_on_the_command_line_takes_its_own_keys() {
+        let plan = load(
+            None,
+            &overrides(
+                Some("mpc"),
+                &["controller.mpc_horizon=5", "controller.k1=10"],
+            ),
+        )
+        .unwrap();
+        let c = &plan.scenario.controller;
+        assert_eq!(c.law, controller::LawName::Mpc);
+        assert_eq!(
+            (c.mpc_horizon, c.k1.clone()),
+            (5, controller::Gain::All(10.0))
+        );
+        // The paper's own keys are gone, as without --set.
+        assert_eq!(c.beta, controller::ControllerParams::default().beta);
+        // A key the law does not take is still refused, by name.
+        let e = load(None, &overrides(Some("pd"), &["controller.beta=3"]))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("controller.beta is not a parameter of law 'pd'"),
+            "{e}"
+        );
+    }
 }

@@ -5,6 +5,7 @@
 mod compare;
 mod hardening;
 mod hardening3;
+mod hardening4;
 mod leftovers;
 mod light_arms;
 mod live;

@@ -27,15 +27,6 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     if args.threads == Some(0) {
         bail!("--threads 0: compare needs at least one thread");
     }
-    // Refuse an unwritable CSV before the runs, not after them.
-    let csv = match &args.csv {
-        Some(path) => Some((
-            path,
-            std::fs::File::create(path)
-                .with_context(|| format!("cannot create CSV file {}", path.display()))?,
-        )),
-        None => None,
-    };
     let common = ScenarioArgs {
         scenario: args.scenario.clone(),
         robot: args.robot.clone(),
@@ -46,6 +37,19 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
         set: args.set.clone(),
     };
     let plan = super::load(&common, None)?;
+    // Refuse an unwritable CSV, or one that is an input, before the runs.
+    let csv = match &args.csv {
+        Some(path) => {
+            let inputs = super::outputs::plan_inputs(args.scenario.as_deref(), &plan);
+            super::outputs::refuse_input("--csv", path, &inputs)?;
+            Some((
+                path,
+                std::fs::File::create(path)
+                    .with_context(|| format!("cannot create CSV file {}", path.display()))?,
+            ))
+        }
+        None => None,
+    };
     if args.controller_cmd.is_empty() {
         super::no_external(&plan, "compare")?;
     }

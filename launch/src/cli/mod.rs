@@ -3,6 +3,7 @@
 mod args;
 mod bench;
 mod compare;
+mod outputs;
 mod replay;
 mod robot;
 mod run;

@@ -11,6 +11,9 @@ use super::print_report;
 use analysis::report::Report;
 
 pub(crate) fn replay(args: ReplayArgs) -> Result<ExitCode> {
+    if let Some(path) = &args.csv {
+        super::outputs::refuse_input("--csv", path, std::slice::from_ref(&args.log))?;
+    }
     let mut csv = match &args.csv {
         Some(path) => {
             Some(BufWriter::new(File::create(path).with_context(|| {

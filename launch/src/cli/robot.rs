@@ -39,6 +39,7 @@ pub fn describe(path: &Path) -> Result<String> {
 /// Writes the default scenario for the arm at `path` to `out` as TOML,
 /// naming the URDF by its absolute path so the file runs from anywhere.
 pub fn write_scenario(path: &Path, out: &Path) -> Result<()> {
+    super::outputs::refuse_input("--write-scenario", out, &[path.to_path_buf()])?;
     let robot = RobotSource::from_file(path, &Locks::new())?;
     let mut s = scenario::Scenario::for_arm(&robot.urdf).map_err(|cause| {
         scenario::ScenarioError::Plant {

@@ -13,6 +13,10 @@ use analysis::report::Report;
 
 pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
     let plan = load(&args.common, args.rate)?;
+    if let Some(path) = &args.common.csv {
+        let inputs = super::outputs::plan_inputs(args.common.scenario.as_deref(), &plan);
+        super::outputs::refuse_input("--csv", path, &inputs)?;
+    }
     let source = plan.source.clone();
     let opts = RunOptions {
         plan: plan.clone(),

@@ -18,8 +18,10 @@ pub(crate) fn sim(args: SimArgs) -> Result<ExitCode> {
     let args = args.common;
     let plan = load(&args, None)?;
     super::no_external(&plan, "sim")?;
+    let inputs = super::outputs::plan_inputs(args.scenario.as_deref(), &plan);
     let mut csv = match &args.csv {
         Some(path) => {
+            super::outputs::refuse_input("--csv", path, &inputs)?;
             let file = File::create(path)
                 .with_context(|| format!("cannot create CSV file {}", path.display()))?;
             let mut w = BufWriter::new(file);

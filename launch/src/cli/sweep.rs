@@ -136,6 +136,7 @@ fn run(a: SweepRunArgs) -> Result<ExitCode> {
 fn report_cmd(a: SweepReportArgs) -> Result<ExitCode> {
     let r = report::report(&a.dir).with_context(|| format!("reading {}", a.dir.display()))?;
     if let Some(path) = &a.csv {
+        super::outputs::refuse_input("--csv", path, &super::outputs::files_in(&a.dir))?;
         std::fs::write(path, report::csv(&r))
             .with_context(|| format!("writing {}", path.display()))?;
     }

@@ -163,6 +163,12 @@ pub fn run(
     if let Some(e) = lock(&first_error).take() {
         return Err(e);
     }
+    // #39 row 16: a folder removed after the last line was written is as
+    // lost as one removed before it.
+    if let Some(w) = lock(&writer).as_ref() {
+        w.check_still_there()?;
+    }
+    results::read_manifest(dir)?;
     let ran = *lock(&ran);
     Ok(RunOutcome {
         total: sweep.runs.len(),

@@ -189,7 +189,7 @@ impl ResultWriter {
     /// Whether the file written to is still the one at its path: a results
     /// folder removed (or replaced) while the sweep ran once left every
     /// result in an unlinked file and the sweep said "results in …".
-    fn check_still_there(&self) -> Result<(), SweepError> {
+    pub fn check_still_there(&self) -> Result<(), SweepError> {
         use std::os::unix::fs::MetadataExt;
         let same = match (std::fs::metadata(&self.path), self.file.metadata()) {
             (Ok(on_disk), Ok(open)) => on_disk.dev() == open.dev() && on_disk.ino() == open.ino(),
