@@ -53,7 +53,7 @@ pub enum AnalysisError {
 pub struct Series {
     /// Sim time of each row, s.
     pub t: Vec<f64>,
-    /// Per joint: q, q_d, k_c, q̇, q̇_d, Z1, ‖Ŵa‖, τ (each indexed [joint][row]).
+    /// Per joint: q, q_d, k_c, q̇, q̇_d, Z1, ‖Ŵa‖, τ (each indexed `[joint][row]`).
     pub q: Vec<Vec<f64>>,
     /// q_d.
     pub q_d: Vec<Vec<f64>>,

@@ -1,6 +1,6 @@
 //! A run's figures, from its log alone.
 //!
-//! Where it sits: after the run. The logger wrote `run.mcap`; [`analyse`]
+//! Where it sits: after the run. The logger wrote `run.mcap`; [`analyse()`](crate::analyse::analyse)
 //! reads it back (through `logger`'s reader), rebuilds one row per control
 //! step ([`assemble::RecordAssembler`] → [`record::StepRecord`]), and feeds
 //! the summary ([`summary`]), the CSV ([`csv_out`]), the figures

@@ -43,7 +43,7 @@ pub fn write_config<T: Serialize>(path: &Path, config: &T) -> Result<(), ConfigE
 pub const MAX_CONFIG_BYTES: u64 = 4 * wire::MAX_URDF_BYTES;
 
 /// Reads a config written by [`write_config`]: a regular file of at most
-/// [`MAX_CONFIG_BYTES`] (`/dev/zero` once read until memory ran out).
+/// `MAX_CONFIG_BYTES` (`/dev/zero` once read until memory ran out).
 pub fn read_config<T: DeserializeOwned>(path: &Path) -> Result<T, ConfigError> {
     let p = path.display().to_string();
     let text =

@@ -103,7 +103,7 @@ pub struct LawDecl {
     pub name: &'static str,
     /// How it is built and stepped.
     pub kind: LawKind,
-    /// Its own `[controller]` keys beyond [`COMMON`].
+    /// Its own `[controller]` keys beyond `COMMON`.
     pub keys: &'static [&'static str],
 }
 

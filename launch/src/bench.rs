@@ -136,7 +136,7 @@ pub struct ArmBench {
     pub plant_step_us: f64,
     /// Real time at the scenario rate.
     pub realtime: RealtimeFigures,
-    /// The bare sleep loop over the same window (see [`FloorProbe`]).
+    /// The bare sleep loop over the same window (see `FloorProbe`).
     pub timer_floor: TimerFloor,
     /// Peak resident memory, kB: the in-process loop (this process) and each node.
     pub peak_rss_kb: Vec<(String, u64)>,

@@ -243,7 +243,7 @@ crate::data_message! {
         deadline_misses: u64 => U64,
         /// Wake-ups late by a whole period so far of the timer floor, a
         /// bare sleep loop beside the plant on its CPU and grid
-        /// ([`crate::clock::TimerFloor`]); [`NONE_U64`]: none ran.
+        /// (the timer floor); [`NONE_U64`]: none ran.
         floor_late_wakeups: u64 => U64 | NONE_U64,
     }
 }

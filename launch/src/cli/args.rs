@@ -63,7 +63,7 @@ pub(crate) struct RunArgs {
     /// Folder for run folders.
     #[arg(long, value_name = "DIR", default_value = "runs")]
     pub(crate) runs_dir: PathBuf,
-    /// Name the run's folder (RUNS_DIR/NAME; default: <epoch seconds>-<pid>);
+    /// Name the run's folder (RUNS_DIR/NAME; default: `<epoch seconds>-<pid>`);
     /// refused if it exists.
     #[arg(long, value_name = "NAME", value_parser = parse_run_name)]
     pub(crate) name: Option<String>,
@@ -230,7 +230,7 @@ pub(crate) struct BenchArgs {
 
 #[derive(Debug, Args)]
 pub(crate) struct ReplayArgs {
-    /// The run's MCAP log (runs/<id>/run.mcap).
+    /// The run's MCAP log (`runs/<id>/run.mcap`).
     #[arg(value_name = "FILE.mcap")]
     pub(crate) log: PathBuf,
     /// Print one JSON object instead of a table.

@@ -47,7 +47,7 @@ enum Command {
     Sim(SimArgs),
     /// Run the stack as separate processes over iceoryx2 shared memory.
     ///
-    /// Writes the run's folder under --runs-dir (runs/<id>/ or runs/NAME/
+    /// Writes the run's folder under --runs-dir (`runs/<id>/` or `runs/NAME/`
     /// with --name: scenario.toml, run.mcap, the Foxglove layout, each
     /// node's config and output in nodes/) and prints the summary with a
     /// timing verdict on standard output; node messages go to standard

@@ -24,7 +24,7 @@ pub(crate) struct SweepRunArgs {
     /// The sweep file (TOML).
     #[arg(value_name = "FILE")]
     file: PathBuf,
-    /// Results folder [default: runs/sweep-<name>].
+    /// Results folder (default: `runs/sweep-<name>`).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
     /// Worker threads [default: one per CPU].
@@ -62,7 +62,7 @@ pub(crate) struct SweepSlurmArgs {
     /// The sweep file (TOML).
     #[arg(value_name = "FILE")]
     file: PathBuf,
-    /// Results folder, shared by the tasks [default: runs/sweep-<name>].
+    /// Results folder, shared by the tasks (default: `runs/sweep-<name>`).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
     /// Array tasks [default: one per run, at most 1000].

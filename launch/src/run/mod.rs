@@ -136,7 +136,7 @@ pub fn node_args(
 }
 
 /// Runs the stack to the end; a run the shared-memory transport failed to
-/// connect is started again ([`transport`]).
+/// connect is started again (`transport`).
 pub fn run(opts: RunOptions) -> Result<RunOutcome, RunError> {
     transport::with_retries(&opts, run_once)
 }

@@ -397,7 +397,7 @@ pub fn peak_rss_kb(pid: u32) -> Option<u64> {
 }
 
 /// CPU time of process `pid` so far, ns: the sum over its threads of the
-/// first field of /proc/<pid>/task/<tid>/schedstat (time on a CPU).
+/// first field of `/proc/<pid>/task/<tid>/schedstat` (time on a CPU).
 pub fn cpu_ns(pid: u32) -> Option<u64> {
     let tasks = std::fs::read_dir(format!("/proc/{pid}/task")).ok()?;
     let mut total = 0;

@@ -1,7 +1,7 @@
 //! `testbed sweep`: Monte Carlo and parameter grids, in process on every
 //! core or as a Slurm job array, into a results folder that resumes.
 //!
-//! A sweep file ([`file`]) is expanded into resolved runs, each exactly
+//! A sweep file ([`file`](mod@file)) is expanded into resolved runs, each exactly
 //! what `testbed sim --law L` would run on the scenario with the cell's
 //! values and seed; each run's result is one JSON line keyed by a hash of
 //! its resolved scenario ([`results`]), so an interrupted sweep, or a
