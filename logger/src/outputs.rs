@@ -31,6 +31,12 @@ pub(crate) struct Outputs {
     arm: ArmScene,
     dof: usize,
     names: Vec<String>,
+    /// `/joint_states` names: the controlled joints, then the others.
+    view_names: Vec<String>,
+    /// The joints that are not controlled, as `/joint_states` lists them.
+    others: Vec<OtherJoint>,
+    /// Scratch for the view's position, velocity and effort.
+    view: [Vec<f64>; 3],
     next_transforms_ns: u64,
     next_scene_ns: u64,
     next_state_view_ns: u64,
@@ -51,12 +57,22 @@ impl Outputs {
             log.add_channel_spec(&spec)?;
         }
         log.flush()?;
+        let others = OtherJoint::of(model);
+        let names = model.joint_names();
+        let view_names = names
+            .iter()
+            .cloned()
+            .chain(others.iter().map(|o| o.name.clone()))
+            .collect();
         Ok(Self {
             log,
             live,
             arm: ArmScene::new(model),
             dof: model.dof(),
-            names: model.joint_names(),
+            names,
+            view_names,
+            others,
+            view: Default::default(),
             next_transforms_ns: 0,
             next_scene_ns: 0,
             next_state_view_ns: 0,
@@ -83,16 +99,7 @@ impl Outputs {
         let (t, wall) = (s.header.t_ns, s.header.wall_ns);
         if t >= self.next_state_view_ns {
             self.next_state_view_ns = t.saturating_add(VIEWS_EVERY_NS);
-            let n = (s.dof as usize).min(wire::MAX_DOF);
-            self.buf.clear();
-            crate::ros2::joint_state(
-                &mut self.buf,
-                t,
-                self.names.get(..n).unwrap_or_default(),
-                &s.q[..n],
-                &s.qd[..n],
-                &s.tau_applied[..n],
-            );
+            self.state_view(s);
             self.emit(JOINT_STATES_TOPIC, t, wall)?;
         }
         let q = s.q.get(..self.dof).filter(|_| s.dof as usize == self.dof);
@@ -111,6 +118,34 @@ impl Outputs {
             self.emit(SCENE_TOPIC, t, wall)?;
         }
         Ok(())
+    }
+
+    /// `/joint_states` of `s` into `buf`: the controlled joints, then
+    /// (for a state of this arm's size) the mimic joints where their
+    /// leaders are and the locked joints at their fixed positions, as a
+    /// robot_state_publisher needs every non-fixed joint of the URDF.
+    fn state_view(&mut self, s: &JointState) {
+        let n = (s.dof as usize).min(wire::MAX_DOF);
+        let [pos, vel, eff] = &mut self.view;
+        for v in [&mut *pos, &mut *vel, &mut *eff] {
+            v.clear();
+        }
+        pos.extend_from_slice(&s.q[..n]);
+        vel.extend_from_slice(&s.qd[..n]);
+        eff.extend_from_slice(&s.tau_applied[..n]);
+        let names = if n == self.dof {
+            for o in &self.others {
+                let (p, v) = o.state(&s.q[..n], &s.qd[..n]);
+                pos.push(p);
+                vel.push(v);
+                eff.push(0.0);
+            }
+            &self.view_names[..]
+        } else {
+            self.names.get(..n).unwrap_or_default()
+        };
+        self.buf.clear();
+        crate::ros2::joint_state(&mut self.buf, s.header.t_ns, names, pos, vel, eff);
     }
 
     /// A command: the sample and, when due, its standard view
@@ -156,5 +191,75 @@ impl Outputs {
             stats.extend(live.finish());
         }
         self.log.finish(stats)
+    }
+}
+
+/// A joint of the URDF that is not controlled: where `/joint_states` puts it.
+#[derive(Debug, Clone)]
+struct OtherJoint {
+    name: String,
+    /// Mimic: (leader's column, multiplier, offset); locked: None.
+    mimic: Option<(usize, f64, f64)>,
+    /// A locked joint's position.
+    position: f64,
+}
+
+impl OtherJoint {
+    fn of(model: &ArmModel) -> Vec<Self> {
+        let mimics = model.mimic.iter().map(|m| Self {
+            name: model.joints[m.joint].name.clone(),
+            mimic: Some((m.leader, m.multiplier, m.offset)),
+            position: 0.0,
+        });
+        let locked = model.locked.iter().map(|l| Self {
+            name: l.name.clone(),
+            mimic: None,
+            position: l.position,
+        });
+        mimics.chain(locked).collect()
+    }
+
+    /// Position and velocity given the controlled joints' `q`, `qd`.
+    fn state(&self, q: &[f64], qd: &[f64]) -> (f64, f64) {
+        match self.mimic {
+            Some((leader, k, offset)) => (
+                k * q.get(leader).copied().unwrap_or(f64::NAN) + offset,
+                k * qd.get(leader).copied().unwrap_or(f64::NAN),
+            ),
+            None => (self.position, 0.0),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// #39 row 14: `/joint_states` lists the joints that are not
+    /// controlled too: a mimic finger where its leader is, a locked joint
+    /// at its fixed position.
+    #[test]
+    fn mimic_and_locked_joints_are_in_the_state_view() {
+        let urdf = include_str!("../../robots/panda.urdf");
+        let mut locks = arm_model::Locks::new();
+        locks.insert("panda_joint7".into(), 0.5);
+        let model = ArmModel::from_urdf_str_locked(urdf, &locks).unwrap();
+        let others = OtherJoint::of(&model);
+        let names: Vec<&str> = others.iter().map(|o| o.name.as_str()).collect();
+        assert_eq!(names, ["panda_finger_joint2", "panda_joint7"]);
+        let (n, finger) = (
+            model.dof(),
+            model
+                .joint_names()
+                .iter()
+                .position(|j| j == "panda_finger_joint1")
+                .unwrap(),
+        );
+        let mut q = vec![0.0; n];
+        q[finger] = 0.02;
+        let qd = vec![0.1; n];
+        assert_eq!(others[0].state(&q, &qd), (0.02, 0.1));
+        assert_eq!(others[1].state(&q, &qd), (0.5, 0.0));
     }
 }

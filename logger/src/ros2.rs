@@ -335,16 +335,15 @@ pub fn tf_schema() -> String {
 /// A rigid transform: translation x, y, z and rotation x, y, z, w.
 pub type Pose = ([f64; 3], [f64; 4]);
 
-/// A `tf2_msgs/msg/TFMessage`: each `(child, pose)` in `parent`, stamped `t_ns`.
+/// A `tf2_msgs/msg/TFMessage`: each `(parent, child, pose)`, stamped `t_ns`.
 pub fn tf_message<'a>(
     out: &mut Vec<u8>,
     t_ns: u64,
-    parent: &str,
-    frames: impl ExactSizeIterator<Item = (&'a str, Pose)>,
+    frames: impl ExactSizeIterator<Item = (&'a str, &'a str, Pose)>,
 ) {
     let mut w = CdrWriter::new(out);
     w.len(frames.len());
-    for (child, (t, r)) in frames {
+    for (parent, child, (t, r)) in frames {
         w.header(t_ns, parent);
         w.string(child);
         for x in t.into_iter().chain(r) {

@@ -1,5 +1,7 @@
 //! The arm in 3D for Foxglove's 3D panel and RViz: every link frame as a
-//! `tf2_msgs/msg/TFMessage` (the `/tf` of ROS 2), and a stick figure (a
+//! `tf2_msgs/msg/TFMessage` (the `/tf` of ROS 2) in the URDF's tree (each
+//! link in its parent link's frame, the root in `world`; links that fixed
+//! joints folded into another one included, at their fixed place), and a stick figure (a
 //! cylinder from each link frame to the next joint, a sphere at each joint)
 //! as a `visualization_msgs/msg/MarkerArray` whose markers ride on those
 //! frames. The poses come from the URDF by the same forward kinematics as
@@ -30,9 +32,18 @@ struct Bone {
 pub struct ArmScene {
     dynamics: Dynamics,
     links: Vec<String>,
+    /// Each model link's parent link (None: the root).
+    parents: Vec<Option<usize>>,
+    /// Links folded into another: (name, the link it is part of, its pose
+    /// there).
+    folded: Vec<(String, usize, Isometry3<f64>)>,
     bones: Vec<Bone>,
     radius: f64,
 }
+
+/// One transform of `/tf`: the parent frame, the child frame, the child's
+/// pose in the parent.
+pub type Frame<'a> = (&'a str, &'a str, Pose);
 
 impl ArmScene {
     /// The scene of `model`: a bone from each link frame to each joint it
@@ -58,30 +69,51 @@ impl ArmScene {
         }
         bones.retain(|b| b.to.norm() > 1e-6);
         let longest = bones.iter().map(|b| b.to.norm()).fold(0.0, f64::max);
+        let mut parents = vec![None; model.links.len()];
+        for j in &model.joints {
+            parents[j.child] = Some(j.parent);
+        }
+        let folded = model
+            .merged_links
+            .iter()
+            .map(|m| (m.name.clone(), m.into, iso(&m.origin)))
+            .collect();
         Self {
             dynamics: Dynamics::new(model, 1.0),
             links: model.links.iter().map(|l| l.name.clone()).collect(),
+            parents,
+            folded,
             bones,
             radius: (0.08 * longest).clamp(0.005, 0.05),
         }
     }
 
-    /// Every link's frame in the world at joint positions `q` (one entry
-    /// per controlled joint).
-    pub fn frames(&mut self, q: &[f64]) -> Vec<(&str, Pose)> {
+    /// Every link's frame in its parent's at joint positions `q` (one
+    /// entry per controlled joint): the model's links from their joints,
+    /// then the folded links at their fixed places. A root link named
+    /// `world` is the world frame itself.
+    pub fn frames(&mut self, q: &[f64]) -> Vec<Frame<'_>> {
         let poses = self.dynamics.link_poses(q);
-        self.links
-            .iter()
-            .zip(poses)
-            .map(|(name, pose)| (name.as_str(), parts(pose)))
-            .collect()
+        let mut out: Vec<Frame<'_>> = Vec::with_capacity(self.links.len() + self.folded.len());
+        for (i, name) in self.links.iter().enumerate() {
+            let (parent, pose) = match self.parents[i] {
+                Some(p) => (self.links[p].as_str(), poses[p].inverse() * poses[i]),
+                None if name == WORLD_FRAME => continue,
+                None => (WORLD_FRAME, poses[i]),
+            };
+            out.push((parent, name.as_str(), parts(&pose)));
+        }
+        for (name, into, pose) in &self.folded {
+            out.push((self.links[*into].as_str(), name.as_str(), parts(pose)));
+        }
+        out
     }
 
     /// [`ArmScene::frames`] as a `tf2_msgs/msg/TFMessage` stamped `t_ns`,
     /// appended to `out`.
     pub fn transforms(&mut self, out: &mut Vec<u8>, t_ns: u64, q: &[f64]) {
         let frames = self.frames(q);
-        ros2::tf_message(out, t_ns, WORLD_FRAME, frames.into_iter());
+        ros2::tf_message(out, t_ns, frames.into_iter());
     }
 
     /// The stick figure: per link a sphere at its origin and a cylinder
@@ -161,8 +193,15 @@ mod tests {
         let model = ArmModel::from_urdf_str(arm_model::TWO_LINK_URDF).unwrap();
         let mut scene = ArmScene::new(&model);
         let frames = scene.frames(&[0.0, 0.0]);
-        let elbow = frames.iter().find(|(n, _)| *n == "link2").unwrap();
-        assert!((elbow.1.0[0] - 0.35).abs() < 1e-12);
+        let elbow = frames.iter().find(|(_, n, _)| *n == "link2").unwrap();
+        assert_eq!(elbow.0, "link1");
+        assert!((elbow.2.0[0] - 0.35).abs() < 1e-12);
+        let root = frames.iter().find(|(p, _, _)| *p == WORLD_FRAME).unwrap();
+        assert_eq!(
+            frames.iter().filter(|f| f.0 == WORLD_FRAME).count(),
+            1,
+            "{root:?}"
+        );
         let markers = scene.markers();
         let link2 = markers
             .iter()
@@ -175,5 +214,47 @@ mod tests {
         assert!((c.rotation * Vector3::z() - Vector3::x()).norm() < 1e-12);
         let down = cylinder_pose(Vector3::new(0.0, 0.0, -1.0));
         assert!((down.rotation * Vector3::z() + Vector3::z()).norm() < 1e-12);
+    }
+}
+
+#[cfg(test)]
+mod tree_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn attribute_values(urdf: &str, tag: &str) -> Vec<String> {
+        urdf.split(&format!("<{tag} name=\""))
+            .skip(1)
+            .map(|s| s.split('"').next().unwrap().to_string())
+            .collect()
+    }
+
+    /// #39 row 14: `/tf` is the URDF's whole tree: every link once, each
+    /// in its parent's frame, down from `world`.
+    #[test]
+    fn every_urdf_link_is_a_frame_of_one_tree() {
+        let urdf = include_str!("../../robots/panda.urdf");
+        let model = ArmModel::from_urdf_str(urdf).unwrap();
+        let mut scene = ArmScene::new(&model);
+        let q = vec![0.3; model.dof()];
+        let frames: Vec<(String, String)> = scene
+            .frames(&q)
+            .into_iter()
+            .map(|(p, c, _)| (p.to_string(), c.to_string()))
+            .collect();
+        let mut children: Vec<&str> = frames.iter().map(|f| f.1.as_str()).collect();
+        children.sort_unstable();
+        let mut links = attribute_values(urdf, "link");
+        links.retain(|l| l != WORLD_FRAME);
+        links.sort_unstable();
+        assert_eq!(children, links);
+        // Every parent is the world or another frame: one connected tree.
+        for (parent, child) in &frames {
+            assert!(
+                parent == WORLD_FRAME || frames.iter().any(|f| &f.1 == parent),
+                "{child}'s parent {parent} is no frame"
+            );
+        }
+        assert_eq!(frames.iter().filter(|f| f.0 == WORLD_FRAME).count(), 1);
     }
 }
