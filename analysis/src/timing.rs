@@ -272,6 +272,13 @@ impl Verdict {
 /// shows about one in three thousand (docs: performance).
 pub const LATE_WAKEUPS_EXPLAINED: f64 = 1e-3;
 
+/// A plant wake-up this late (real time) is a stall, named in the verdict
+/// whatever it did to the figures: 50 ms is 50 steps at 1 kHz without
+/// real time, where the bench's bare sleep loop on this project's 2-CPU VM
+/// stays within a period (docs: performance). One such wake-up is one late
+/// wake-up to the count above, which the timer floor may explain.
+pub const STALL_NS: f64 = 50e6;
+
 /// Plant wake-ups late by a whole period that the timer floor beside it
 /// explains: up to 1.5 times the floor's own, plus 2.
 pub fn explained_by_floor(floor_late: u64) -> u64 {
@@ -365,6 +372,15 @@ pub fn judge(t: &mut TimingSummary, facts: &RunFacts<'_>) {
             ))
         }
         _ => {}
+    }
+    let worst_ns = t.wake_late_us.max * 1e3;
+    if t.mode == Mode::Realtime && worst_ns >= STALL_NS {
+        degraded.push(format!(
+            "the plant stalled: it woke {:.0} ms late once (at least {} periods without \
+             real time)",
+            worst_ns / 1e6,
+            (worst_ns / facts.period_ns.max(1) as f64).floor()
+        ));
     }
     t.verdict = if !invalid.is_empty() {
         Verdict::Invalid
@@ -486,6 +502,32 @@ mod verdict_tests {
         judge(&mut t, &finished());
         assert_eq!(t.verdict, Verdict::Clean, "{:?}", t.reasons);
         assert!(t.reasons.is_empty());
+    }
+
+    /// #39 row 11: one wake-up 500 ms late (a plant stopped) is named,
+    /// even when the timer floor explains one late wake-up.
+    #[test]
+    fn a_stalled_plant_is_named() {
+        let mut s = TimingStats::new(1_000_000);
+        for k in 0..1000 {
+            s.add(&Timing {
+                wake_late_ns: if k == 500 { 500_000_000 } else { 0 },
+                floor_late_wakeups: 1,
+                ..Timing::default()
+            });
+        }
+        let mut t = s.finish(
+            Mode::Realtime,
+            1000.0,
+            Some(DataPath::new(1000, 1_000_000).finish()),
+        );
+        judge(&mut t, &finished());
+        assert_eq!(t.verdict, Verdict::Degraded, "{:?}", t.reasons);
+        assert!(
+            t.reasons[0].contains("stalled: it woke 500 ms late"),
+            "{:?}",
+            t.reasons
+        );
     }
 
     #[test]

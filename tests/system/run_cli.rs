@@ -519,6 +519,14 @@ fn a_stopped_and_continued_realtime_run_goes_on() {
     assert_eq!(s["run_end"], "finished");
     assert_ne!(s["timing"]["verdict"], "invalid", "{s}");
     assert!(s["timing"]["late_wakeups"].as_u64().unwrap() > 0, "{s}");
+    // #39 row 11: the 300 ms stops are named, whatever they changed.
+    assert_eq!(s["timing"]["verdict"], "degraded", "{s}");
+    assert!(
+        s["timing"]["reasons"]
+            .to_string()
+            .contains("the plant stalled"),
+        "{s}"
+    );
 }
 
 /// Ctrl-Z then `fg` of a lockstep run (#25 item 5): a publisher waiting
