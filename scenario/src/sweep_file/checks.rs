@@ -89,7 +89,7 @@ pub(super) fn count_runs(
         return Err(SweepFileError::File {
             file: file.to_string(),
             reason: format!(
-                "{} runs: at most {MAX_RUNS} per sweep",
+                "{} runs: at most {MAX_RUNS} per sweep (each is resolved before the first starts; split a larger study into several sweeps)",
                 if total == usize::MAX {
                     "too many".to_string()
                 } else {
