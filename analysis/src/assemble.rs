@@ -22,6 +22,15 @@ use crate::record::StepRecord;
 /// slack for reordering.
 const GIVE_UP_AFTER: u64 = 8;
 
+/// Rows that may wait for a topic at once: a sample this far past the next
+/// row gives up the rows before it, so that a log missing a topic (or
+/// naming steps far ahead) cannot make replay's memory grow with its
+/// length. 16 384 rows of every topic hold at most about 105 MB (a state
+/// is 1.6 kB, a diagnostics sample 4.4 kB, own diagnostics 0.3 kB, at
+/// `MAX_DOF` joints), where the logger interleaves topics within a few
+/// thousand steps.
+pub const PENDING_ROWS: u64 = 16_384;
+
 /// Collects states and diagnostics and emits complete rows in step order.
 #[derive(Debug)]
 pub struct RecordAssembler {
@@ -73,7 +82,10 @@ impl RecordAssembler {
     /// Adds an own-diagnostics sample (ignored unless rows need them).
     pub fn push_own(&mut self, o: OwnDiagnostics) {
         let seq = o.header.seq;
-        if self.own_len.is_some() && seq >= self.next {
+        if self.own_len.is_some() {
+            self.make_room(seq);
+        }
+        if self.own_len.is_some() && (self.next..self.steps).contains(&seq) {
             self.newest_own = Some(self.newest_own.map_or(seq, |n| n.max(seq)));
             self.owns.insert(seq, Box::new(o));
         }
@@ -82,7 +94,9 @@ impl RecordAssembler {
     /// Adds a joint state.
     pub fn push_state(&mut self, s: JointState) {
         let seq = s.header.seq;
-        if seq >= self.next {
+        self.make_room(seq);
+        // Rows need states up to `steps` (row k uses k + 1).
+        if (self.next..=self.steps).contains(&seq) {
             self.newest_state = Some(self.newest_state.map_or(seq, |n| n.max(seq)));
             self.states.insert(seq, Box::new(s));
         }
@@ -91,7 +105,8 @@ impl RecordAssembler {
     /// Adds a diagnostics sample.
     pub fn push_diag(&mut self, d: ControllerDiagnostics) {
         let seq = d.header.seq;
-        if seq >= self.next {
+        self.make_room(seq);
+        if (self.next..self.steps).contains(&seq) {
             self.newest_diag = Some(self.newest_diag.map_or(seq, |n| n.max(seq)));
             self.diags.insert(seq, Box::new(d));
         }
@@ -181,6 +196,20 @@ impl RecordAssembler {
         Ok(())
     }
 
+    /// Gives up the rows more than [`PENDING_ROWS`] before `seq` (counted
+    /// as missing), at once however far ahead `seq` is.
+    fn make_room(&mut self, seq: u64) {
+        let floor = seq.saturating_sub(PENDING_ROWS - 1).min(self.steps);
+        if floor <= self.next {
+            return;
+        }
+        self.missing += floor - self.next;
+        self.next = floor;
+        self.states = self.states.split_off(&floor);
+        self.diags = self.diags.split_off(&floor);
+        self.owns = self.owns.split_off(&floor);
+    }
+
     fn skip(&mut self, k: u64) {
         self.states.remove(&k);
         self.diags.remove(&k);
@@ -198,6 +227,28 @@ fn past(newest: Option<u64>, seq: u64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// #39 row 5: a log without diagnostics keeps at most
+    /// [`PENDING_ROWS`] states waiting, and gives up the rest as missing.
+    #[test]
+    fn a_missing_topic_keeps_memory_bounded() {
+        let steps = 3 * PENDING_ROWS;
+        let mut a = RecordAssembler::new(2, 1e-3, steps);
+        for k in 0..=steps {
+            let mut s = JointState::default();
+            s.header.seq = k;
+            a.push_state(s);
+            assert!(a.states.len() as u64 <= PENDING_ROWS);
+        }
+        assert_eq!(a.missing(), steps + 1 - PENDING_ROWS);
+        // A sample naming a step far ahead gives up everything before it,
+        // at once.
+        let mut d = ControllerDiagnostics::default();
+        d.header.seq = u64::MAX;
+        a.push_diag(d);
+        assert_eq!(a.missing() + a.unfinished(), steps);
+        assert!(a.complete() && a.diags.is_empty() && a.states.len() <= 1);
+    }
 
     fn state(k: u64) -> JointState {
         JointState {
