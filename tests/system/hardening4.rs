@@ -166,3 +166,61 @@ fn a_law_on_the_command_line_takes_its_own_keys_from_set() {
         "{e}"
     );
 }
+
+/// Row 10: a controller's helper that leaves its node's process group and
+/// session (`setsid`) still ends with the run.
+#[test]
+fn a_helper_in_its_own_session_ends_with_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let marker = format!(
+        "{}.{}",
+        300 + std::process::id() % 600,
+        std::process::id() % 89
+    );
+    let script = dir.path().join("ctl.sh");
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/sh\nsetsid sleep {marker} &\nexec {} \"$@\"\n",
+            env!("CARGO_BIN_EXE_example-pd-controller")
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&script, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    let mut run = testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--duration",
+            "0.5",
+            "--law",
+            "pd",
+        ])
+        .arg("--controller-cmd")
+        .arg(&script)
+        .arg("--runs-dir")
+        .arg(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let status = crate::util::wait_bounded(&mut run, 60);
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut run.stderr.take().unwrap(), &mut err).unwrap();
+    assert!(status.success(), "{err}");
+    let helpers = std::process::Command::new("pgrep")
+        .args(["-f", &format!("sleep {marker}")])
+        .output()
+        .unwrap();
+    let left = String::from_utf8_lossy(&helpers.stdout).to_string();
+    for pid in left.split_whitespace() {
+        let _ = std::process::Command::new("kill")
+            .args(["-9", pid])
+            .status();
+    }
+    assert!(
+        left.trim().is_empty(),
+        "the helper outlived the run: {left}"
+    );
+}

@@ -190,9 +190,16 @@ fn describe(command: &[String]) -> Result<Option<String>, RunError> {
     let Some((program, words)) = command.split_first() else {
         return Ok(None);
     };
+    // Named like a run's nodes, so that a helper it leaves ends too.
+    let tag = format!(
+        "describe-{}-{:?}",
+        std::process::id(),
+        std::thread::current().id()
+    );
     let mut child = Command::new(program)
         .args(words)
         .arg("--describe")
+        .env(super::strays::RUN_ENV, &tag)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
@@ -203,6 +210,7 @@ fn describe(command: &[String]) -> Result<Option<String>, RunError> {
     let group = nix::unistd::Pid::from_raw(child.id() as i32);
     let end_group = || {
         let _ = nix::sys::signal::killpg(group, nix::sys::signal::Signal::SIGKILL);
+        super::strays::end_strays(&tag);
     };
     let mut out = String::new();
     let stdout = child.stdout.take();

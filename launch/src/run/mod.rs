@@ -6,6 +6,7 @@ pub mod external;
 mod files;
 mod nodes;
 pub mod spawn;
+mod strays;
 mod transport;
 
 pub use error::RunError;
@@ -187,6 +188,8 @@ fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
     // Close every port of this process, then remove what is left of the
     // run's domain (including what a killed node left behind).
     drop((status, control, bus));
+    // What the nodes started and left behind (a helper in its own session).
+    strays::end_strays(prefix.as_str());
     let _ = prefix.remove_domain_if_unused();
     prefix.remove_leftover_files(true);
     let wall_time_s = result?;

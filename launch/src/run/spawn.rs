@@ -172,8 +172,14 @@ fn spawn_program(
     output: &Path,
 ) -> std::io::Result<Child> {
     let file = std::fs::File::create(output)?;
+    // The run's name, inherited by whatever the node starts (strays.rs).
+    let run = argv
+        .windows(2)
+        .find(|w| w[0] == "--prefix")
+        .map_or("", |w| w[1].as_str());
     let mut process = std::process::Command::new(program)
         .args(argv)
+        .env(super::strays::RUN_ENV, run)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
