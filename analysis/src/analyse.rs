@@ -177,6 +177,15 @@ fn meta_err(path: &Path, reason: impl Into<String>) -> AnalysisError {
     }
 }
 
+/// `e`, a log's metadata that does not make a plan, with the reason when
+/// the log's checksums say it was changed (read in full only then).
+fn damaged_or(path: &Path, e: AnalysisError) -> AnalysisError {
+    match logger::read_log(path, None).ok().and_then(|c| c.cut_short) {
+        Some(why) => meta_err(path, format!("{e}; the log is damaged: {why}")),
+        None => e,
+    }
+}
+
 /// Rebuilds the run's plan from the log's metadata and URDF attachment.
 fn plan_from(contents: &LogContents) -> Result<(Plan, Mode), AnalysisError> {
     let path = contents.path.as_path();
@@ -310,7 +319,7 @@ impl Analyser<'_, '_> {
 /// Reads the log at `path` and computes everything from it.
 pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, AnalysisError> {
     let head = read_log_head(path)?;
-    let (plan, mode) = plan_from(&head)?;
+    let (plan, mode) = plan_from(&head).map_err(|e| damaged_or(path, e))?;
     let n = plan.robot.model.dof();
     let own = own_layout(&head, n)?;
     let own_len = own.len(n);

@@ -137,6 +137,11 @@ fn stream(
     let mut walk = Walk::new(path);
     let mut at = magic.len() as u64;
     let mut part = Vec::new();
+    // The data section's checksum covers every record before DataEnd, those
+    // outside the chunks (channels, the run's metadata, the URDF) too: a
+    // changed byte there once turned a degraded log into a clean one.
+    let mut data_crc = crc32fast::Hasher::new();
+    data_crc.update(&magic);
     while at < len {
         let rest = len - at;
         let mut header = [0u8; 9];
@@ -168,6 +173,14 @@ fn stream(
             walk.damaged = Some(format!("the chunk at byte {at} is damaged: {why}"));
             break;
         }
+        if op == OP_DATA_END {
+            if let Some(why) = data_crc_differs(&part[start..], &data_crc) {
+                walk.damaged = Some(why);
+                break;
+            }
+        } else if !head_only {
+            data_crc.update(&part[mcap::MAGIC.len()..]);
+        }
         if walk.feed(
             crate::records::Records::part(&part),
             &mut on_message,
@@ -181,6 +194,23 @@ fn stream(
         }
     }
     walk.finish(head_only)
+}
+
+/// The DataEnd record's opcode.
+const OP_DATA_END: u8 = 0x0F;
+
+/// Why the data section's checksum in DataEnd's `body` does not match
+/// `crc` (None when it does, or when the writer left it 0: not computed).
+fn data_crc_differs(body: &[u8], crc: &crc32fast::Hasher) -> Option<String> {
+    let stored = u32::from_le_bytes(body.get(..4)?.try_into().ok()?);
+    let computed = crc.clone().finalize();
+    (stored != 0 && stored != computed).then(|| {
+        format!(
+            "the data section's checksum does not match ({computed:#010x}, the log says \
+             {stored:#010x}): a record was changed after it was written (a channel, the \
+             run's metadata, the URDF or a chunk)"
+        )
+    })
 }
 
 /// [`read_log`] of a log already in memory (`path` names it in messages).

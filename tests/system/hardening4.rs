@@ -224,3 +224,58 @@ fn a_helper_in_its_own_session_ends_with_the_run() {
         "the helper outlived the run: {left}"
     );
 }
+
+/// Row 1: a byte changed in a record outside the chunks (the run's
+/// metadata, a channel) makes the log invalid: the data section's
+/// checksum covers them.
+#[test]
+fn a_changed_record_outside_the_chunks_makes_the_log_invalid() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = a_log(dir.path());
+    let bytes = std::fs::read(&log).unwrap();
+    let find = |needle: &[u8]| {
+        bytes
+            .windows(needle.len())
+            .position(|w| w == needle)
+            .unwrap()
+    };
+    let clean = json_of(testbed().args(["replay", "--json"]).arg(&log));
+    assert_ne!(clean["timing"]["verdict"], "invalid", "{clean}");
+    // The first copies are in the data section: the run's metadata (its
+    // scenario text) and the /joint_states channel.
+    for needle in [&b"duration_s"[..], &b"/joint_states"[..]] {
+        let mut b = bytes.clone();
+        b[find(needle) + 1] ^= 0x01;
+        let damaged = dir.path().join("damaged.mcap");
+        std::fs::write(&damaged, &b).unwrap();
+        let out = testbed()
+            .args(["replay", "--json"])
+            .arg(&damaged)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        // Either the analysis says the log is invalid, or (the run's
+        // metadata no longer reads) the error says why.
+        match serde_json::from_slice::<serde_json::Value>(&out.stdout) {
+            Ok(s) => {
+                assert_eq!(s["timing"]["verdict"], "invalid", "{s}");
+                assert!(s.to_string().contains("checksum does not match"), "{s}");
+            }
+            Err(_) => {
+                assert!(
+                    !out.status.success() && err.contains("checksum does not match"),
+                    "{err}"
+                );
+            }
+        }
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+/// The JSON a command printed, whatever its exit code.
+fn json_of(cmd: &mut std::process::Command) -> serde_json::Value {
+    let out = cmd.output().unwrap();
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!("{e}: {}", String::from_utf8_lossy(&out.stderr));
+    })
+}
