@@ -373,3 +373,100 @@ fn a_taken_live_port_fails_before_anything_starts() {
     let err = fails(testbed().args(["run", "--live", "nowhere"]));
     assert!(err.contains("ADDR:PORT"), "{err}");
 }
+
+/// The ports process `pid` listens on at 127.0.0.1 (from its
+/// `/proc/<pid>/net/tcp` rows whose sockets it holds).
+fn loopback_listen_ports(pid: u32) -> Vec<u16> {
+    let inodes: Vec<String> = std::fs::read_dir(format!("/proc/{pid}/fd"))
+        .map(|d| {
+            d.flatten()
+                .filter_map(|e| std::fs::read_link(e.path()).ok())
+                .filter_map(|t| {
+                    let t = t.to_string_lossy().to_string();
+                    Some(t.strip_prefix("socket:[")?.strip_suffix(']')?.to_string())
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let table = std::fs::read_to_string(format!("/proc/{pid}/net/tcp")).unwrap_or_default();
+    table
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            let (local, state, inode) = (f.get(1)?, f.get(3)?, f.get(9)?);
+            let (ip, port) = local.split_once(':')?;
+            (ip == "0100007F" && *state == "0A" && inodes.iter().any(|i| i == inode))
+                .then(|| u16::from_str_radix(port, 16).ok())?
+        })
+        .collect()
+}
+
+/// #39 row 8: the client limit holds on every port: a viewer that goes to
+/// the server's loopback port past the relay is cut, and the log counts it.
+#[test]
+fn the_limit_holds_on_the_servers_own_port() {
+    let dir = tempfile::tempdir().unwrap();
+    let port = free_port();
+    let extra = [
+        "--duration",
+        "30",
+        "--live-clients",
+        "1",
+        "--no-realtime-setup",
+    ];
+    let mut run = live_run(port, "realtime", &extra, dir.path());
+    let _viewer = Viewer::connect(port, &mut run, SDK);
+    let logger = wait_for_nodes(run.id())
+        .into_iter()
+        .find(|n| n.0 == "logger")
+        .unwrap()
+        .1;
+    let inner = loopback_listen_ports(logger)
+        .into_iter()
+        .find(|p| *p != port)
+        .expect("the server's loopback port");
+    let mut sneaky = TcpStream::connect(("127.0.0.1", inner)).unwrap();
+    // Watchdog: a cut connection ends the read long before this.
+    sneaky
+        .set_read_timeout(Some(Duration::from_secs(30)))
+        .unwrap();
+    std::io::Write::write_all(
+        &mut sneaky,
+        format!(
+            "GET / HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n\
+             Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\
+             Sec-WebSocket-Protocol: {SDK}\r\n\r\n"
+        )
+        .as_bytes(),
+    )
+    .unwrap();
+    let started = Instant::now();
+    let mut buf = [0u8; 4096];
+    loop {
+        match std::io::Read::read(&mut sneaky, &mut buf) {
+            Ok(0) | Err(_) => break,
+            Ok(_) => assert!(
+                started.elapsed() < Duration::from_secs(25),
+                "the connection past the relay was not cut"
+            ),
+        }
+    }
+    assert!(
+        started.elapsed() < Duration::from_secs(25),
+        "the connection past the relay was not cut"
+    );
+    let _ = nix::sys::signal::kill(
+        nix::unistd::Pid::from_raw(run.id() as i32),
+        nix::sys::signal::Signal::SIGINT,
+    );
+    let (_, _, err) = ended(&mut run, 120);
+    let log = std::fs::read_dir(dir.path())
+        .unwrap()
+        .flatten()
+        .map(|e| e.path().join("run.mcap"))
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| panic!("no log: {err}"));
+    let stats = logger::read_log(&log, None).unwrap().stats.unwrap();
+    assert_ne!(stats["live.bypass_cut"], "0", "{stats:?}");
+}

@@ -6,19 +6,23 @@
 //!   queue for each; the relay refuses the one past the limit with an HTTP
 //!   503 that says why, so 200 stalled viewers cost at most `max_clients`
 //!   queues.
+//!   A client gets [`HANDSHAKE_WAIT`] in all to send its handshake (a
+//!   client that dribbles a byte at a time cannot hold a slot), and the
+//!   guard (`guard.rs`) closes any connection that reached the server's
+//!   loopback port past the relay.
 //! - **The older subprotocol name.** Clients of the widely used
 //!   `foxglove.websocket.v1` (e.g. npm `@foxglove/ws-protocol`) speak the
 //!   same messages as `foxglove.sdk.v1` under another name; the server
 //!   knows only the new one, so the relay renames the offer on the way in
 //!   and the answer on the way out. After the handshake it copies bytes.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::io::{Read, Write};
 use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// The subprotocol name the server knows.
 const SDK_V1: &str = "foxglove.sdk.v1";
@@ -26,7 +30,7 @@ const SDK_V1: &str = "foxglove.sdk.v1";
 const LEGACY_V1: &str = "foxglove.websocket.v1";
 /// Longest handshake head accepted (browsers send ~1 KB).
 const MAX_HEAD: usize = 16 * 1024;
-/// How long a client may take to send its handshake.
+/// How long a client may take to send its whole handshake.
 const HANDSHAKE_WAIT: Duration = Duration::from_secs(10);
 
 /// The relay, running.
@@ -36,19 +40,33 @@ pub(super) struct Front {
     accept: Option<JoinHandle<()>>,
 }
 
-/// What the accept thread and the connections share with the logger.
-struct Shared {
-    stop: AtomicBool,
+/// What the accept thread, the connections and the guard share with the
+/// logger.
+pub(super) struct Shared {
+    pub(super) stop: AtomicBool,
     max_clients: usize,
     refused: AtomicU64,
     accepted: AtomicU64,
+    /// Connections to the server's port that the relay did not make, cut.
+    pub(super) bypassed: AtomicU64,
     /// Open client connections by number, kept to cut them at the end.
     open: Mutex<HashMap<u64, TcpStream>>,
+    /// Local ports of the relay's own connections to the server.
+    relayed: Mutex<HashSet<u16>>,
 }
 
 impl Shared {
     fn open(&self) -> std::sync::MutexGuard<'_, HashMap<u64, TcpStream>> {
         self.open.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn relayed(&self) -> std::sync::MutexGuard<'_, HashSet<u16>> {
+        self.relayed.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The relay's connections to the server, by local port.
+    pub(super) fn relayed_ports(&self) -> HashSet<u16> {
+        self.relayed().clone()
     }
 }
 
@@ -66,12 +84,18 @@ impl Front {
             max_clients,
             refused: AtomicU64::new(0),
             accepted: AtomicU64::new(0),
+            bypassed: AtomicU64::new(0),
             open: Mutex::new(HashMap::new()),
+            relayed: Mutex::new(HashSet::new()),
         });
         let s = shared.clone();
         let accept = std::thread::Builder::new()
             .name("live-front".into())
             .spawn(move || accept_loop(&listener, inner, &s))?;
+        let g = shared.clone();
+        std::thread::Builder::new()
+            .name("live-guard".into())
+            .spawn(move || super::guard::guard(inner.port(), &g))?;
         Ok(Self {
             addr,
             shared,
@@ -90,6 +114,12 @@ impl Front {
             self.shared.refused.load(Ordering::Relaxed),
             self.shared.accepted.load(Ordering::Relaxed),
         )
+    }
+
+    /// Connections to the server's loopback port that came past the relay
+    /// and were cut.
+    pub(super) fn bypassed(&self) -> u64 {
+        self.shared.bypassed.load(Ordering::Relaxed)
     }
 
     /// Stops accepting and cuts every open connection.
@@ -144,7 +174,7 @@ fn accept_loop(listener: &TcpListener, inner: SocketAddr, shared: &Arc<Shared>) 
             .name("live-client".into())
             .spawn(move || {
                 // A client that breaks the handshake or leaves ends here.
-                let _ = relay(client, inner);
+                let _ = relay(client, inner, &s);
                 s.open().remove(&id);
             });
         if spawned.is_err() {
@@ -171,15 +201,26 @@ fn refuse(mut client: TcpStream, max: usize) {
 
 /// One client: the handshake with the subprotocol renamed if need be, then
 /// bytes both ways until either side closes.
-fn relay(mut client: TcpStream, inner: SocketAddr) -> std::io::Result<()> {
-    client.set_read_timeout(Some(HANDSHAKE_WAIT))?;
-    let (head, early) = read_head(&mut client)?;
-    let (head, legacy) = rename_offer(&head);
+fn relay(mut client: TcpStream, inner: SocketAddr, shared: &Shared) -> std::io::Result<()> {
+    let (head, early) = read_head(&mut client, Instant::now() + HANDSHAKE_WAIT)?;
     let mut server = TcpStream::connect(inner)?;
-    server.set_read_timeout(Some(HANDSHAKE_WAIT))?;
+    let port = server.local_addr()?.port();
+    shared.relayed().insert(port);
+    let r = relay_to(client, &mut server, &head, &early);
+    shared.relayed().remove(&port);
+    r
+}
+
+fn relay_to(
+    mut client: TcpStream,
+    server: &mut TcpStream,
+    head: &str,
+    early: &[u8],
+) -> std::io::Result<()> {
+    let (head, legacy) = rename_offer(head);
     server.write_all(head.as_bytes())?;
-    server.write_all(&early)?;
-    let (answer, rest) = read_head(&mut server)?;
+    server.write_all(early)?;
+    let (answer, rest) = read_head(server, Instant::now() + HANDSHAKE_WAIT)?;
     let answer = if legacy {
         rename_answer(&answer)
     } else {
@@ -187,7 +228,7 @@ fn relay(mut client: TcpStream, inner: SocketAddr) -> std::io::Result<()> {
     };
     client.write_all(answer.as_bytes())?;
     client.write_all(&rest)?;
-    for s in [&client, &server] {
+    for s in [&client, &*server] {
         s.set_read_timeout(None)?;
         s.set_nodelay(true)?;
     }
@@ -198,7 +239,7 @@ fn relay(mut client: TcpStream, inner: SocketAddr) -> std::io::Result<()> {
             let _ = std::io::copy(&mut up_from, &mut up_to);
             let _ = up_to.shutdown(Shutdown::Write);
         })?;
-    let _ = std::io::copy(&mut server, &mut client);
+    let _ = std::io::copy(server, &mut client);
     // The server closed (or the run ends): the client's half goes too.
     let _ = client.shutdown(Shutdown::Both);
     let _ = server.shutdown(Shutdown::Both);
@@ -206,11 +247,20 @@ fn relay(mut client: TcpStream, inner: SocketAddr) -> std::io::Result<()> {
     Ok(())
 }
 
-/// Reads up to the end of an HTTP head; returns it and the bytes after it.
-fn read_head(s: &mut TcpStream) -> std::io::Result<(String, Vec<u8>)> {
+/// Reads up to the end of an HTTP head by `deadline` (a whole-head limit,
+/// not one per read); returns it and the bytes after it.
+fn read_head(s: &mut TcpStream, deadline: Instant) -> std::io::Result<(String, Vec<u8>)> {
     let mut buf = Vec::with_capacity(1024);
     let mut chunk = [0u8; 1024];
     loop {
+        let left = deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::TimedOut,
+                "no whole handshake in time",
+            ));
+        }
+        s.set_read_timeout(Some(left))?;
         if let Some(end) = buf.windows(4).position(|w| w == b"\r\n\r\n") {
             let rest = buf.split_off(end + 4);
             let head = String::from_utf8(buf)
@@ -273,6 +323,39 @@ fn rename_answer(head: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// #39 row 8: a client that dribbles its handshake a byte at a time
+    /// (each read on time) is given up at the whole handshake's deadline.
+    #[test]
+    fn a_dribbled_handshake_is_given_up_at_its_deadline() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap();
+        let done = Arc::new(AtomicBool::new(false));
+        let d = done.clone();
+        let dribbler = std::thread::spawn(move || {
+            let mut c = TcpStream::connect(addr).unwrap();
+            while !d.load(Ordering::SeqCst) {
+                if c.write_all(b"G").is_err() {
+                    break;
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        });
+        let (mut server_side, _) = listener.accept().unwrap();
+        let start = Instant::now();
+        let e = read_head(&mut server_side, start + Duration::from_millis(300)).unwrap_err();
+        done.store(true, Ordering::SeqCst);
+        dribbler.join().unwrap();
+        assert!(
+            matches!(
+                e.kind(),
+                std::io::ErrorKind::TimedOut | std::io::ErrorKind::WouldBlock
+            ),
+            "{e}"
+        );
+        // Watchdog, not a timing claim: it did not wait for ever.
+        assert!(start.elapsed() < Duration::from_secs(30));
+    }
 
     const OFFER: &str =
         "GET / HTTP/1.1\r\nHost: x\r\nsec-websocket-protocol: foxglove.websocket.v1\r\n\r\n";

@@ -163,6 +163,7 @@ impl Live {
             let (refused, accepted) = front.counts();
             out.insert("live.connections".into(), accepted.to_string());
             out.insert("live.refused_clients".into(), refused.to_string());
+            out.insert("live.bypass_cut".into(), front.bypassed().to_string());
         }
         for t in &self.topics {
             let name = t.name.trim_start_matches('/');
