@@ -129,14 +129,9 @@ impl ErrorMpc {
     /// solution, and the solver is not called.
     pub(crate) fn solve(&mut self, x: &MpcInput<'_>) -> (&[f64], bool) {
         let mut breached = false;
-        for (i, joint) in self.joints.iter_mut().enumerate() {
-            let bounds = Bounds {
-                t: x.t,
-                tc: self.tc,
-                h: self.h,
-                kc: x.kc[i],
-                rate: x.kc_dot[i] / x.kc[i],
-            };
+        for i in 0..self.joints.len() {
+            let bounds = self.bounds(x, i);
+            let joint = &mut self.joints[i];
             let x0 = [x.e[i], x.ed[i]];
             let [ke, kv] = joint.lqr;
             let unconstrained = -(ke * x0[0] + kv * x0[1]);
@@ -172,14 +167,19 @@ impl ErrorMpc {
     /// is active (tests).
     #[cfg(test)]
     pub(crate) fn solve_joint(&mut self, i: usize, x: &MpcInput<'_>) -> Option<f64> {
-        let bounds = Bounds {
+        let bounds = self.bounds(x, i);
+        self.joints[i].solve([x.e[i], x.ed[i]], self.horizon, &bounds)
+    }
+
+    /// Joint `i`'s envelope over the horizon.
+    fn bounds(&self, x: &MpcInput<'_>, i: usize) -> Bounds {
+        Bounds {
             t: x.t,
             tc: self.tc,
             h: self.h,
             kc: x.kc[i],
             rate: x.kc_dot[i] / x.kc[i],
-        };
-        self.joints[i].solve([x.e[i], x.ed[i]], self.horizon, &bounds)
+        }
     }
 }
 

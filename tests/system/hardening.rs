@@ -3,7 +3,7 @@
 
 use std::process::Command;
 
-use crate::util::{fails, ok, testbed};
+use crate::util::{fails, lockstep_log as a_log, ok, testbed};
 
 fn scenario(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
     let p = dir.join(name);
@@ -145,23 +145,6 @@ fn special_files_are_refused_without_reading_them() {
         let e = fails(testbed().args(&args));
         assert!(e.contains("not a regular file"), "{args:?}: {e}");
     }
-}
-
-/// A fresh lockstep log of 0.3 s.
-fn a_log(dir: &std::path::Path) -> std::path::PathBuf {
-    let out = ok(testbed()
-        .args([
-            "run",
-            "--mode",
-            "lockstep",
-            "--duration",
-            "0.3",
-            "--json",
-            "--runs-dir",
-        ])
-        .arg(dir));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    std::path::PathBuf::from(v["log"].as_str().unwrap())
 }
 
 /// Rows 3 and 4, logs: a Header claiming u64::MAX bytes and a chunk asking

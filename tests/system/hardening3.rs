@@ -149,38 +149,10 @@ fn a_controllers_helper_ends_with_the_run() {
         300 + std::process::id() % 600,
         std::process::id() % 97
     );
-    let script = dir.path().join("ctl.sh");
-    std::fs::write(
-        &script,
-        format!(
-            "#!/bin/sh\nsleep {marker} &\nprintf 'bytes \\377\\376 not utf-8\\n' >&2\nexec {} \"$@\"\n",
-            env!("CARGO_BIN_EXE_example-pd-controller")
-        ),
-    )
-    .unwrap();
-    std::fs::set_permissions(&script, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
-    let mut run = testbed()
-        .args([
-            "run",
-            "--mode",
-            "lockstep",
-            "--duration",
-            "0.5",
-            "--law",
-            "pd",
-        ])
-        .arg("--controller-cmd")
-        .arg(&script)
-        .arg("--runs-dir")
-        .arg(dir.path())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // Watchdog: the launcher must end long before the helper would.
-    let status = crate::util::wait_bounded(&mut run, 60);
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut run.stderr.take().unwrap(), &mut err).unwrap();
+    let (status, err) = crate::util::run_with_controller_script(
+        dir.path(),
+        &format!("sleep {marker} &\nprintf 'bytes \\377\\376 not utf-8\\n' >&2"),
+    );
     assert!(status.success(), "{err}");
     assert!(
         err.contains("[controller] bytes \u{fffd}\u{fffd} not utf-8"),

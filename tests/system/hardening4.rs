@@ -1,23 +1,6 @@
 //! Hardening, round 4 (#39): one reproducer per row fixed.
 
-use crate::util::{fails, ok, testbed};
-
-/// A fresh lockstep log of 0.3 s in `dir`.
-fn a_log(dir: &std::path::Path) -> std::path::PathBuf {
-    let out = ok(testbed()
-        .args([
-            "run",
-            "--mode",
-            "lockstep",
-            "--duration",
-            "0.3",
-            "--json",
-            "--runs-dir",
-        ])
-        .arg(dir));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    std::path::PathBuf::from(v["log"].as_str().unwrap())
-}
+use crate::util::{fails, lockstep_log as a_log, ok, testbed};
 
 /// Row 2: an output that is one of the command's inputs (by device and
 /// inode, so a second name counts) is refused before anything is written,
@@ -177,37 +160,8 @@ fn a_helper_in_its_own_session_ends_with_the_run() {
         300 + std::process::id() % 600,
         std::process::id() % 89
     );
-    let script = dir.path().join("ctl.sh");
-    std::fs::write(
-        &script,
-        format!(
-            "#!/bin/sh\nsetsid sleep {marker} &\nexec {} \"$@\"\n",
-            env!("CARGO_BIN_EXE_example-pd-controller")
-        ),
-    )
-    .unwrap();
-    std::fs::set_permissions(&script, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
-    let mut run = testbed()
-        .args([
-            "run",
-            "--mode",
-            "lockstep",
-            "--duration",
-            "0.5",
-            "--law",
-            "pd",
-        ])
-        .arg("--controller-cmd")
-        .arg(&script)
-        .arg("--runs-dir")
-        .arg(dir.path())
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let status = crate::util::wait_bounded(&mut run, 60);
-    let mut err = String::new();
-    std::io::Read::read_to_string(&mut run.stderr.take().unwrap(), &mut err).unwrap();
+    let (status, err) =
+        crate::util::run_with_controller_script(dir.path(), &format!("setsid sleep {marker} &"));
     assert!(status.success(), "{err}");
     let helpers = std::process::Command::new("pgrep")
         .args(["-f", &format!("sleep {marker}")])

@@ -202,3 +202,58 @@ pub fn venv_python(script: &str) -> String {
     );
     String::from_utf8_lossy(&out.stdout).trim().to_string()
 }
+
+/// A fresh lockstep log of 0.3 s in `dir`.
+pub fn lockstep_log(dir: &Path) -> PathBuf {
+    let out = ok(testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--duration",
+            "0.3",
+            "--json",
+            "--runs-dir",
+        ])
+        .arg(dir));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    PathBuf::from(v["log"].as_str().unwrap())
+}
+
+/// A 0.5 s lockstep `pd` run whose controller is a shell script that runs
+/// `before` and then the Rust example controller; returns its exit status
+/// and stderr (watchdog: 60 s, long before any helper would end).
+pub fn run_with_controller_script(dir: &Path, before: &str) -> (std::process::ExitStatus, String) {
+    let script = dir.join("ctl.sh");
+    std::fs::write(
+        &script,
+        format!(
+            "#!/bin/sh\n{before}\nexec {} \"$@\"\n",
+            env!("CARGO_BIN_EXE_example-pd-controller")
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&script, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    let mut run = testbed()
+        .args([
+            "run",
+            "--mode",
+            "lockstep",
+            "--duration",
+            "0.5",
+            "--law",
+            "pd",
+        ])
+        .arg("--controller-cmd")
+        .arg(&script)
+        .arg("--runs-dir")
+        .arg(dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let status = wait_bounded(&mut run, 60);
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut run.stderr.take().unwrap(), &mut err).unwrap();
+    (status, err)
+}
