@@ -96,6 +96,12 @@ fn an_example_controller_replaces_the_controller_node() {
     // −400·0.6 − 40·(0 − 2) = −160 N m.
     let tau = s["joints"][0]["max_abs_torque"].as_f64().unwrap();
     assert!(tau > 150.0, "{s}");
+    // #39 row 15: the run does not pass the hand-started node off as the
+    // scenario's law.
+    assert_eq!(
+        s["controller_cmd"], "a controller node started by hand (--external controller)",
+        "{s}"
+    );
 }
 
 /// A trajectory node publishing another reference (the paper's shifted by

@@ -51,6 +51,9 @@ fn new_folder(runs_dir: &Path, name: Option<&str>) -> Result<PathBuf, RunError> 
     ))
 }
 
+/// What a log says ran as the controller when it was started by hand.
+const BY_HAND: &str = "a controller node started by hand (--external controller)";
+
 impl RunFiles {
     pub(super) fn write(
         opts: &RunOptions,
@@ -78,7 +81,15 @@ impl RunFiles {
         })?;
         std::fs::write(&layout_file, layout + "\n").map_err(out(&layout_file))?;
         let log = run_dir.join("run.mcap");
-        let command = opts.controller_cmd.as_ref().map(shell_words::join);
+        // A controller node started by hand runs what its starter chose: the
+        // log must not label it as the scenario's law alone (#39 row 15).
+        let by_hand =
+            opts.external.contains(&wire::NodeKind::Controller) && opts.controller_cmd.is_none();
+        let command = match &opts.controller_cmd {
+            Some(c) => Some(shell_words::join(c)),
+            None if by_hand => Some(BY_HAND.to_string()),
+            None => None,
+        };
         let configs = crate::node::configs::write_all(
             &run_dir.join("nodes"),
             plan,
