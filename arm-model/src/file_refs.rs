@@ -1,23 +1,33 @@
-//! `<texture/>` and `<mesh/>` elements without a `filename`: the URDF
-//! reader under `urdf-rs` refuses them (its structs require the field), but
-//! Pinocchio, MuJoCo and ROS read such files (romeo and icub in
-//! example-robot-data have a bare `<texture />` in their materials).
-//! Neither a texture nor a mesh moves the arm, so the missing attribute is
-//! filled with an empty name before parsing, and the model notes it.
+//! Attributes `urdf-rs` requires that Pinocchio, MuJoCo and ROS do without:
+//! `<texture/>` and `<mesh/>` elements without a `filename` (romeo and icub
+//! in example-robot-data have a bare `<texture />` in their materials), and
+//! a joint `<limit>` without a `velocity`. None of them moves the arm (the
+//! testbed uses no joint velocity limit), so the missing attribute is
+//! filled before parsing (an empty name; a velocity of 0, read as "none
+//! given"), and the model notes it.
 
 use std::borrow::Cow;
 
-/// The elements whose `filename` may be missing.
-const ELEMENTS: [&str; 2] = ["texture", "mesh"];
+/// The elements whose attribute may be missing, the attribute, and what
+/// it is filled with.
+const FILLS: [(&str, &str, &str); 3] = [
+    ("texture", "filename", ""),
+    ("mesh", "filename", ""),
+    ("limit", "velocity", "0"),
+];
 
-/// `text` with `filename=""` added to every such element without one, and
-/// how many were filled per element name.
+/// `text` with each attribute of [`FILLS`] added to every element without
+/// one, and how many were filled per element name.
 pub(super) fn fill_missing(text: &str) -> (Cow<'_, str>, Vec<(&'static str, usize)>) {
     let mut inserts = Vec::new();
     let mut filled = Vec::new();
-    for name in ELEMENTS {
+    for (name, attr, value) in FILLS {
         let before = inserts.len();
-        inserts.extend(missing(text, name));
+        inserts.extend(
+            missing(text, name, attr)
+                .into_iter()
+                .map(|at| (at, attr, value)),
+        );
         if inserts.len() > before {
             filled.push((name, inserts.len() - before));
         }
@@ -26,19 +36,19 @@ pub(super) fn fill_missing(text: &str) -> (Cow<'_, str>, Vec<(&'static str, usiz
         return (Cow::Borrowed(text), filled);
     }
     inserts.sort_unstable();
-    let mut out = String::with_capacity(text.len() + 12 * inserts.len());
+    let mut out = String::with_capacity(text.len() + 16 * inserts.len());
     let mut copied = 0;
-    for at in inserts {
+    for (at, attr, value) in inserts {
         out.push_str(&text[copied..at]);
-        out.push_str(" filename=\"\"");
+        out.push_str(&format!(" {attr}=\"{value}\""));
         copied = at;
     }
     out.push_str(&text[copied..]);
     (Cow::Owned(out), filled)
 }
 
-/// Offsets just past `<name` of each `name` element with no `filename`.
-fn missing(text: &str, name: &str) -> Vec<usize> {
+/// Offsets just past `<name` of each `name` element with no `attr`.
+fn missing(text: &str, name: &str, attr: &str) -> Vec<usize> {
     let open = format!("<{name}");
     let mut out = Vec::new();
     let mut from = 0;
@@ -48,7 +58,7 @@ fn missing(text: &str, name: &str) -> Vec<usize> {
         // `<meshes>` or `<texture_x>` are other elements.
         let whole_name =
             text[after..].starts_with(|c: char| c.is_ascii_whitespace() || c == '/' || c == '>');
-        if whole_name && !has_filename(&text[after..tag_end(text, after)]) {
+        if whole_name && !has_attr(&text[after..tag_end(text, after)], attr) {
             out.push(after);
         }
     }
@@ -70,11 +80,11 @@ fn tag_end(text: &str, from: usize) -> usize {
     text.len()
 }
 
-/// Whether a tag's attribute text names a `filename`.
-fn has_filename(attrs: &str) -> bool {
-    attrs.match_indices("filename").any(|(i, _)| {
+/// Whether a tag's attribute text names `attr`.
+fn has_attr(attrs: &str, attr: &str) -> bool {
+    attrs.match_indices(attr).any(|(i, _)| {
         let before_ok = attrs[..i].ends_with(|c: char| c.is_ascii_whitespace());
-        let after = attrs[i + "filename".len()..].trim_start();
+        let after = attrs[i + attr.len()..].trim_start();
         before_ok && after.starts_with('=')
     })
 }
@@ -94,5 +104,27 @@ mod tests {
         assert_eq!(filled, [("texture", 1), ("mesh", 1)]);
         let (same, none) = fill_missing("<robot><mesh filename=\"x\"/></robot>");
         assert!(matches!(same, Cow::Borrowed(_)) && none.is_empty());
+    }
+
+    /// #38 item 4: a `<limit>` without `velocity` (valid for Pinocchio
+    /// and MuJoCo) gets velocity 0; one with it, and `<limits>`, are left.
+    #[test]
+    fn a_limit_without_velocity_gets_one() {
+        let text =
+            r#"<limit lower="-1" upper="1" effort="5"/><limit effort="1" velocity="2"/><limits/>"#;
+        let (out, filled) = fill_missing(text);
+        assert_eq!(
+            out,
+            r#"<limit velocity="0" lower="-1" upper="1" effort="5"/><limit effort="1" velocity="2"/><limits/>"#
+        );
+        assert_eq!(filled, [("limit", 1)]);
+        let urdf = r#"<robot name="t"><link name="base"/><link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link><joint name="j" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="5"/></joint></robot>"#;
+        let model = crate::ArmModel::from_urdf_str(urdf).unwrap();
+        assert_eq!(model.dof(), 1);
+        assert!(
+            model.notes[0].contains("without a velocity"),
+            "{:?}",
+            model.notes
+        );
     }
 }

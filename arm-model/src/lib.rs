@@ -247,13 +247,18 @@ impl ArmModel {
         })?;
         let mut model = tree::build(&robot, locks)?;
         for (element, n) in unnamed_files.iter().rev() {
-            model.notes.insert(
-                0,
+            let note = if *element == "limit" {
+                format!(
+                    "{n} joint <limit> element(s) without a velocity: read as none given \
+                     (the testbed uses no joint velocity limit)"
+                )
+            } else {
                 format!(
                     "{n} <{element}> element(s) without a filename: read as naming no file \
                      (they do not change the dynamics)"
-                ),
-            );
+                )
+            };
+            model.notes.insert(0, note);
         }
         if !undeclared.is_empty() {
             model.notes.insert(

@@ -151,8 +151,23 @@ const ADJUSTMENTS: usize = 4;
 impl ArmDefault {
     /// The default scenario for the arm in `urdf` (see the module docs).
     pub fn new(urdf: &str) -> Result<Self, PlantError> {
+        Self::with_locks(urdf, &Locks::new())
+    }
+
+    /// The default scenario with the joints of `user` locked where it says
+    /// before anything else is chosen (`--set plant.lock.J=…`): the
+    /// remedy for an arm of more joints than a sample carries.
+    pub fn with_locks(urdf: &str, user: &Locks) -> Result<Self, PlantError> {
         let full = ArmModel::from_urdf_str(urdf)?;
-        let mut chosen = default_locks(&full);
+        let mut chosen: Vec<(String, f64, String)> = user
+            .iter()
+            .map(|(n, p)| (n.clone(), *p, "locked as asked (plant.lock)".to_string()))
+            .collect();
+        chosen.extend(
+            default_locks(&full)
+                .into_iter()
+                .filter(|(n, ..)| !user.contains_key(n)),
+        );
         let mut armature: Vec<(String, f64, String)> = Vec::new();
         let mut attempt = 0;
         loop {
@@ -367,5 +382,10 @@ impl Scenario {
     /// The default scenario for the arm in `urdf` (see the module docs).
     pub fn for_arm(urdf: &str) -> Result<Self, PlantError> {
         ArmDefault::new(urdf).map(|d| d.scenario)
+    }
+
+    /// [`Scenario::for_arm`] with the joints of `locks` locked first.
+    pub fn for_arm_locked(urdf: &str, locks: &Locks) -> Result<Self, PlantError> {
+        ArmDefault::with_locks(urdf, locks).map(|d| d.scenario)
     }
 }

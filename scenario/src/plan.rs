@@ -149,6 +149,22 @@ fn apply_set(
     Ok((text, format!("{source} with {}", said.join(" "))))
 }
 
+/// The joints `--set plant.lock.J=POSITION` locks: the default scenario
+/// of an arm is chosen with them locked (a 34-joint hand runs once two are).
+fn set_locks(set: &[(String, toml::Value)]) -> Locks {
+    set.iter()
+        .filter_map(|(key, value)| {
+            let joint = key.strip_prefix("plant.lock.")?;
+            let position = match value {
+                toml::Value::Float(x) => *x,
+                toml::Value::Integer(i) => *i as f64,
+                _ => return None,
+            };
+            Some((joint.to_string(), position))
+        })
+        .collect()
+}
+
 /// `text` with its `[controller]` table replaced by `params`.
 fn with_controller(
     text: &str,
@@ -191,9 +207,12 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
     };
     let (scenario, toml_text, source) = match (&arm, path) {
         (Some(arm), None) => {
-            let s = Scenario::for_arm(&arm.urdf).map_err(|cause| ScenarioError::Plant {
-                file: arm.label(),
-                cause,
+            let locks = set_locks(&overrides.set);
+            let s = Scenario::for_arm_locked(&arm.urdf, &locks).map_err(|cause| {
+                ScenarioError::Plant {
+                    file: arm.label(),
+                    cause,
+                }
             })?;
             let text = toml::to_string(&s).map_err(|e| ScenarioError::Toml {
                 file: arm.label(),
@@ -411,6 +430,36 @@ mod tests {
             law: law.map(|l| l.parse().unwrap()),
             set: set.iter().map(|s| parse_set(s).unwrap()).collect(),
         }
+    }
+
+    /// #38 item 4: the remedy for more joints than a sample carries works
+    /// as the error says: `--set plant.lock.J=…` on an arm's default
+    /// scenario locks J before the scenario is chosen.
+    #[test]
+    fn locking_by_set_brings_a_34_joint_arm_to_32() {
+        let mut urdf = String::from(
+            r#"<robot name="chain"><link name="l0"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>"#,
+        );
+        for i in 1..=34 {
+            urdf += &format!(
+                r#"<link name="l{i}"><inertial><origin xyz="0.05 0 0"/><mass value="0.2"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link><joint name="j{i}" type="revolute"><parent link="l{p}"/><child link="l{i}"/><origin xyz="0.1 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"#,
+                p = i - 1
+            );
+        }
+        urdf += "</robot>";
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("chain.urdf");
+        std::fs::write(&path, urdf).unwrap();
+        let with = |set: &[&str]| {
+            let mut o = overrides(None, set);
+            o.robot = Some(path.clone());
+            load(None, &o)
+        };
+        let e = with(&[]).unwrap_err().to_string();
+        assert!(e.contains("at most 32") && e.contains("plant.lock"), "{e}");
+        let plan = with(&["plant.lock.j33=0", "plant.lock.j34=0.5"]).unwrap();
+        assert_eq!(plan.robot.model.dof(), 32);
+        assert_eq!(plan.scenario.plant.lock.get("j34"), Some(&0.5));
     }
 
     /// #39 row 15: `--law X --set controller.<X's key>` sets X's key.
