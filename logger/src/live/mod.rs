@@ -14,6 +14,7 @@ use crate::ChannelSpec;
 
 #[cfg(feature = "live")]
 mod front;
+#[cfg(feature = "live")]
 mod guard;
 #[cfg(feature = "live")]
 mod server;
