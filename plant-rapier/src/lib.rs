@@ -44,8 +44,8 @@ pub use arm_model::{
     MimicJoint, MimicSpec, ModelError, Origin, TWO_LINK_URDF,
 };
 pub use config::{
-    ActuationConfig, DisturbanceConfig, FrictionConfig, PayloadConfig, PerJoint, PlantConfig,
-    SensorConfig,
+    ActuationConfig, ActuatorConfig, DisturbanceConfig, FrictionConfig, Harmonic, JointActuator,
+    PayloadConfig, PerJoint, PlantConfig, SensorConfig, Spring,
 };
 pub use effects::Effects;
 pub use engine::EngineName;

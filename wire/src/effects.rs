@@ -24,8 +24,16 @@ impl Effects {
     /// No new command reached the motors this period (lost, or not there in
     /// time): the last one was held.
     pub const COMMAND_HELD: u32 = 1 << 8;
+    /// The motor torque follows the command through a lag or a slew limit.
+    pub const MOTOR_LAG: u32 = 1 << 9;
+    /// Some transmission has gear backlash.
+    pub const BACKLASH: u32 = 1 << 10;
+    /// Some motor cogs (torque harmonics in its angle).
+    pub const COGGING: u32 = 1 << 11;
+    /// Some joint is series elastic (a spring between motor and link).
+    pub const ELASTIC: u32 = 1 << 12;
 
-    const NAMES: [(u32, &'static str); 9] = [
+    const NAMES: [(u32, &'static str); 13] = [
         (Self::FRICTION, "friction"),
         (Self::PAYLOAD, "payload"),
         (Self::DISTURBANCE, "disturbance"),
@@ -35,6 +43,10 @@ impl Effects {
         (Self::DELAYED, "delayed"),
         (Self::COMMAND_DROPPED, "command_dropped"),
         (Self::COMMAND_HELD, "command_held"),
+        (Self::MOTOR_LAG, "motor_lag"),
+        (Self::BACKLASH, "backlash"),
+        (Self::COGGING, "cogging"),
+        (Self::ELASTIC, "elastic"),
     ];
 
     /// Whether every bit of `bits` is set.
@@ -67,6 +79,6 @@ mod tests {
         assert_eq!(e.names(), ["friction", "command_held"]);
         assert!(e.has(Effects::FRICTION));
         assert!(!e.has(Effects::PAYLOAD));
-        assert_eq!(Effects::all_names().count(), 9);
+        assert_eq!(Effects::all_names().count(), 13);
     }
 }

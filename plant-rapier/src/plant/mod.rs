@@ -7,9 +7,11 @@ use arm_model::ArmModel;
 
 mod articulated;
 mod build;
+mod motor;
 mod rapier;
 
-use articulated::{Articulated, Drive, Setup};
+use articulated::{Articulated, Drive, Setup, Springs, Stage};
+use motor::Motors;
 use rapier::RapierArm;
 
 /// The engine that integrates the rigid-body dynamics.
@@ -25,13 +27,17 @@ pub struct Plant {
     substeps: u32,
     /// Effort limit per joint (infinite when none or saturation is off).
     effort: Vec<f64>,
-    /// The torque applied over the last step, after saturation.
+    /// The command the motors were given over the last step, after
+    /// saturation.
+    commanded: Vec<f64>,
+    /// The motors' mean torque over the last step.
     applied: Vec<f64>,
     /// Whether the last step clipped any joint's torque.
     saturated: bool,
     /// Torque from outside the motors (the disturbance), held until changed.
     external: Vec<f64>,
     friction: Friction,
+    motors: Motors,
 }
 
 /// Joint friction the scenario adds: viscous coefficient, Coulomb level
@@ -43,20 +49,26 @@ struct Friction {
     smoothing_velocity: f64,
 }
 
-/// What drives the joints over a step: the applied and external torques
-/// minus the friction at the current velocity.
+/// What drives the joints over a step: the motors (through their
+/// transmissions) and the external torque, minus the friction at the
+/// current velocity.
 struct Torques<'a> {
-    applied: &'a [f64],
+    motors: &'a Motors,
     external: &'a [f64],
     friction: &'a Friction,
 }
 
 impl Drive for Torques<'_> {
-    fn torque(&self, qd: &[f64], out: &mut [f64]) {
-        let f = self.friction;
+    fn torque(&self, at: &Stage, out: &mut [f64], dx: &mut [f64]) {
+        let (f, n) = (self.friction, out.len());
         for (i, x) in out.iter_mut().enumerate() {
-            *x = self.applied[i] + self.external[i]
-                - friction(qd[i], f.viscous[i], f.coulomb[i], f.smoothing_velocity);
+            let (link, motor_accel) = self.motors.drive(i, at.s, at.q[i], at.qd[i], at.x);
+            if !dx.is_empty() {
+                dx[i] = at.x[n + i];
+                dx[n + i] = motor_accel;
+            }
+            *x = link + self.external[i]
+                - friction(at.qd[i], f.viscous[i], f.coulomb[i], f.smoothing_velocity);
         }
     }
 }
@@ -87,8 +99,25 @@ impl Plant {
             coulomb: f.coulomb.resolve("plant.friction.coulomb", n)?,
             smoothing_velocity: f.smoothing_velocity,
         };
+        let motors = Motors::new(config.actuator.resolve(n)?);
         let engine = match config.engine {
             EngineName::Articulated => {
+                let spring = |f: fn(&crate::Spring) -> f64| -> Vec<f64> {
+                    let joints = motors.joints();
+                    joints
+                        .iter()
+                        .map(|j| j.spring.as_ref().map_or(0.0, f))
+                        .collect()
+                };
+                let (stiffness, damping) = (spring(|s| s.stiffness), spring(|s| s.damping));
+                let per_inertia = |f: fn(&crate::Spring) -> f64| {
+                    motors
+                        .joints()
+                        .iter()
+                        .filter_map(|j| j.spring.as_ref())
+                        .map(|s| f(s) / s.motor_inertia)
+                        .fold(0.0, f64::max)
+                };
                 let slope: Vec<f64> = (0..n)
                     .map(|i| {
                         friction.viscous[i] + friction.coulomb[i] / friction.smoothing_velocity
@@ -99,6 +128,15 @@ impl Plant {
                     armature: &armature,
                     urdf_dynamics: config.urdf_dynamics,
                     extra_damping: &slope,
+                    springs: Springs {
+                        stiffness: &stiffness,
+                        damping: &damping,
+                        per_motor_inertia: (
+                            per_inertia(|s| s.stiffness),
+                            per_inertia(|s| s.damping),
+                        ),
+                        states: motors.extra_states(),
+                    },
                 };
                 Engine::Articulated(Box::new(Articulated::new(model, &setup)?))
             }
@@ -111,10 +149,12 @@ impl Plant {
             names: model.joint_names(),
             substeps: config.substeps_or_default(),
             effort: build::effort_limits(model, config)?,
+            commanded: vec![0.0; n],
             applied: vec![0.0; n],
             saturated: false,
             external: vec![0.0; n],
             friction,
+            motors,
         })
     }
 
@@ -177,9 +217,20 @@ impl Plant {
         match &mut self.engine {
             Engine::Articulated(a) => {
                 a.set_state(q, qd);
+                self.motors.rest_at(q, qd, a.extra_state_mut());
                 Ok(())
             }
             Engine::Rapier(r) => r.set_state(q, qd),
+        }
+    }
+
+    /// The series-elastic motors' angles and speeds (None without them).
+    pub fn motor_state(&self) -> Option<(&[f64], &[f64])> {
+        match &self.engine {
+            Engine::Articulated(a) if !a.extra_state().is_empty() => {
+                Some(a.extra_state().split_at(self.dof()))
+            }
+            _ => None,
         }
     }
 
@@ -194,22 +245,23 @@ impl Plant {
             });
         }
         self.saturated = false;
-        for ((a, t), e) in self.applied.iter_mut().zip(tau).zip(&self.effort) {
-            *a = t.clamp(-e, *e);
-            self.saturated |= *a != *t;
+        for ((c, t), e) in self.commanded.iter_mut().zip(tau).zip(&self.effort) {
+            *c = t.clamp(-e, *e);
+            self.saturated |= *c != *t;
         }
+        self.motors.begin(&self.commanded);
         let drive = Torques {
-            applied: &self.applied,
+            motors: &self.motors,
             external: &self.external,
             friction: &self.friction,
         };
         match &mut self.engine {
-            Engine::Articulated(a) => a.step(&drive, dt, self.substeps),
-            Engine::Rapier(r) => {
-                r.step(&drive, dt, self.substeps);
-                Ok(())
-            }
+            Engine::Articulated(a) => a.step(&drive, dt, self.substeps)?,
+            Engine::Rapier(r) => r.step(&drive, dt, self.substeps),
         }
+        self.motors.mean_into(dt, &mut self.applied);
+        self.motors.end(dt);
+        Ok(())
     }
 
     /// The joint-space dynamics at the current state, with the plant's
@@ -285,8 +337,9 @@ impl Plant {
         }
     }
 
-    /// The torque applied over the last step: the command clipped to the
-    /// effort limits.
+    /// The motor torque applied over the last step, on average: the command
+    /// clipped to the effort limits, through the motors' lag and slew limit
+    /// (a series-elastic joint's link feels it through its spring).
     pub fn applied_torque(&self) -> &[f64] {
         &self.applied
     }

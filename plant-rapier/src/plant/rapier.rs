@@ -6,7 +6,7 @@
 use rapier3d_f64::glamx::EulerRot;
 use rapier3d_f64::prelude::*;
 
-use super::articulated::Drive;
+use super::articulated::{Drive, Stage};
 use super::build::{couple_mimics, dof_of, insert_bodies, insert_joints, joint_dynamics, settle};
 use crate::{PlantConfig, PlantError};
 use arm_model::{ArmModel, Origin};
@@ -47,6 +47,7 @@ pub(crate) struct RapierArm {
     /// Each link's own mass properties, before any payload.
     link_mprops: Vec<MassProperties>,
     /// Scratch: joint velocities and the torque Rapier is given per substep.
+    q: Vec<f64>,
     qd: Vec<f64>,
     total: Vec<f64>,
 }
@@ -112,6 +113,7 @@ impl RapierArm {
             coupled,
             bodies: handles,
             link_mprops,
+            q: vec![0.0; n],
             qd: vec![0.0; n],
             total: vec![0.0; n],
         })
@@ -176,20 +178,24 @@ impl RapierArm {
     }
 
     /// Advances by `dt` in `substeps` Rapier steps, the torque re-evaluated
-    /// (friction follows the velocity) and re-applied about the current axes
-    /// before each.
+    /// (friction follows the velocity, the motors their lag) and re-applied
+    /// about the current axes before each.
     pub(crate) fn step(&mut self, drive: &dyn Drive, dt: f64, substeps: u32) {
-        self.world.integration_parameters.dt = dt / f64::from(substeps);
-        for _ in 0..substeps {
-            let mut qd = std::mem::take(&mut self.qd);
-            let v = self.mb().generalized_velocity();
-            for (x, d) in qd.iter_mut().zip(&self.dofs) {
-                *x = v[d.assembly_id];
-            }
+        let h = dt / f64::from(substeps);
+        self.world.integration_parameters.dt = h;
+        for k in 0..substeps {
+            let (mut q, mut qd) = (std::mem::take(&mut self.q), std::mem::take(&mut self.qd));
+            self.state_into(&mut q, &mut qd);
             let mut total = std::mem::take(&mut self.total);
-            drive.torque(&qd, &mut total);
+            let at = Stage {
+                s: f64::from(k) * h,
+                q: &q,
+                qd: &qd,
+                x: &[],
+            };
+            drive.torque(&at, &mut total, &mut []);
             self.apply_torques(&total);
-            (self.qd, self.total) = (qd, total);
+            (self.q, self.qd, self.total) = (q, qd, total);
             self.world.step();
         }
     }

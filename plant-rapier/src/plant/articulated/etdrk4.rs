@@ -5,7 +5,7 @@
 
 use super::exponential::{self, MILD_DAMPING, Modes};
 use super::linalg::Cholesky;
-use super::{Articulated, Drive};
+use super::{Articulated, Drive, Stage};
 
 /// ETDRK4's buffers: per joint, the start, the damping's shares, the
 /// stages' velocities and (in the damping's coordinates, up to 2n long)
@@ -49,8 +49,10 @@ impl Exponential {
 impl Articulated {
     /// One ETDRK4 step of `h` (Cox & Matthews' scheme; see
     /// `exponential.rs`): positions as in RK4, velocities in the damping's
-    /// modes at the start of the step, each decaying exactly.
-    pub(super) fn etdrk4(&mut self, x: &mut Exponential, drive: &dyn Drive, h: f64) {
+    /// modes at the start of the step, each decaying exactly. The step
+    /// starts `s0` into the period; the drive has no states of its own
+    /// (with them the arm takes RK4 steps).
+    pub(super) fn etdrk4(&mut self, x: &mut Exponential, drive: &dyn Drive, s0: f64, h: f64) {
         let n = self.q.len();
         x.q0.copy_from_slice(&self.q);
         x.v0.copy_from_slice(&self.qd);
@@ -64,7 +66,7 @@ impl Articulated {
             exponential::damping_shares(chol, &self.reduced_damping, &mut x.qs, &mut x.shares);
         x.modal = h * stiffest > MILD_DAMPING;
         if !x.modal {
-            self.rk4(drive, h, true);
+            self.rk4(drive, s0, h, true);
             return;
         }
         if !x.modes.update(chol, &self.reduced_damping, &x.shares, h) {
@@ -73,7 +75,13 @@ impl Articulated {
             return;
         }
         let len = x.modes.len();
-        self.accelerate_factored(drive, &x.v0, &mut x.g);
+        let at = Stage {
+            s: s0,
+            q: &x.q0,
+            qd: &x.v0,
+            x: &[],
+        };
+        self.accelerate_factored(drive, &at, &mut x.g, &mut []);
         x.modes.to_modes(&x.v0, &mut x.y[0]);
         forcing(x, 0);
         // Stages a, b, c: position, then the velocity in modes.
@@ -100,7 +108,13 @@ impl Articulated {
                 std::mem::take(&mut x.qs),
                 std::mem::take(&mut x.v[stage - 1]),
             );
-            self.acceleration(drive, &qs, &vs, &mut x.g);
+            let at = Stage {
+                s: s0 + if stage == 3 { h } else { 0.5 * h },
+                q: &qs,
+                qd: &vs,
+                x: &[],
+            };
+            self.acceleration(drive, &at, &mut x.g, &mut []);
             (x.qs, x.v[stage - 1]) = (qs, vs);
             forcing(x, stage);
         }

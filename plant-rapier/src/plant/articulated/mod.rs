@@ -43,11 +43,23 @@ struct Follow {
     offset: f64,
 }
 
-/// The generalised torque on the controlled joints for a joint velocity:
-/// what the motors, the disturbance and the friction model add.
+/// Where the arm is at one stage of an integrator step: `s` seconds into
+/// the control period, the joints at (q, q̇), the drive's own states at `x`.
+pub(crate) struct Stage<'a> {
+    pub(crate) s: f64,
+    pub(crate) q: &'a [f64],
+    pub(crate) qd: &'a [f64],
+    pub(crate) x: &'a [f64],
+}
+
+/// The generalised torque on the controlled joints: what the motors, the
+/// disturbance and the friction model add. A drive may carry states of its
+/// own (a series-elastic joint's motor), which the engine integrates with
+/// the arm.
 pub(crate) trait Drive {
-    /// τ(q̇) into `out` (length `dof`).
-    fn torque(&self, qd: &[f64], out: &mut [f64]);
+    /// τ at `at` into `out` (length `dof`), and the rates of the drive's
+    /// states into `dx` (the length of `at.x`).
+    fn torque(&self, at: &Stage, out: &mut [f64], dx: &mut [f64]);
 }
 
 /// An arm in joint coordinates.
@@ -74,10 +86,20 @@ pub(crate) struct Articulated {
     damping_rate: f64,
     /// The exponential integrator's state, for an arm with URDF damping.
     exponential: Option<Box<Exponential>>,
+    /// A bound on the fastest oscillation of the series-elastic joints,
+    /// rad/s (0 without them): RK4 follows it while a substep times it
+    /// stays ≤ `MAX_PHASE_STEP`.
+    oscillation_rate: f64,
     q: Vec<f64>,
     qd: Vec<f64>,
+    /// The drive's own states (series-elastic motors' angles and speeds).
+    x: Vec<f64>,
     scratch: Scratch,
 }
+
+/// The largest phase a substep may advance the fastest elastic oscillation
+/// by: RK4's phase error is then ~(0.1)⁵/120 ≈ 1e-7 rad per substep.
+const MAX_PHASE_STEP: f64 = 0.1;
 
 /// Buffers for one evaluation and the RK4 stages, allocated once.
 #[derive(Debug, Clone)]
@@ -92,6 +114,8 @@ struct Scratch {
     qd0: Vec<f64>,
     k_q: [Vec<f64>; 4],
     k_qd: [Vec<f64>; 4],
+    x0: Vec<f64>,
+    k_x: [Vec<f64>; 4],
 }
 
 /// What the engine needs from the model beyond its tree.
@@ -102,6 +126,18 @@ pub(crate) struct Setup<'a> {
     /// Viscous damping the plant adds per controlled joint (the friction
     /// model's slope at rest), for the substep bound.
     pub(crate) extra_damping: &'a [f64],
+    /// The series-elastic joints, for the substep bound.
+    pub(crate) springs: Springs<'a>,
+}
+
+/// The series-elastic transmissions: per controlled joint, the stiffness
+/// and damping (0 where rigid), the largest stiffness and damping per motor
+/// inertia, and the drive's state count (0 without them).
+pub(crate) struct Springs<'a> {
+    pub(crate) stiffness: &'a [f64],
+    pub(crate) damping: &'a [f64],
+    pub(crate) per_motor_inertia: (f64, f64),
+    pub(crate) states: usize,
 }
 
 impl Articulated {
@@ -142,9 +178,10 @@ impl Articulated {
             reduced_damping[f.leader] += f.multiplier * f.multiplier * d;
         }
         let chol = mass_structure(&tree, &follow, n);
-        let exponential = reduced_damping
-            .iter()
-            .any(|d| *d > 0.0)
+        // The drive's states are integrated by RK4 alone: with them, URDF
+        // damping is explicit, its rate in the substep bound.
+        let springs = &setup.springs;
+        let exponential = (springs.states == 0 && reduced_damping.iter().any(|d| *d > 0.0))
             .then(|| Box::new(Exponential::new(&chol, n)));
         let mut arm = Self {
             names: model.joint_names(),
@@ -158,8 +195,10 @@ impl Articulated {
             gravity: Vector3::from(setup.gravity),
             armature: setup.armature.to_vec(),
             damping_rate: 0.0,
+            oscillation_rate: 0.0,
             q: vec![0.0; n],
             qd: vec![0.0; n],
+            x: vec![0.0; springs.states],
             scratch: Scratch {
                 qf: vec![0.0; nf],
                 qdf: vec![0.0; nf],
@@ -171,12 +210,22 @@ impl Articulated {
                 qd0: vec![0.0; n],
                 k_q: std::array::from_fn(|_| vec![0.0; n]),
                 k_qd: std::array::from_fn(|_| vec![0.0; n]),
+                x0: vec![0.0; springs.states],
+                k_x: std::array::from_fn(|_| vec![0.0; springs.states]),
             },
         };
         // A singular M at the start is a model no step can integrate.
         let (q, qd) = (arm.q.clone(), arm.qd.clone());
         arm.factor_mass(&q, &qd)?;
         arm.damping_rate = arm.rate_of(setup.extra_damping);
+        if springs.states > 0 {
+            // The coupled motor–link system's rates are at most twice the
+            // motors' and the links' own (|a − b|² ≤ 2|a|² + 2|b|²).
+            let (k_b, d_b) = springs.per_motor_inertia;
+            let urdf = arm.reduced_damping.clone();
+            arm.damping_rate += arm.rate_of(&urdf) + 2.0 * (d_b + arm.rate_of(springs.damping));
+            arm.oscillation_rate = (2.0 * (k_b + arm.rate_of(springs.stiffness))).sqrt();
+        }
         Ok(arm)
     }
 
@@ -189,6 +238,16 @@ impl Articulated {
     pub(crate) fn set_state(&mut self, q: &[f64], qd: &[f64]) {
         self.q.copy_from_slice(q);
         self.qd.copy_from_slice(qd);
+    }
+
+    /// The drive's own states (empty without them).
+    pub(crate) fn extra_state(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// The drive's own states, to set.
+    pub(crate) fn extra_state_mut(&mut self) -> &mut [f64] {
+        &mut self.x
     }
 
     /// M(q) with armature (row-major) into `inertia`, and the bias
@@ -226,7 +285,9 @@ impl Articulated {
     /// `substeps`: more only where stiff scenario friction needs them.
     pub(crate) fn substeps_for(&self, dt: f64, substeps: u32) -> u32 {
         // The friction slope acts through the explicit stages.
-        substeps.max((dt * self.damping_rate).ceil().min(1e6) as u32)
+        let damped = (dt * self.damping_rate).ceil();
+        let oscillating = (dt * self.oscillation_rate / MAX_PHASE_STEP).ceil();
+        substeps.max(damped.max(oscillating).min(1e6) as u32)
     }
 
     /// Advances by `dt` in `substeps` steps (RK4, or ETDRK4 with URDF
@@ -239,13 +300,14 @@ impl Articulated {
     ) -> Result<(), PlantError> {
         let substeps = self.substeps_for(dt, substeps);
         let h = dt / f64::from(substeps);
-        for _ in 0..substeps {
+        for k in 0..substeps {
+            let s0 = f64::from(k) * h;
             match self.exponential.take() {
                 Some(mut x) => {
-                    self.etdrk4(&mut x, drive, h);
+                    self.etdrk4(&mut x, drive, s0, h);
                     self.exponential = Some(x);
                 }
-                None => self.rk4(drive, h, false),
+                None => self.rk4(drive, s0, h, false),
             }
             self.constrain(h);
         }
@@ -258,31 +320,45 @@ impl Articulated {
         self.qd.iter_mut().for_each(|v| *v = f64::NAN);
     }
 
-    /// One RK4 step of `h`; `factored`: the inertia at the start is the
-    /// one factored last.
-    fn rk4(&mut self, drive: &dyn Drive, h: f64, factored: bool) {
+    /// One RK4 step of `h` from `s0` into the period, the drive's states
+    /// with it; `factored`: the inertia at the start is the one factored
+    /// last.
+    fn rk4(&mut self, drive: &dyn Drive, s0: f64, h: f64, factored: bool) {
         let s = &mut self.scratch;
         s.q0.copy_from_slice(&self.q);
         s.qd0.copy_from_slice(&self.qd);
+        s.x0.copy_from_slice(&self.x);
         for stage in 0..4 {
             let frac = [0.0, 0.5, 0.5, 1.0][stage];
             let (mut q, mut qd) = (std::mem::take(&mut self.q), std::mem::take(&mut self.qd));
+            let mut x = std::mem::take(&mut self.x);
             if stage > 0 {
                 let s = &self.scratch;
                 for i in 0..q.len() {
                     q[i] = s.q0[i] + frac * h * s.k_q[stage - 1][i];
                     qd[i] = s.qd0[i] + frac * h * s.k_qd[stage - 1][i];
                 }
+                for (i, xi) in x.iter_mut().enumerate() {
+                    *xi = s.x0[i] + frac * h * s.k_x[stage - 1][i];
+                }
             }
             let mut qdd = std::mem::take(&mut self.scratch.k_qd[stage]);
+            let mut dx = std::mem::take(&mut self.scratch.k_x[stage]);
+            let at = Stage {
+                s: s0 + frac * h,
+                q: &q,
+                qd: &qd,
+                x: &x,
+            };
             if stage == 0 && factored {
-                self.accelerate_factored(drive, &qd, &mut qdd);
+                self.accelerate_factored(drive, &at, &mut qdd, &mut dx);
             } else {
-                self.acceleration(drive, &q, &qd, &mut qdd);
+                self.acceleration(drive, &at, &mut qdd, &mut dx);
             }
             self.scratch.k_qd[stage] = qdd;
+            self.scratch.k_x[stage] = dx;
             self.scratch.k_q[stage].copy_from_slice(&qd);
-            (self.q, self.qd) = (q, qd);
+            (self.q, self.qd, self.x) = (q, qd, x);
         }
         let s = &self.scratch;
         for i in 0..self.armature.len() {
@@ -291,24 +367,36 @@ impl Articulated {
             self.q[i] = s.q0[i] + h / 6.0 * dq;
             self.qd[i] = s.qd0[i] + h / 6.0 * dqd;
         }
+        for (i, x) in self.x.iter_mut().enumerate() {
+            let dx = s.k_x[0][i] + 2.0 * (s.k_x[1][i] + s.k_x[2][i]) + s.k_x[3][i];
+            *x = s.x0[i] + h / 6.0 * dx;
+        }
     }
 
-    /// q̈ = M⁻¹ (τ(q̇) − h − D q̇) at (q, q̇). A state that has blown up
-    /// (the torque of a diverging law) has no inertia to factor: its
-    /// acceleration is NaN, and the run reports the non-finite state, as it
-    /// does with Rapier.
-    fn acceleration(&mut self, drive: &dyn Drive, q: &[f64], qd: &[f64], qdd: &mut [f64]) {
-        if self.factor_mass(q, qd).is_err() {
-            qdd.iter_mut().for_each(|x| *x = f64::NAN);
+    /// q̈ = M⁻¹ (τ − h − D q̇) at `at`, and the drive's state rates. A state
+    /// that has blown up (the torque of a diverging law) has no inertia to
+    /// factor: its acceleration is NaN, and the run reports the non-finite
+    /// state, as it does with Rapier.
+    fn acceleration(&mut self, drive: &dyn Drive, at: &Stage, qdd: &mut [f64], dx: &mut [f64]) {
+        if self.factor_mass(at.q, at.qd).is_err() {
+            qdd.iter_mut()
+                .chain(dx.iter_mut())
+                .for_each(|x| *x = f64::NAN);
             return;
         }
-        self.accelerate_factored(drive, qd, qdd);
+        self.accelerate_factored(drive, at, qdd, dx);
     }
 
     /// [`Self::acceleration`] at the state `factor_mass` was last called at.
-    fn accelerate_factored(&mut self, drive: &dyn Drive, qd: &[f64], qdd: &mut [f64]) {
+    fn accelerate_factored(
+        &mut self,
+        drive: &dyn Drive,
+        at: &Stage,
+        qdd: &mut [f64],
+        dx: &mut [f64],
+    ) {
         let s = &mut self.scratch;
-        drive.torque(qd, &mut s.tau);
+        drive.torque(at, &mut s.tau, dx);
         for (k, f) in self.follow.iter().enumerate() {
             let damping = self.damping[k] * s.qdf[k];
             s.tau[f.leader] -= f.multiplier * (s.hf[k] + damping);

@@ -6,6 +6,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::{EngineName, Locks, PlantError};
 
+mod actuator;
+
+pub use actuator::{ActuatorConfig, Harmonic, JointActuator, Spring};
+
 /// How the plant integrates, and the effects it adds on top of the rigid
 /// body dynamics.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -44,6 +48,11 @@ pub struct PlantConfig {
     pub sensor: SensorConfig,
     /// What happens to a command between the controller and the motors.
     pub actuation: ActuationConfig,
+    /// The motors and transmissions: torque lag and slew, cogging, series
+    /// elasticity and backlash. Unwritten when off, so that scenarios'
+    /// identities keep.
+    #[serde(skip_serializing_if = "ActuatorConfig::is_off")]
+    pub actuator: ActuatorConfig,
     /// Joints held still, by URDF name and position (rad or m):
     /// `[plant.lock]` with `finger_joint1 = 0.02`. A locked joint is
     /// simulated as fixed and is not controlled; a joint that mimics it is
@@ -74,6 +83,7 @@ impl Default for PlantConfig {
             disturbance: DisturbanceConfig::default(),
             sensor: SensorConfig::default(),
             actuation: ActuationConfig::default(),
+            actuator: ActuatorConfig::default(),
             lock: Locks::new(),
             urdf_dynamics: true,
             armature: PerJoint::default(),
@@ -359,6 +369,14 @@ impl PlantConfig {
         }
         self.disturbance.validate()?;
         self.validate_sensor_and_actuation()?;
+        self.actuator.validate()?;
+        if self.engine == EngineName::Rapier && self.actuator.elastic() {
+            return Err(invalid(
+                "plant.actuator.stiffness",
+                "set",
+                "0 with engine = \"rapier\": series-elastic joints are integrated by the articulated engine only",
+            ));
+        }
         Ok(())
     }
 
@@ -413,6 +431,10 @@ impl PlantConfig {
             (!s.q_resolution.is_zero(), E::QUANTISED),
             (a.delay_periods > 0, E::DELAYED),
             (a.drop_probability > 0.0, E::COMMAND_DROPPED),
+            (self.actuator.lags(), E::MOTOR_LAG),
+            (self.actuator.has_backlash(), E::BACKLASH),
+            (self.actuator.cogs(), E::COGGING),
+            (self.actuator.elastic(), E::ELASTIC),
         ] {
             if on {
                 bits |= bit;
@@ -441,6 +463,7 @@ impl PlantConfig {
         s.q_noise_std.resolve("plant.sensor.q_noise_std", n)?;
         s.qd_noise_std.resolve("plant.sensor.qd_noise_std", n)?;
         s.q_resolution.resolve("plant.sensor.q_resolution", n)?;
+        self.actuator.resolve(n)?;
         if let Some(p) = &self.payload
             && !link_names.contains(&p.link)
         {
