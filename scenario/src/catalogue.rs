@@ -36,6 +36,7 @@ pub const SHIPPED: &[Shipped] = shipped![
     "iiwa_csv",
     "paper_randomised",
     "ur5_randomised",
+    "iiwa_actuators",
 ];
 
 impl Shipped {

@@ -51,6 +51,7 @@ fn every_shipped_scenario_keeps_its_envelope() {
             "saturation_slow_reference" => &["saturated"],
             "paper_randomised" => &["sensor_noise", "disturbance"],
             "ur5_randomised" => &["disturbance"],
+            "iiwa_actuators" => &["motor_lag", "backlash", "cogging", "elastic"],
             _ => &[],
         };
         for w in want {
@@ -60,7 +61,8 @@ fn every_shipped_scenario_keeps_its_envelope() {
 }
 
 /// Every random effect at once (sensor noise, quantisation, disturbance
-/// noise, lost commands, delay, friction, a payload picked up): the four
+/// noise, lost commands, delay, friction, a payload picked up), on motors
+/// that lag, cog and drive through elastic gears with backlash: the four
 /// processes in lockstep give the in-process loop's bits; the same seed
 /// gives the same run; another seed another run.
 #[test]
@@ -77,7 +79,10 @@ fn seeded_effects_reproduce_exactly_across_processes_and_seeds_differ() {
                  [plant.payload]\nlink = \"link2\"\nmass = 0.5\noffset = [0.31, 0.0, 0.0]\nattach_at_s = 1.5\n\
                  [plant.disturbance]\nnoise_std = 0.5\nsin_amplitude = 1.0\n\
                  [plant.sensor]\nq_noise_std = 0.0005\nqd_noise_std = 0.01\nq_resolution = 0.001\n\
-                 [plant.actuation]\ndelay_periods = 1\ndrop_probability = 0.1\n"
+                 [plant.actuation]\ndelay_periods = 1\ndrop_probability = 0.1\n\
+                 [plant.actuator]\nbandwidth_hz = 50.0\nslew_rate = 2000.0\nstiffness = 3000.0\n\
+                 damping = 3.0\nmotor_inertia = 0.05\nbacklash = 0.001\n\
+                 [[plant.actuator.cogging]]\norder = 20.0\namplitude = 0.1\n"
             ),
         )
         .unwrap();
@@ -117,8 +122,9 @@ fn seeded_effects_reproduce_exactly_across_processes_and_seeds_differ() {
         .map(|l| l.split(',').nth(col).unwrap().parse::<u32>().unwrap())
         .fold(0, |a, b| a | b);
     // friction, payload, disturbance, sensor noise, quantised, delayed,
-    // command dropped, command held.
-    assert_eq!(seen & 0b1_1111_0111, 0b1_1111_0111, "{seen:b}");
+    // command dropped, command held, motor lag, backlash, cogging, elastic.
+    let all = 0b1_1111_1111_0111;
+    assert_eq!(seen & all, all, "{seen:b}");
 }
 
 /// A reference published at 100 Hz under a 1 kHz loop, in real time: the
