@@ -13,9 +13,10 @@
 //! irrelevant, `<mimic>` joints become coupled joints, and joints a scenario
 //! locks become fixed ones. Undeclared XML namespace prefixes are read as
 //! declared, a joint hanging from an undefined `world` link hangs from the
-//! fixed world, and a placeholder link (under 1 % of the heaviest link's
-//! mass) whose inertia is malformed is taken as massless; each is said in
-//! [`ArmModel::notes`] or [`ArmModel::ignored`].
+//! fixed world, and a light link (under 1 % of the heaviest link's mass)
+//! whose inertia is malformed keeps its mass and centre of mass with a
+//! sphere's tensor; each is said in [`ArmModel::notes`] or
+//! [`ArmModel::ignored`].
 //!
 //! ```
 //! use arm_model::{ArmModel, TWO_LINK_URDF, dynamics::Dynamics};

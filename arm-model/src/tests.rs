@@ -369,23 +369,32 @@ fn a_world_parent_without_a_world_link_is_the_fixed_root() {
 }
 
 /// A 3.8 g fingertip with moments (0, 0, 1e-6), which no body has, on a
-/// 1 kg arm: a placeholder, taken as massless and listed; the same tensor
-/// on a link of real mass is refused, naming the link and the remedy.
+/// 1 kg arm: kept with its mass (the arm still carries it) and a sphere's
+/// tensor, and said; the same tensor on a link of real mass is simulated as
+/// given, and said.
 #[test]
-fn a_placeholder_link_with_malformed_inertia_is_massless() {
+fn a_light_link_with_malformed_inertia_keeps_its_mass() {
     let bad = r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="1e-6""#;
     let jb = J1.replace("j1", "tip_joint").replace("\"a\"", "\"tip\"");
     let jb = jb.replace("<parent link=\"base\"/>", "<parent link=\"a\"/>");
     let text = arm(&format!("{J1}{jb}"), &link("tip", "0.0038", bad));
     let m = ArmModel::from_urdf_str(&text).unwrap();
-    assert_eq!(m.ignored.len(), 1, "{:?}", m.ignored);
-    assert_eq!(m.ignored[0].name, "tip");
+    assert!(m.ignored.is_empty(), "{:?}", m.ignored);
+    let tip = m.links.iter().find(|l| l.name == "tip").unwrap();
+    assert_eq!(tip.mass, 0.0038);
+    // 3.8 g of water: r = 9.68 mm, 2/5 m r² = 1.42e-7 kg m².
+    let moment =
+        0.4 * 0.0038 * (3.0 * 0.0038 / (4.0 * std::f64::consts::PI * 1000.0)).powf(2.0 / 3.0);
+    assert!((tip.inertia[0] - moment).abs() < 1e-18 && (moment - 1.424e-7).abs() < 1e-9);
+    assert_eq!(tip.inertia[5], tip.inertia[0]);
     assert!(
-        m.ignored[0].reason.contains("placeholder") && m.ignored[0].reason.contains("massless"),
-        "{}",
-        m.ignored[0].reason
+        m.notes
+            .iter()
+            .any(|n| n.starts_with("link 'tip'") && n.contains("kept with its mass")),
+        "{:?}",
+        m.notes
     );
-    assert_eq!(m.joints_moving_no_mass(), ["tip_joint"]);
+    assert!(m.joints_moving_no_mass().is_empty());
     // A real link with the same tensor is simulated as given, and said.
     let heavy = arm(&format!("{J1}{jb}"), &link("tip", "0.5", bad));
     let m = ArmModel::from_urdf_str(&heavy).unwrap();

@@ -278,6 +278,13 @@ fn apply_locks(
     Ok(locked)
 }
 
+/// The moment of inertia of a uniform sphere of `mass` kg at water's
+/// density (1000 kg/m³): 2/5 m r², r = (3m / 4πρ)^⅓.
+fn sphere_moment(mass: f64) -> f64 {
+    let r = (3.0 * mass / (4.0 * std::f64::consts::PI * 1000.0)).cbrt();
+    0.4 * mass * r * r
+}
+
 /// Zeroes what cannot matter (links welded to the fixed root, links of
 /// zero or negligible mass) and checks the inertia of every link that moves.
 fn settle_masses(
@@ -328,23 +335,21 @@ fn settle_masses(
         }
         match check_inertia(&l.name, &l.inertia) {
             Ok(Tensor::Fine(note)) => notes.extend(note),
-            // A placeholder (a fingertip frame of a few grams) with a
-            // tensor no body has: what it adds is below what the arm's
-            // own rounding moves, so it is dropped rather than refused.
+            // A light link (a finger of a few grams to 100 g) with a tensor
+            // no body has: its mass and centre of mass still load the arm,
+            // so they are kept; its tensor, which matters far less, becomes
+            // a uniform sphere's of that mass.
             Ok(Tensor::Impossible(reason)) | Err(ModelError::BadInertia { reason, .. })
                 if l.mass < PLACEHOLDER_MASS_RATIO * heaviest =>
             {
-                ignored.push(IgnoredLink {
-                    name: l.name.clone(),
-                    mass: l.mass,
-                    reason: format!(
-                        "a placeholder ({:e} kg, under {} % of the heaviest link's {heaviest} kg) whose inertia is malformed ({reason}): treated as massless",
-                        l.mass,
-                        100.0 * PLACEHOLDER_MASS_RATIO
-                    ),
-                });
-                l.mass = 0.0;
-                l.inertia = [0.0; 6];
+                let moment = sphere_moment(l.mass);
+                notes.push(format!(
+                    "link '{}' ({} kg, under {} % of the heaviest link's {heaviest} kg): its inertia is malformed ({reason}); kept with its mass and centre of mass, its tensor replaced by a uniform sphere's of that mass at water's density ({moment:.3e} kg m² about every axis)",
+                    l.name,
+                    l.mass,
+                    100.0 * PLACEHOLDER_MASS_RATIO
+                ));
+                l.inertia = [moment, 0.0, 0.0, moment, 0.0, moment];
             }
             // A real link with such a tensor still simulates (M stays
             // positive semi-definite), as Pinocchio and PyBullet take it.
