@@ -30,6 +30,11 @@ pub struct Report {
     pub locked_joints: Vec<String>,
     /// Joints coupled by `<mimic>`, not controlled.
     pub mimic_joints: Vec<String>,
+    /// What the testbed changed beyond the scenario and URDF files, and
+    /// what it warns about (see `scenario::Plan::changes`); empty for a
+    /// replayed log.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub changes: Vec<String>,
     /// The control law, whether it is model-based, and its parameters.
     pub law: LawInfo,
     /// The user's command that ran as the controller node (`run
@@ -135,6 +140,7 @@ impl Report {
             k2: g.k2,
             k2_below_analysis: g.below,
             locked_joints: g.locked,
+            changes: plan.changes.clone(),
             mimic_joints: g.mimic,
             realtime_factor: sim_s / wall_time_s.max(1e-9),
             summary,
@@ -167,6 +173,7 @@ impl Report {
             k2: g.k2,
             k2_below_analysis: g.below,
             locked_joints: g.locked,
+            changes: a.plan.changes.clone(),
             mimic_joints: g.mimic,
             scenario: a.plan.scenario.name.clone(),
             scenario_source: meta("scenario_source"),

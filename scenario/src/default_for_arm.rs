@@ -172,6 +172,18 @@ impl ArmDefault {
         let mut attempt = 0;
         loop {
             let (d, model) = Self::attempt(urdf, &chosen, &armature)?;
+            if d.gains.stability_number >= 2.0 {
+                // The gains aim for 1 everywhere checked: 2 is a failure of
+                // the choice, never a run.
+                return Err(PlantError::InvalidConfig {
+                    key: "controller.k2 (the default)".into(),
+                    value: format!(
+                        "gains with Δt·λmax(K2^½ M⁻¹ K2^½) = {:.3} at a posture along the reference",
+                        d.gains.stability_number
+                    ),
+                    need: "below 2 (the sampled loop's stability limit): write a scenario with lower k2 or a higher rate_hz".into(),
+                });
+            }
             let unheld = d.gains.unheld();
             attempt += 1;
             if attempt > ADJUSTMENTS {
@@ -376,6 +388,24 @@ fn warnings(
         }
     }
     Ok(out)
+}
+
+impl ArmDefault {
+    /// What this default changes of the arm and why, and what it warns
+    /// about, one sentence each (what `sim` and `run` say before a run).
+    pub fn changes(&self) -> Vec<String> {
+        let locked = self.locked.iter().map(|(name, why)| {
+            let at = self.scenario.plant.lock.get(name).copied().unwrap_or(0.0);
+            format!("locked {name} at {at:.4}: {why}")
+        });
+        let armature = self.armature.iter().map(|(name, a, why)| {
+            format!("armature {a:.3e} added to {name} ([plant] armature): {why}")
+        });
+        locked
+            .chain(armature)
+            .chain(self.warnings.iter().cloned())
+            .collect()
+    }
 }
 
 impl Scenario {

@@ -26,7 +26,7 @@
 use plant_rapier::{ArmModel, PlantError};
 
 use crate::Scenario;
-use crate::probe::Probe;
+use crate::probe::{Probe, Prober};
 
 /// Target for Δt·λ_max(K2^½ M⁻¹ K2^½): half the stability limit.
 const RHO: f64 = 1.0;
@@ -36,8 +36,12 @@ const ERROR_FRACTION: f64 = 0.4;
 const K1_DT_MAX: f64 = 0.2;
 /// The paper's gain: the smallest K1_i chosen.
 const K1_MIN: f64 = 15.0;
-/// Postures probed along the reference.
-const POSTURES: usize = 12;
+/// Reference time between two postures probed, s: M(q) changes little
+/// between them, and the postures halfway are checked too.
+const PROBE_SPACING_S: f64 = 0.05;
+/// Postures probed on the straight way from q(0) to the reference's start
+/// (the arm crosses them before T_c).
+const APPROACH: usize = 4;
 /// How far into the envelope the loop must stay stable with the barrier
 /// term: |Z1γ| up to this fraction of k_c (the steady error aimed for is 0.4).
 const BARRIER_EDGE: f64 = 0.8;
@@ -102,8 +106,12 @@ pub struct GainChoice {
     pub rate_hz: f64,
     /// Per joint.
     pub joints: Vec<JointGain>,
-    /// The largest Δt·λ_max(K2^½ M⁻¹ K2^½) over the postures (< 2 is stable).
+    /// The largest Δt·λ_max(K2^½ M⁻¹ K2^½) over the postures checked
+    /// (< 2 is stable; the gains aim for 1).
     pub stability_number: f64,
+    /// How many postures along the reference (and on the way to it) the
+    /// stability number was checked at.
+    pub postures_checked: usize,
     /// Envelope offset k_c per joint: the scenario's, or wider where the
     /// load needs it and the joint's range allows it.
     pub envelope: Vec<f64>,
@@ -127,21 +135,45 @@ impl GainChoice {
     }
 }
 
-/// The postures probed: the reference at evenly spread times, and q(0).
+/// The reference's posture at `t`.
+fn reference_at(s: &Scenario, t: f64) -> Vec<f64> {
+    s.reference.joints.iter().map(|r| r.eval(t)[0]).collect()
+}
+
+/// The postures probed: the reference every [`PROBE_SPACING_S`] (and at
+/// its end), q(0), and the way from q(0) to the reference's start.
 fn postures(s: &Scenario) -> Vec<Vec<f64>> {
-    let mut out: Vec<Vec<f64>> = (0..POSTURES)
-        .map(|k| {
-            let t = s.duration_s * k as f64 / POSTURES as f64;
-            s.reference.joints.iter().map(|r| r.eval(t)[0]).collect()
-        })
+    let count = (s.duration_s / PROBE_SPACING_S).ceil().max(1.0) as usize;
+    let mut out: Vec<Vec<f64>> = (0..=count)
+        .map(|k| reference_at(s, s.duration_s * k as f64 / count as f64))
         .collect();
-    out.push(s.initial.q.clone());
+    let (q0, start) = (&s.initial.q, reference_at(s, 0.0));
+    for k in 0..APPROACH {
+        let f = k as f64 / APPROACH as f64;
+        out.push(
+            q0.iter()
+                .zip(&start)
+                .map(|(a, b)| a + f * (b - a))
+                .collect(),
+        );
+    }
     out
+}
+
+/// The postures halfway between those [`postures`] takes on the reference:
+/// where the loop's stability is checked again.
+fn midpoints(s: &Scenario) -> Vec<Vec<f64>> {
+    let count = (s.duration_s / PROBE_SPACING_S).ceil().max(1.0) as usize;
+    (0..count)
+        .map(|k| reference_at(s, s.duration_s * (k as f64 + 0.5) / count as f64))
+        .collect()
 }
 
 /// What the plant reports about the arm along the reference.
 struct Measured {
     probes: Vec<Probe>,
+    /// Probes halfway between the reference's: for the stability check.
+    between: Vec<Probe>,
     minv_diag: Vec<f64>,
     load: Vec<f64>,
     gravity: Vec<f64>,
@@ -151,9 +183,14 @@ struct Measured {
 fn measure(model: &ArmModel, s: &Scenario) -> Result<Measured, PlantError> {
     let n = model.dof();
     let armature = s.plant.armature.resolve("plant.armature", n)?;
+    let mut prober = Prober::new(model, &armature)?;
     let probes = postures(s)
         .iter()
-        .map(|q| Probe::at(model, q, &armature))
+        .map(|q| prober.at(q))
+        .collect::<Result<Vec<_>, _>>()?;
+    let between = midpoints(s)
+        .iter()
+        .map(|q| prober.at(q))
         .collect::<Result<Vec<_>, _>>()?;
     let minv_diag: Vec<f64> = (0..n)
         .map(|i| probes.iter().map(|p| p.minv[(i, i)]).fold(0.0, f64::max))
@@ -187,20 +224,30 @@ fn measure(model: &ArmModel, s: &Scenario) -> Result<Measured, PlantError> {
         .collect();
     Ok(Measured {
         probes,
+        between,
         minv_diag,
         load,
         gravity,
     })
 }
 
-/// K2 at period `dt`: ρ/(Δt M⁻¹_ii), scaled down together to the coupled bound.
+impl Measured {
+    /// The largest stability number of `k2` over every posture probed and
+    /// every one halfway between them.
+    fn stability_number(&self, k2: &[f64], dt: f64) -> f64 {
+        self.probes
+            .iter()
+            .chain(&self.between)
+            .map(|p| p.stability_number(k2, dt))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// K2 at period `dt`: ρ/(Δt M⁻¹_ii), scaled down together to the coupled
+/// bound at every posture checked.
 fn k2_at(m: &Measured, dt: f64) -> Vec<f64> {
     let mut k2: Vec<f64> = m.minv_diag.iter().map(|x| RHO / (dt * x)).collect();
-    let worst = m
-        .probes
-        .iter()
-        .map(|p| p.stability_number(&k2, dt))
-        .fold(0.0, f64::max);
+    let worst = m.stability_number(&k2, dt);
     if worst > RHO {
         k2.iter_mut().for_each(|k| *k *= RHO / worst);
     }
@@ -283,11 +330,8 @@ pub fn choose_gains(
     Ok(GainChoice {
         rate_hz: rate,
         joints,
-        stability_number: m
-            .probes
-            .iter()
-            .map(|p| p.stability_number(&k2, dt))
-            .fold(0.0, f64::max),
+        stability_number: m.stability_number(&k2, dt),
+        postures_checked: m.probes.len() + m.between.len(),
         envelope,
     })
 }

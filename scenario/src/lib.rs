@@ -15,6 +15,7 @@
 
 mod catalogue;
 mod default_for_arm;
+mod effort;
 mod gains;
 mod plan;
 mod posture;
@@ -35,9 +36,10 @@ pub const TRAJECTORY_FILE_BYTES: u64 = 128 << 20;
 
 pub use catalogue::{SHIPPED, Shipped, find as find_shipped};
 pub use default_for_arm::{ArmDefault, GRIPPER_LOCK};
+pub use effort::{EFFORT_WARNING_FRACTION, effort_warnings};
 pub use gains::{ArmatureFor, GainChoice, JointGain};
 pub use plan::{Overrides, Plan, load, load_named, parse_set, plan, resolve_scenario};
-pub use probe::Probe;
+pub use probe::{Probe, Prober};
 pub use randomise::{Dist, Randomise, drawn};
 pub use robot::RobotSource;
 pub use wire::ns_to_s;

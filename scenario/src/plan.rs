@@ -30,6 +30,10 @@ pub struct Plan {
     pub reference_period_ns: u64,
     /// Number of control steps.
     pub steps: u64,
+    /// What the testbed changed beyond the files, and why: links of the
+    /// URDF that contribute nothing, and, for an arm's default scenario,
+    /// the joints it locks, the armature it adds and its warnings.
+    pub changes: Vec<String>,
 }
 
 impl Plan {
@@ -205,15 +209,18 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
         Some(path) => Some(RobotSource::from_file(path, &Locks::new())?),
         None => None,
     };
+    let mut default_changes = Vec::new();
     let (scenario, toml_text, source) = match (&arm, path) {
         (Some(arm), None) => {
             let locks = set_locks(&overrides.set);
-            let s = Scenario::for_arm_locked(&arm.urdf, &locks).map_err(|cause| {
+            let d = crate::ArmDefault::with_locks(&arm.urdf, &locks).map_err(|cause| {
                 ScenarioError::Plant {
                     file: arm.label(),
                     cause,
                 }
             })?;
+            default_changes = d.changes();
+            let s = d.scenario;
             let text = toml::to_string(&s).map_err(|e| ScenarioError::Toml {
                 file: arm.label(),
                 message: format!("cannot write the default scenario: {e}"),
@@ -280,7 +287,9 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
         file: source.clone(),
         cause: Box::new(cause),
     })?;
-    plan(scenario, source, toml_text, robot)
+    let mut plan = plan(scenario, source, toml_text, robot)?;
+    plan.changes.extend(default_changes);
+    Ok(plan)
 }
 
 /// A scenario argument as `--scenario` takes it: a file, or else the name
@@ -354,6 +363,12 @@ pub fn plan(
             return Err(mismatch(key, len));
         }
     }
+    let changes = robot
+        .model
+        .ignored
+        .iter()
+        .map(|l| format!("link '{}' dropped from the dynamics: {}", l.name, l.reason))
+        .collect();
     let undrawn = scenario.clone();
     let scenario = crate::drawn(&scenario, dof);
     if scenario != undrawn {
@@ -414,6 +429,7 @@ pub fn plan(
         period_ns,
         reference_period_ns,
         steps,
+        changes,
     })
 }
 

@@ -18,16 +18,16 @@ pub struct Probe {
     pub gravity: DVector<f64>,
 }
 
-impl Probe {
-    /// Probes `model` at `q` with `armature` (per joint) added.
-    ///
-    /// M and G are read from the articulated engine, not differenced from
-    /// a short step's response to unit torques: on a near-singular arm
-    /// (a head whose inertia is a point mass on its axis, M⁻¹_ii ~ 1e8)
-    /// the step itself moves the joint fast enough that its response is
-    /// no longer linear, and the load G = −M a₀ came out wrong by orders.
-    pub fn at(model: &ArmModel, q: &[f64], armature: &[f64]) -> Result<Self, PlantError> {
-        let n = model.dof();
+/// One plant probed at many postures (building it once).
+#[derive(Debug)]
+pub struct Prober {
+    plant: Plant,
+    rest: Vec<f64>,
+}
+
+impl Prober {
+    /// The plant of `model` with `armature` (per joint) added, to probe.
+    pub fn new(model: &ArmModel, armature: &[f64]) -> Result<Self, PlantError> {
         let config = PlantConfig {
             engine: EngineName::Articulated,
             saturate: false,
@@ -35,9 +35,23 @@ impl Probe {
             armature: plant_rapier::PerJoint::Each(armature.to_vec()),
             ..PlantConfig::default()
         };
-        let mut plant = Plant::new(model, &config)?;
-        plant.set_state(q, &vec![0.0; n])?;
-        let (m, bias) = plant.inertia_and_bias()?;
+        Ok(Self {
+            plant: Plant::new(model, &config)?,
+            rest: vec![0.0; model.dof()],
+        })
+    }
+
+    /// M(q)⁻¹, M(q) and G(q) at `q`.
+    ///
+    /// M and G are read from the articulated engine, not differenced from
+    /// a short step's response to unit torques: on a near-singular arm
+    /// (a head whose inertia is a point mass on its axis, M⁻¹_ii ~ 1e8)
+    /// the step itself moves the joint fast enough that its response is
+    /// no longer linear, and the load G = −M a₀ came out wrong by orders.
+    pub fn at(&mut self, q: &[f64]) -> Result<Probe, PlantError> {
+        let n = self.rest.len();
+        self.plant.set_state(q, &self.rest)?;
+        let (m, bias) = self.plant.inertia_and_bias()?;
         let engine = |what: &str| PlantError::Engine(format!("probing M(q) at {q:?}: {what}"));
         let m = DMatrix::from_row_slice(n, n, &m);
         let m = (&m + m.transpose()) * 0.5;
@@ -51,7 +65,15 @@ impl Probe {
         }
         // At rest the bias is G(q) alone.
         let gravity = DVector::from_vec(bias);
-        Ok(Self { minv, m, gravity })
+        Ok(Probe { minv, m, gravity })
+    }
+}
+
+impl Probe {
+    /// Probes `model` at `q` with `armature` (per joint) added (see
+    /// [`Prober::at`]).
+    pub fn at(model: &ArmModel, q: &[f64], armature: &[f64]) -> Result<Self, PlantError> {
+        Prober::new(model, armature)?.at(q)
     }
 
     /// Δt · λ_max(K^½ M⁻¹ K^½): below 2 for the discrete loop to be stable (SPEC §11).

@@ -387,3 +387,54 @@ fn envelope_from_joint_limits_is_respected() {
         "{err}"
     );
 }
+
+/// #38 item 3: `sim` says what it changed and why (the panda's fingers
+/// locked, on stderr and in `--json`), and warns where the reference loads
+/// a joint past 80 % of its effort, or a joint has no limit at all, in
+/// `sim` and in `robot` alike.
+#[test]
+fn sim_and_robot_say_what_they_changed_and_where_effort_runs_short() {
+    let out = ok(testbed().args(["sim", "--json", "--robot", "robots/panda.urdf"]));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("testbed: note: locked panda_finger_joint1 at 0.0200: a gripper"),
+        "{stderr}"
+    );
+    let changes = json(&out)["changes"].clone();
+    assert!(
+        changes.as_array().unwrap().iter().any(|c| c
+            .as_str()
+            .unwrap()
+            .starts_with("locked panda_finger_joint1")),
+        "{changes}"
+    );
+    // The paper's reference needs 7.79 N m at the shoulder, 1.52 at the
+    // elbow: 8 N m is 97 %, 2 N m 76 % (not warned).
+    let dir = tempfile::tempdir().unwrap();
+    let weak = dir.path().join("weak.toml");
+    std::fs::write(&weak, "[plant]\neffort_limit = [8.0, 2.0]\n").unwrap();
+    let out = ok(testbed().args(["sim", "--scenario"]).arg(&weak));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("joint 'joint1': the reference needs up to")
+            && stderr.contains("97 % of its effort limit 8 N m: expect saturation"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("'joint2'"), "{stderr}");
+    // No effort limit: said by `robot` and by `sim`.
+    let text = std::fs::read_to_string(crate::util::repo_root().join("robots/two_link.urdf"))
+        .unwrap()
+        .replace("effort=", "data-effort=");
+    let free = dir.path().join("free.urdf");
+    std::fs::write(&free, text).unwrap();
+    let said = "no effort limit for joint1, joint2";
+    let robot = ok(testbed().arg("robot").arg(&free));
+    let robot = String::from_utf8_lossy(&robot.stdout);
+    assert!(robot.contains(&format!("warning: {said}")), "{robot}");
+    let sim = ok(testbed().args(["sim", "--robot"]).arg(&free));
+    let stderr = String::from_utf8_lossy(&sim.stderr);
+    assert!(
+        stderr.contains(&format!("testbed: note: {said}")),
+        "{stderr}"
+    );
+}

@@ -240,10 +240,19 @@ pub(crate) fn load(common: &ScenarioArgs, rate: Option<f64>) -> Result<scenario:
         law: common.law,
         set: common.set.clone(),
     };
-    Ok(scenario::load_named(
-        common.scenario.as_deref(),
-        &overrides,
-    )?)
+    let mut plan = scenario::load_named(common.scenario.as_deref(), &overrides)?;
+    let effort =
+        scenario::effort_warnings(&plan).map_err(|cause| scenario::ScenarioError::Plant {
+            file: plan.source.clone(),
+            cause,
+        })?;
+    plan.changes.extend(effort);
+    // Said before the run: what the testbed changed beyond the files, and
+    // where the scenario asks a motor for more than it can give.
+    for line in &plan.changes {
+        eprintln!("testbed: note: {line}");
+    }
+    Ok(plan)
 }
 
 /// Refuses a scenario with an `[external]` table where no external

@@ -32,7 +32,18 @@ pub fn describe(path: &Path) -> Result<String> {
         cause,
     })?;
     default_scenario(&mut out, &d);
-    warnings(&mut out, &d);
+    let locked = robot.relocked(&d.scenario.plant.lock)?;
+    // An arm past the wire's MAX_DOF has no plan (the warnings say so).
+    let effort = if locked.model.dof() <= wire::MAX_DOF {
+        let plan = scenario::plan(d.scenario.clone(), robot.label(), String::new(), locked)?;
+        scenario::effort_warnings(&plan).map_err(|cause| scenario::ScenarioError::Plant {
+            file: robot.label(),
+            cause,
+        })?
+    } else {
+        Vec::new()
+    };
+    warnings(&mut out, &d, &effort);
     Ok(out)
 }
 
@@ -138,7 +149,7 @@ fn links(out: &mut String, m: &ArmModel) {
 
 /// Everything the default scenario had to change or could not fix, together
 /// at the end where a user looks: each a line starting "warning:".
-fn warnings(out: &mut String, d: &ArmDefault) {
+fn warnings(out: &mut String, d: &ArmDefault, effort: &[String]) {
     let mut lines: Vec<String> = Vec::new();
     let controlled = d.gains.joints.len();
     if controlled > wire::MAX_DOF {
@@ -161,6 +172,7 @@ fn warnings(out: &mut String, d: &ArmDefault) {
         ));
     }
     lines.extend(d.warnings.iter().cloned());
+    lines.extend(effort.iter().cloned());
     if !lines.is_empty() {
         let _ = writeln!(out);
     }
@@ -204,8 +216,8 @@ fn default_scenario(out: &mut String, d: &ArmDefault) {
     }
     let _ = writeln!(
         out,
-        "  K2_i = 1/(Δt·max M⁻¹_ii), scaled so that Δt·λmax(K2^½ M⁻¹ K2^½) = {:.3} (< 2 is stable)",
-        g.stability_number
+        "  K2_i = 1/(Δt·max M⁻¹_ii), scaled so that Δt·λmax(K2^½ M⁻¹ K2^½) = {:.3} (< 2 is stable) at the worst of {} postures along the reference and on the way to it",
+        g.stability_number, g.postures_checked
     );
     let below = g.below_half();
     if !below.is_empty() {
