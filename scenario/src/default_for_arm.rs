@@ -86,18 +86,28 @@ fn kc_cap(model: &ArmModel) -> Vec<f64> {
                 .limits
                 .map_or(f64::INFINITY, |(lo, hi)| 0.5 * (hi - lo));
             match model.joints[ji].kind {
-                JointKind::Prismatic => 0.15 * half,
+                JointKind::Prismatic => (0.15 * half).min(PRISMATIC_KC_CAP_M),
                 _ => (0.3 * half).min(1.0),
             }
         })
         .collect()
 }
 
-/// Per joint: the reference about `offsets`, the envelope (offset `kc` when
-/// given), and the initial position.
+/// The largest reference amplitude of a prismatic joint, m: a mobile
+/// base's ±1000 m rail is not swung over 300 m.
+const PRISMATIC_AMPLITUDE_M: f64 = 0.25;
+/// The default envelope of a prismatic joint at most, m.
+const PRISMATIC_KC_M: f64 = 0.05;
+/// The widest envelope a prismatic joint may be given, m.
+const PRISMATIC_KC_CAP_M: f64 = 0.15;
+
+/// Per joint: the reference about `offsets`, its amplitude times the
+/// joint's factor in `amplitude` (by name; 1 if absent), the envelope
+/// (offset `kc` when given), and the initial position.
 fn shape(
     model: &ArmModel,
     offsets: &[f64],
+    amplitude: &[(String, f64)],
     kc: Option<&[f64]>,
 ) -> (Vec<Signal>, Vec<Signal>, Vec<f64>) {
     let (mut reference, mut envelope, mut q0) = (Vec::new(), Vec::new(), Vec::new());
@@ -106,9 +116,17 @@ fn shape(
         let half = j.limits.map_or(f64::INFINITY, |(lo, hi)| 0.5 * (hi - lo));
         let center = offsets[i];
         let (amp, kc_default) = match j.kind {
-            JointKind::Prismatic => (0.3 * half, 0.15 * half),
+            JointKind::Prismatic => (
+                (0.3 * half).min(PRISMATIC_AMPLITUDE_M),
+                (0.15 * half).min(PRISMATIC_KC_M),
+            ),
             _ => ((0.3 * half).min(0.5), 0.25f64.min(0.3 * half)),
         };
+        let factor = amplitude
+            .iter()
+            .find(|(n, _)| *n == j.name)
+            .map_or(1.0, |a| a.1);
+        let amp = amp * factor;
         let kc = kc.map_or(kc_default, |k| k[i]);
         let omega = 0.8 + 0.2 * (i % 3) as f64;
         // Alternate sin and cos so the joints do not all start at rest.
@@ -169,9 +187,10 @@ impl ArmDefault {
                 .filter(|(n, ..)| !user.contains_key(n)),
         );
         let mut armature: Vec<(String, f64, String)> = Vec::new();
+        let mut amplitude: Vec<(String, f64)> = Vec::new();
         let mut attempt = 0;
         loop {
-            let (d, model) = Self::attempt(urdf, &chosen, &armature)?;
+            let (d, model) = Self::attempt(urdf, &chosen, &armature, &amplitude)?;
             if d.gains.stability_number >= 2.0 {
                 // The gains aim for 1 everywhere checked: 2 is a failure of
                 // the choice, never a run.
@@ -192,6 +211,16 @@ impl ArmDefault {
             let overloaded = overloaded(&d);
             if !overloaded.is_empty() && overloaded.len() < model.dof() {
                 chosen.extend(overloaded);
+                continue;
+            }
+            let slower = within_effort(&d);
+            if !slower.is_empty() {
+                for (name, f) in slower {
+                    match amplitude.iter_mut().find(|(n, _)| *n == name) {
+                        Some(a) => a.1 *= f,
+                        None => amplitude.push((name, f)),
+                    }
+                }
                 continue;
             }
             if unheld.is_empty() {
@@ -243,11 +272,12 @@ impl ArmDefault {
         urdf: &str,
         chosen: &[(String, f64, String)],
         armature: &[(String, f64, String)],
+        amplitude: &[(String, f64)],
     ) -> Result<(Self, ArmModel), PlantError> {
         let lock: Locks = chosen.iter().map(|(n, p, _)| (n.clone(), *p)).collect();
         let model = ArmModel::from_urdf_str_locked(urdf, &lock)?;
         let offsets = crate::posture::choose(&model)?;
-        let (reference, envelope, q0) = shape(&model, &offsets, None);
+        let (reference, envelope, q0) = shape(&model, &offsets, amplitude, None);
         let n = q0.len();
         let mut s = Scenario {
             name: format!("default for {}", model.name),
@@ -287,7 +317,7 @@ impl ArmDefault {
             s.plant.armature = PerJoint::Each(per_joint.clone());
         }
         let gains = choose_gains(&model, &s, &kc_cap(&model))?;
-        let (_, envelope, q0) = shape(&model, &offsets, Some(&gains.envelope));
+        let (_, envelope, q0) = shape(&model, &offsets, amplitude, Some(&gains.envelope));
         s.envelope.joints = envelope;
         s.initial.q = q0;
         s.rate_hz = gains.rate_hz;
@@ -347,6 +377,25 @@ fn overloaded(d: &ArmDefault) -> Vec<(String, f64, String)> {
                     ),
                 )
             })
+        })
+        .collect()
+}
+
+/// The share of a joint's effort its reference may need: the rest is the
+/// controller's to correct with.
+const REFERENCE_EFFORT_SHARE: f64 = 0.7;
+
+/// Joints whose reference needs more than [`REFERENCE_EFFORT_SHARE`] of
+/// their effort limit while gravity alone leaves room: the factor to scale
+/// their reference's amplitude by (its motion's load scales with it).
+fn within_effort(d: &ArmDefault) -> Vec<(String, f64)> {
+    d.gains
+        .joints
+        .iter()
+        .filter_map(|g| {
+            let room = REFERENCE_EFFORT_SHARE * g.effort? - g.gravity;
+            let motion = g.load - g.gravity;
+            (room > 0.0 && motion > room).then(|| (g.name.clone(), room / motion))
         })
         .collect()
 }

@@ -50,3 +50,41 @@ fn default_gains_are_stable_everywhere_along_the_reference() {
         );
     }
 }
+
+/// A mobile base on a ±1000 m rail (a prismatic joint of 100 N carrying
+/// 20 kg) under a 1 kg arm joint: its reference is a swing of at most
+/// 0.25 m that its motor drives with room to spare (metres and newtons,
+/// not a third of the rail), and a reference too hard for a joint's effort
+/// is slowed to fit.
+#[test]
+fn a_mobile_base_gets_a_reference_within_its_effort() {
+    let urdf = r#"<robot name="cart">
+      <link name="world"/>
+      <link name="base"><inertial><mass value="20"/><origin xyz="0 0 0"/>
+        <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+      <link name="arm"><inertial><mass value="1"/><origin xyz="0.3 0 0"/>
+        <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+      <joint name="rail" type="prismatic"><parent link="world"/><child link="base"/>
+        <axis xyz="1 0 0"/><limit lower="-1000" upper="1000" effort="100" velocity="1"/></joint>
+      <joint name="turn" type="revolute"><parent link="base"/><child link="arm"/>
+        <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="50" velocity="3"/></joint>
+    </robot>"#;
+    let d = ArmDefault::new(urdf).unwrap();
+    let rail = &d.scenario.reference.joints[0];
+    let swing = (0..1000)
+        .map(|k| (rail.eval(f64::from(k) * 0.01)[0] - rail.offset).abs())
+        .fold(0.0, f64::max);
+    assert!(swing > 0.01 && swing <= 0.25 + 1e-9, "{swing} m");
+    let g = &d.gains.joints[0];
+    assert!(g.load <= 0.7 * 100.0 + 1e-9, "{} N", g.load);
+    assert!(d.gains.envelope[0] <= 0.15, "{} m", d.gains.envelope[0]);
+    // A weak rail motor: 21 kg swung 0.25 m at 0.8 rad/s needs 3.4 N; the
+    // swing is cut to fit 70 % of its 3 N.
+    let weak = urdf.replace(r#"effort="100""#, r#"effort="3""#);
+    let d = ArmDefault::new(&weak).unwrap();
+    let g = &d.gains.joints[0];
+    assert!(g.load <= 0.7 * 3.0 * 1.01, "{} N of 3", g.load);
+    let rail = &d.scenario.reference.joints[0];
+    let amp = rail.eval(std::f64::consts::PI / 1.6)[0] - rail.offset;
+    assert!(amp.abs() < 0.2, "{amp} m");
+}
