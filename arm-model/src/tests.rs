@@ -444,3 +444,46 @@ fn a_texture_without_a_filename_is_read() {
         m.notes
     );
 }
+
+/// The Robotiq 2F-85's pattern: a leader in [0, 0.8] and mimic joints at
+/// multiplier −1 listing [0, 0.8757]: their stops would pin the leader at
+/// 0, so their limits are dropped (as ROS drives mimic joints), with a
+/// note; a mimic whose limits leave the leader a range keeps them.
+#[test]
+fn mimic_limits_that_leave_the_leader_no_range_are_dropped_and_said() {
+    let range = |j: String, lo: &str, hi: &str| {
+        j.replace(
+            r#"lower="-1" upper="1""#,
+            &format!(r#"lower="{lo}" upper="{hi}""#),
+        )
+    };
+    let follow = |m: &str| format!(r#"<mimic joint="j1" multiplier="{m}" offset="0"/>"#);
+    let text = format!(
+        r#"<robot name="r"><link name="base"/>{}{}{}{}{}{}</robot>"#,
+        link("a", "1", I),
+        link("b", "1", I),
+        link("c", "1", I),
+        range(joint("j1", "revolute", "base", "a", ""), "0", "0.8"),
+        range(
+            joint("inner", "revolute", "a", "b", &follow("-1")),
+            "0",
+            "0.8757"
+        ),
+        range(
+            joint("outer", "revolute", "a", "c", &follow("1")),
+            "0",
+            "0.81"
+        ),
+    );
+    let m = ArmModel::from_urdf_str(&text).unwrap();
+    let limits = |name: &str| m.joints.iter().find(|j| j.name == name).unwrap().limits;
+    assert_eq!(limits("inner"), None);
+    assert_eq!(limits("outer"), Some((0.0, 0.81)));
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.starts_with("mimic joint 'inner'") && n.contains("leave 'j1' no range")),
+        "{:?}",
+        m.notes
+    );
+}

@@ -87,8 +87,42 @@ pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, M
     notes.extend(inertia_notes);
     let folded = merge_fixed(links, joints);
     let mut model = finish(robot.name.clone(), folded, &leaders, locked, ignored)?;
+    notes.extend(free_contradicting_mimic_limits(&mut model));
     model.notes = notes;
     Ok(model)
+}
+
+/// Drops the limits of a mimic joint that leave its leader no range: the
+/// Robotiq 2F-85's inner finger joints follow `finger_joint` ∈ [0, 0.8]
+/// with multiplier −1 but list [0, 0.8757], so their stops would pin the
+/// whole gripper at 0. ROS drives mimic joints without their limits; so
+/// does the testbed here, and says so. Limits that leave a range are kept.
+fn free_contradicting_mimic_limits(model: &mut ArmModel) -> Vec<String> {
+    let mut notes = Vec::new();
+    for m in &model.mimic {
+        let leader = &model.joints[model.actuated[m.leader]];
+        let (Some((lo, hi)), Some((a, b))) = (model.joints[m.joint].limits, leader.limits) else {
+            continue;
+        };
+        if m.multiplier == 0.0 {
+            continue;
+        }
+        // The leader's positions the mimic's limits allow.
+        let (x, y) = (
+            (lo - m.offset) / m.multiplier,
+            (hi - m.offset) / m.multiplier,
+        );
+        let (x, y) = (x.min(y), x.max(y));
+        let room = y.min(b) - x.max(a);
+        if room <= 1e-9 * (b - a).abs().max(1.0) {
+            let (name, leader) = (model.joints[m.joint].name.clone(), leader.name.clone());
+            notes.push(format!(
+                "mimic joint '{name}': its limits [{lo}, {hi}] leave '{leader}' no range (they allow it [{x:.4}, {y:.4}], its own is [{a}, {b}]): ignored, as ROS drives mimic joints"
+            ));
+            model.joints[m.joint].limits = None;
+        }
+    }
+    notes
 }
 
 /// The link a fixed-base model's root joint conventionally hangs from.

@@ -303,6 +303,10 @@ impl ArmDefault {
             ..Scenario::default()
         };
         s.plant.lock = lock;
+        let stuck = friction_beyond_effort(&model);
+        if stuck.is_some() {
+            s.plant.urdf_dynamics = false;
+        }
         let per_joint: Vec<f64> = model
             .joint_names()
             .iter()
@@ -323,7 +327,8 @@ impl ArmDefault {
         s.rate_hz = gains.rate_hz;
         s.controller.k1 = controller::Gain::Each(gains.joints.iter().map(|g| g.k1).collect());
         s.controller.k2 = controller::Gain::Each(gains.joints.iter().map(|g| g.k2).collect());
-        let warnings = warnings(&model, &offsets, &per_joint, &gains)?;
+        let mut warnings = warnings(&model, &offsets, &per_joint, &gains)?;
+        warnings.extend(stuck);
         let d = Self {
             scenario: s,
             locked: chosen
@@ -379,6 +384,31 @@ fn overloaded(d: &ArmDefault) -> Vec<(String, f64, String)> {
             })
         })
         .collect()
+}
+
+/// Joints whose URDF dry friction is at least their effort limit (Drake's
+/// Allegro hand lists 10 N m of friction on 0.7 N m motors): no motor moves
+/// them, so the default turns URDF dynamics off, and says why.
+fn friction_beyond_effort(model: &ArmModel) -> Option<String> {
+    let stuck: Vec<String> = model
+        .moving_joints()
+        .map(|ji| &model.joints[ji])
+        .filter(|j| j.effort.is_some_and(|e| j.friction >= e))
+        .map(|j| {
+            format!(
+                "{} ({} N m ≥ {} N m)",
+                j.name,
+                j.friction,
+                j.effort.unwrap_or(0.0)
+            )
+        })
+        .collect();
+    (!stuck.is_empty()).then(|| {
+        format!(
+            "the URDF's dry friction is at least the effort limit on {}: no motor could move them, so the default turns URDF damping and friction off ([plant] urdf_dynamics = false)",
+            stuck.join(", ")
+        )
+    })
 }
 
 /// The share of a joint's effort its reference may need: the rest is the

@@ -1,6 +1,6 @@
-//! #38 item 3: the default gains of every shipped arm hold the sampled
-//! loop's stability number at its target (1, half the limit of 2) along
-//! the whole reference, checked ten times as densely as they were chosen.
+//! #38 item 3: the default scenario of an arm holds on arms the shipped
+//! ones do not cover: gains stable along the whole reference, a mobile
+//! base swung within its effort, URDF friction no motor overcomes.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
@@ -87,4 +87,33 @@ fn a_mobile_base_gets_a_reference_within_its_effort() {
     let rail = &d.scenario.reference.joints[0];
     let amp = rail.eval(std::f64::consts::PI / 1.6)[0] - rail.offset;
     assert!(amp.abs() < 0.2, "{amp} m");
+}
+
+/// Drake's Allegro hand lists 10 N m of dry friction on 0.7 N m motors:
+/// no motor could move a finger, so the default turns URDF dynamics off
+/// and says which joints and why.
+#[test]
+fn urdf_friction_beyond_effort_turns_urdf_dynamics_off_and_says_so() {
+    let urdf = std::fs::read_to_string(format!(
+        "{}/../robots/two_link.urdf",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let d = ArmDefault::new(&urdf).unwrap();
+    assert!(d.scenario.plant.urdf_dynamics);
+    let stuck = urdf.replacen(
+        "<limit lower=\"-3.14159\" upper=\"3.14159\" effort=\"500\" velocity=\"20\"/>",
+        "<limit lower=\"-3.14159\" upper=\"3.14159\" effort=\"20\" velocity=\"20\"/>\n    <dynamics damping=\"0\" friction=\"25\"/>",
+        1,
+    );
+    assert_ne!(stuck, urdf);
+    let d = ArmDefault::new(&stuck).unwrap();
+    assert!(!d.scenario.plant.urdf_dynamics);
+    assert!(
+        d.changes()
+            .iter()
+            .any(|c| c.contains("joint1 (25 N m ≥ 20 N m)") && c.contains("urdf_dynamics = false")),
+        "{:?}",
+        d.changes()
+    );
 }
