@@ -329,6 +329,12 @@ impl ArmDefault {
         s.controller.k2 = controller::Gain::Each(gains.joints.iter().map(|g| g.k2).collect());
         let mut warnings = warnings(&model, &offsets, &per_joint, &gains)?;
         warnings.extend(stuck);
+        for (name, f) in amplitude.iter().filter(|(_, f)| *f < 1.0) {
+            warnings.push(format!(
+                "joint '{name}': reference swing cut to {f:.3} of the default's: it needed more than {:.0} % of the joint's effort limit",
+                100.0 * REFERENCE_EFFORT_SHARE
+            ));
+        }
         let d = Self {
             scenario: s,
             locked: chosen
@@ -416,16 +422,25 @@ fn friction_beyond_effort(model: &ArmModel) -> Option<String> {
 const REFERENCE_EFFORT_SHARE: f64 = 0.7;
 
 /// Joints whose reference needs more than [`REFERENCE_EFFORT_SHARE`] of
-/// their effort limit while gravity alone leaves room: the factor to scale
-/// their reference's amplitude by (its motion's load scales with it).
+/// their effort limit: the factor to scale their reference's amplitude by.
+/// Where gravity alone leaves room, the motion's load scales with the
+/// amplitude, so the factor fits it; where gravity along the swing takes
+/// the room (a long arm swung away from upright), the swing is halved,
+/// which brings it back towards the posture chosen to unload it.
 fn within_effort(d: &ArmDefault) -> Vec<(String, f64)> {
     d.gains
         .joints
         .iter()
         .filter_map(|g| {
-            let room = REFERENCE_EFFORT_SHARE * g.effort? - g.gravity;
-            let motion = g.load - g.gravity;
-            (room > 0.0 && motion > room).then(|| (g.name.clone(), room / motion))
+            let share = REFERENCE_EFFORT_SHARE * g.effort?;
+            let (room, motion) = (share - g.gravity, g.load - g.gravity);
+            if g.load <= share {
+                None
+            } else if room > 0.0 {
+                Some((g.name.clone(), room / motion))
+            } else {
+                Some((g.name.clone(), 0.5))
+            }
         })
         .collect()
 }

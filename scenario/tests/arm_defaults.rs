@@ -117,3 +117,30 @@ fn urdf_friction_beyond_effort_turns_urdf_dynamics_off_and_says_so() {
         d.changes()
     );
 }
+
+/// The paper's arm with a 5 N m shoulder: gravity along the default swing
+/// takes the room, so the swing is halved until it fits (and said); at
+/// 3 N m gravity alone is beyond the motor and the joint is locked.
+#[test]
+fn a_swing_gravity_makes_too_heavy_is_cut_and_said() {
+    let urdf = std::fs::read_to_string(format!(
+        "{}/../robots/two_link.urdf",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let with_effort = |e: &str| urdf.replacen("effort=\"500\"", &format!("effort=\"{e}\""), 1);
+    let d = ArmDefault::new(&with_effort("5")).unwrap();
+    let cut = d
+        .changes()
+        .into_iter()
+        .find(|c| c.starts_with("joint 'joint1': reference swing cut to"));
+    assert!(cut.is_some(), "{:?}", d.changes());
+    let g = &d.gains.joints[0];
+    assert!(g.load <= 0.8 * 5.0, "{} N m of 5", g.load);
+    let d = ArmDefault::new(&with_effort("3")).unwrap();
+    assert!(
+        d.scenario.plant.lock.contains_key("joint1"),
+        "{:?}",
+        d.changes()
+    );
+}
