@@ -68,7 +68,9 @@ pub enum ModelError {
         reason: String,
     },
     /// An actuated joint with a zero axis.
-    #[error("joint '{joint}' has a zero-length axis")]
+    #[error(
+        "joint '{joint}' has a zero-length axis (or an <axis> without xyz): a moving joint needs one"
+    )]
     ZeroAxis {
         /// The joint.
         joint: String,

@@ -1,19 +1,21 @@
 //! Attributes `urdf-rs` requires that Pinocchio, MuJoCo and ROS do without:
 //! `<texture/>` and `<mesh/>` elements without a `filename` (romeo and icub
 //! in example-robot-data have a bare `<texture />` in their materials), and
-//! a joint `<limit>` without a `velocity`. None of them moves the arm (the
-//! testbed uses no joint velocity limit), so the missing attribute is
-//! filled before parsing (an empty name; a velocity of 0, read as "none
-//! given"), and the model notes it.
+//! a joint `<limit>` without a `velocity`, an `<axis>` without `xyz`. None
+//! of them moves the arm (the testbed uses no joint velocity limit), so the
+//! missing attribute is filled before parsing (an empty name; a velocity of
+//! 0, read as "none given"; a zero axis, which a fixed joint ignores as
+//! urdfdom does, and a moving joint is refused for), and the model notes it.
 
 use std::borrow::Cow;
 
 /// The elements whose attribute may be missing, the attribute, and what
 /// it is filled with.
-const FILLS: [(&str, &str, &str); 3] = [
+const FILLS: [(&str, &str, &str); 4] = [
     ("texture", "filename", ""),
     ("mesh", "filename", ""),
     ("limit", "velocity", "0"),
+    ("axis", "xyz", "0 0 0"),
 ];
 
 /// `text` with each attribute of [`FILLS`] added to every element without
@@ -126,5 +128,29 @@ mod tests {
             "{:?}",
             model.notes
         );
+    }
+
+    /// An `<axis>` without `xyz` on a fixed joint (amrPioneer3DX's
+    /// base_top_joint) is ignored, as urdfdom ignores a fixed joint's axis;
+    /// on a moving joint it is a zero axis, refused by name.
+    #[test]
+    fn an_axis_without_xyz_is_ignored_on_a_fixed_joint_and_refused_on_a_moving_one() {
+        let urdf = |kind: &str| {
+            format!(
+                r#"<robot name="t"><link name="base"/><link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link><link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link><joint name="j" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="5" velocity="1"/></joint><joint name="top" type="{kind}"><parent link="a"/><child link="b"/><axis/><limit lower="-1" upper="1" effort="5" velocity="1"/></joint></robot>"#
+            )
+        };
+        let model = crate::ArmModel::from_urdf_str(&urdf("fixed")).unwrap();
+        assert_eq!(model.dof(), 1);
+        assert!(
+            model
+                .notes
+                .iter()
+                .any(|n| n.contains("<axis> element(s) without an xyz")),
+            "{:?}",
+            model.notes
+        );
+        let err = crate::ArmModel::from_urdf_str(&urdf("revolute")).unwrap_err();
+        assert!(err.to_string().contains("joint 'top'"), "{err}");
     }
 }

@@ -253,6 +253,11 @@ impl ArmModel {
                     "{n} joint <limit> element(s) without a velocity: read as none given \
                      (the testbed uses no joint velocity limit)"
                 )
+            } else if *element == "axis" {
+                format!(
+                    "{n} <axis> element(s) without an xyz: ignored on fixed joints, as urdfdom \
+                     does (a moving joint needs one)"
+                )
             } else {
                 format!(
                     "{n} <{element}> element(s) without a filename: read as naming no file \
