@@ -114,6 +114,12 @@ pub(super) fn joint_info(
     }
     let limits = limits(j, kind, &field)?;
     let effort = finite(format!("{field} limit effort"), j.limit.effort)?;
+    // −1 is SDF's (and Gazebo's) "no limit"; files converted from it keep it.
+    let effort = if effort == UNLIMITED_EFFORT {
+        0.0
+    } else {
+        effort
+    };
     if effort < 0.0 {
         return Err(ModelError::InvalidConfig {
             key: format!("{field} limit effort"),
@@ -140,6 +146,9 @@ pub(super) fn joint_info(
         },
     })
 }
+
+/// The effort SDF writes for "no limit" (read as none, and said).
+pub(super) const UNLIMITED_EFFORT: f64 = -1.0;
 
 /// Position limits of a revolute or prismatic joint.
 fn limits(

@@ -487,3 +487,18 @@ fn mimic_limits_that_leave_the_leader_no_range_are_dropped_and_said() {
         m.notes
     );
 }
+
+/// Halodi's Eve lists effort -1, SDF's "no limit": read as none, and said;
+/// any other negative effort is still refused.
+#[test]
+fn an_effort_of_minus_one_is_no_limit() {
+    let m =
+        ArmModel::from_urdf_str(&arm(&J1.replace(r#"effort="10""#, r#"effort="-1""#), "")).unwrap();
+    assert_eq!(m.joints[m.actuated[0]].effort, None);
+    assert!(
+        m.notes.iter().any(|n| n.contains("effort -1 on j1")),
+        "{:?}",
+        m.notes
+    );
+    assert!(err(&arm(&J1.replace(r#"effort="10""#, r#"effort="-5""#), "")).contains("effort = -5"));
+}

@@ -58,6 +58,16 @@ pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, M
             j.name
         ));
     }
+    let unlimited: Vec<&str> = (robot.joints.iter())
+        .filter(|j| j.limit.effort == super::parse::UNLIMITED_EFFORT)
+        .map(|j| j.name.as_str())
+        .collect();
+    if !unlimited.is_empty() {
+        notes.push(format!(
+            "effort -1 on {}: read as no effort limit (SDF's convention)",
+            unlimited.join(", ")
+        ));
+    }
     let mut joints = Vec::with_capacity(robot.joints.len());
     let mut parent_of: Vec<Option<usize>> = vec![None; links.len()];
     let mut joint_names = HashMap::new();

@@ -107,4 +107,15 @@ pub enum PlantError {
     /// Rapier did something this crate did not expect.
     #[error("physics engine: {0}")]
     Engine(String),
+    /// M(q) is singular at a joint: nothing it moves has inertia about its
+    /// axis beyond what the joints before it account for.
+    #[error(
+        "physics engine: the joint-space inertia is singular at joint '{joint}' (q = {q:?}): nothing it moves has inertia about its axis that the joints before it do not already account for; give the links it moves inertia, add [plant] armature for it, or lock it in [plant.lock]"
+    )]
+    SingularInertia {
+        /// The joint.
+        joint: String,
+        /// The posture.
+        q: Vec<f64>,
+    },
 }

@@ -190,7 +190,23 @@ impl ArmDefault {
         let mut amplitude: Vec<(String, f64)> = Vec::new();
         let mut attempt = 0;
         loop {
-            let (d, model) = Self::attempt(urdf, &chosen, &armature, &amplitude)?;
+            let (d, model) = match Self::attempt(urdf, &chosen, &armature, &amplitude) {
+                // A joint with no inertia about its axis (AL5D's wrist) has
+                // no acceleration: lock it, as one that moves no mass is.
+                Err(PlantError::SingularInertia { joint, .. })
+                    if chosen.len() + 1 < full.dof() && !chosen.iter().any(|c| c.0 == joint) =>
+                {
+                    let limits =
+                        (full.joints.iter().find(|j| j.name == joint)).and_then(|j| j.limits);
+                    chosen.push((
+                        joint,
+                        lock_position(limits),
+                        "nothing it moves has inertia about its axis (M(q) is singular there), so its acceleration is undefined".to_string(),
+                    ));
+                    continue;
+                }
+                other => other?,
+            };
             if d.gains.stability_number >= 2.0 {
                 // The gains aim for 1 everywhere checked: 2 is a failure of
                 // the choice, never a run.

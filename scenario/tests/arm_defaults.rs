@@ -144,3 +144,32 @@ fn a_swing_gravity_makes_too_heavy_is_cut_and_said() {
         d.changes()
     );
 }
+
+/// The AL5D's wrist carries a point mass on its axis: M(q) is singular
+/// there. The default locks that joint, says why, and controls the rest.
+#[test]
+fn a_joint_with_no_inertia_about_its_axis_is_locked_and_said() {
+    let urdf = r#"<robot name="r"><link name="base"/>
+      <link name="a"><inertial><mass value="1"/><origin xyz="0.3 0 0"/>
+        <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+      <link name="tip"><inertial><mass value="0.2"/><origin xyz="0 0 0"/>
+        <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+      <joint name="shoulder" type="revolute"><parent link="base"/><child link="a"/>
+        <axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="50" velocity="2"/></joint>
+      <joint name="wrist" type="revolute"><parent link="a"/><child link="tip"/>
+        <origin xyz="0.6 0 0"/><axis xyz="1 0 0"/><limit lower="-2" upper="2" effort="5" velocity="2"/></joint>
+    </robot>"#;
+    let d = ArmDefault::new(urdf).unwrap();
+    assert!(
+        d.scenario.plant.lock.contains_key("wrist"),
+        "{:?}",
+        d.changes()
+    );
+    assert!(
+        d.changes()
+            .iter()
+            .any(|c| c.starts_with("locked wrist") && c.contains("M(q) is singular there")),
+        "{:?}",
+        d.changes()
+    );
+}

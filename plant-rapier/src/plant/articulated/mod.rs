@@ -434,11 +434,9 @@ impl Articulated {
             m[i * n + i] += a;
         }
         let names = &self.names;
-        s.chol.factor().map_err(|row| {
-            let joint = names.get(row).map_or("?", String::as_str);
-            PlantError::Engine(format!(
-                "the joint-space inertia is singular at joint '{joint}' (q = {q:?}): nothing it moves has inertia about its axis that the joints before it do not already account for; give the links it moves inertia, add [plant] armature for it, or lock it in [plant.lock]"
-            ))
+        s.chol.factor().map_err(|row| PlantError::SingularInertia {
+            joint: names.get(row).map_or("?", String::as_str).to_string(),
+            q: q.to_vec(),
         })
     }
 
