@@ -43,7 +43,9 @@ def main() -> None:
     ap.add_argument("--testbed", default="target/release/testbed")
     ap.add_argument("--timeout", type=float, default=120.0)
     args = ap.parse_args()
-    for urdf in sorted(args.folder.rglob("*.urdf")):
+    # `.URDF` too: Robotiq's grippers ship that way.
+    urdfs = (p for p in args.folder.rglob("*") if p.suffix.lower() == ".urdf" and p.is_file())
+    for urdf in sorted(urdfs):
         print(f"{urdf.relative_to(args.folder)} | {check(args.testbed, urdf, args.timeout)}", flush=True)
 
 
