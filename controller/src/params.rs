@@ -59,126 +59,135 @@ fn is_default<T: Default + PartialEq>(x: &T) -> bool {
     *x == T::default()
 }
 
-/// Every parameter of the law. Unset keys take the paper's values.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct ControllerParams {
+/// Declares every parameter once: its documentation, serde attributes,
+/// type, default and check. The struct, its `Default`, the range checks,
+/// [`ControllerParams::KEYS`], [`ControllerParams::changed_keys`] and what
+/// [`ControllerParams::for_law`] carries are all made from this one list.
+macro_rules! parameters {
+    ($(
+        $(#[$meta:meta])*
+        $field:ident : $ty:ty = $default:expr, $check:path;
+    )*) => {
+        /// Every parameter of the law. Unset keys take the paper's values.
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(default, deny_unknown_fields)]
+        pub struct ControllerParams {
+            $( $(#[$meta])* pub $field: $ty, )*
+        }
+
+        impl Default for ControllerParams {
+            fn default() -> Self {
+                Self { $( $field: $default, )* }
+            }
+        }
+
+        impl ControllerParams {
+            /// Every key of `[controller]`, in the order a scenario lists them.
+            pub const KEYS: &'static [&'static str] = &[$( stringify!($field) ),*];
+
+            /// Every key whose value differs from its default.
+            pub fn changed_keys(&self) -> Vec<&'static str> {
+                let d = Self::default();
+                let mut out = Vec::new();
+                $( if self.$field != d.$field { out.push(stringify!($field)); } )*
+                out
+            }
+
+            /// Each key's own check; the error names it (`controller.<key>`).
+            fn check_each(&self) -> Result<(), ControllerError> {
+                $( $check(concat!("controller.", stringify!($field)), &self.$field)?; )*
+                Ok(())
+            }
+
+            /// Copies from `other` every key `keep` accepts.
+            fn carry(&mut self, other: &Self, keep: impl Fn(&str) -> bool) {
+                $( if keep(stringify!($field)) { self.$field = other.$field.clone(); } )*
+            }
+        }
+    };
+}
+
+parameters! {
     /// The law (default: "nac", the paper's). Every other key must be one
     /// the law takes ([`LawName::keys`]) or be left at its default.
-    pub law: LawName,
+    law: LawName = LawName::Nac, any;
     /// Prescribed time T_c at which the constraint is fully on (default: 2, s).
-    pub tc: f64,
+    tc: f64 = 2.0, positive;
     /// Position-error gain K1 = diag(K1_i): one number or one per joint
     /// (default: 15, 1/s; SPEC §7 needs K1_i > 0).
-    pub k1: Gain,
+    k1: Gain = Gain::All(15.0), positive_gain;
     /// Velocity-error gain K2 = diag(K2_i): one number or one per joint
     /// (default: 15, N m s/rad; the analysis asks K2_i > 1/2, SPEC §7 allows
     /// less on very light joints and the testbed reports them).
-    pub k2: Gain,
+    k2: Gain = Gain::All(15.0), positive_gain;
     /// Barrier steepness β (default: 10).
-    pub beta: f64,
+    beta: f64 = 10.0, positive;
     /// Actor learning rate σ_a (default: 50).
-    pub sigma_a: f64,
+    sigma_a: f64 = 50.0, positive;
     /// Critic learning rate σ_c (default: 50).
-    pub sigma_c: f64,
+    sigma_c: f64 = 50.0, positive;
     /// Actor regularisation η_a (default: 0.01).
-    pub eta_a: f64,
+    eta_a: f64 = 0.01, positive;
     /// Critic regularisation η_c (default: 0.5).
-    pub eta_c: f64,
-    /// RBF neurons N in each network (default: 10).
-    pub neurons: usize,
+    eta_c: f64 = 0.5, positive;
+    /// RBF neurons N in each network (default: 10; at most [`MAX_NEURONS`]).
+    neurons: usize = 10, neuron_count;
     /// Smallest RBF centre c_min (default: -5).
-    pub center_min: f64,
+    center_min: f64 = -5.0, finite;
     /// Largest RBF centre c_max (default: 5).
-    pub center_max: f64,
+    center_max: f64 = 5.0, finite;
     /// RBF width η (default: 1).
-    pub width: f64,
+    width: f64 = 1.0, positive;
     /// Where the centres lie (default: "diagonal", the paper's).
-    pub rbf_layout: RbfLayout,
+    rbf_layout: RbfLayout = RbfLayout::Diagonal, any;
     /// Young's-inequality weight a in α (default: 1).
-    pub a: f64,
+    a: f64 = 1.0, positive;
     /// Critic discount time constant ψ (default: 1, s).
-    pub psi: f64,
+    psi: f64 = 1.0, positive;
     /// Critic-to-actor gain k_a (default: 0.1).
-    pub k_a: f64,
+    k_a: f64 = 0.1, non_negative;
     /// Q = q_weight · I on Z_c = [Z1; Z2] (default: 1).
-    pub q_weight: f64,
+    q_weight: f64 = 1.0, non_negative;
     /// R = r_weight · I on τ (default: 0.01).
-    pub r_weight: f64,
+    r_weight: f64 = 0.01, non_negative;
     /// Weight integrator (default: "exact").
-    pub integrator: Integrator,
+    integrator: Integrator = Integrator::Exact, any;
     /// Barrier mode (default: "per-joint").
-    pub barrier: BarrierMode,
+    barrier: BarrierMode = BarrierMode::PerJoint, any;
     /// Guard ε: D is clamped to at least ε k_c² (default: 1e-6).
-    pub breach_epsilon: f64,
+    breach_epsilon: f64 = 1e-6, open_unit;
     /// `pd-gravity`, `ctc`: every link's mass and inertia in the law's copy
     /// of the model is scaled by this (default: 1, the URDF's).
-    pub model_scale: f64,
+    model_scale: f64 = 1.0, positive;
     /// `ppc`: the final velocity-funnel width ρ2,∞ (default: 4, rad/s: the
     /// smallest power of two that keeps every shipped two-link scenario
     /// inside both funnels; 2 breaches under the 3 ms actuation delay).
-    pub rho2_inf: f64,
+    rho2_inf: f64 = 4.0, positive;
     /// `smc`: the switching gain k_s, N m (default: 2: the size of an
     /// unmodelled torque the law rejects inside its boundary layer, e.g.
     /// the paper arm's payload and friction).
-    pub smc_gain: f64,
+    smc_gain: f64 = 2.0, non_negative;
     /// `smc`: the boundary layer's width φ on s = ė + K1 e, rad/s (default:
     /// 0.05: the switch is linear for |s| < φ, which keeps it from
     /// chattering at a 1 ms period).
-    pub smc_boundary: f64,
+    smc_boundary: f64 = 0.05, positive;
     /// `cbf-ctc`: the filter's rate λ, 1/s: h = k_c² − e² obeys
     /// ḧ + 2λ ḣ + λ² h ≥ 0, a double pole at −λ (default: 20).
-    pub cbf_rate: f64,
+    cbf_rate: f64 = 20.0, positive;
     /// `mpc`: prediction steps N (default: 10; with `mpc_step` a 0.1 s
     /// look-ahead for the envelope, 1.5 time constants of the default
     /// gains' error dynamics; beyond it the terminal cost is the infinite
-    /// horizon's, so N sets only how far ahead the envelope is seen).
-    pub mpc_horizon: usize,
+    /// horizon's, so N sets only how far ahead the envelope is seen; at
+    /// most [`MAX_MPC_HORIZON`]).
+    mpc_horizon: usize = 10, horizon_steps;
     /// `mpc`: the prediction step h, s (default: 0.01: ten control periods
     /// at 1 kHz; the QP is still solved every period).
-    pub mpc_step: f64,
+    mpc_step: f64 = 0.01, positive;
     /// `ctc`, `cbf-ctc`, `mpc`, `ppc`: how K1, K2 become the law's gains (default:
     /// "as-given"; "matched" matches `pd`'s error dynamics). Unwritten at
     /// its default so that existing scenarios keep their identity.
     #[serde(skip_serializing_if = "is_default")]
-    pub tuning: Tuning,
-}
-
-impl Default for ControllerParams {
-    fn default() -> Self {
-        Self {
-            law: LawName::Nac,
-            tc: 2.0,
-            k1: Gain::All(15.0),
-            k2: Gain::All(15.0),
-            beta: 10.0,
-            sigma_a: 50.0,
-            sigma_c: 50.0,
-            eta_a: 0.01,
-            eta_c: 0.5,
-            neurons: 10,
-            center_min: -5.0,
-            center_max: 5.0,
-            width: 1.0,
-            rbf_layout: RbfLayout::Diagonal,
-            a: 1.0,
-            psi: 1.0,
-            k_a: 0.1,
-            q_weight: 1.0,
-            r_weight: 0.01,
-            integrator: Integrator::Exact,
-            barrier: BarrierMode::PerJoint,
-            breach_epsilon: 1e-6,
-            model_scale: 1.0,
-            rho2_inf: 4.0,
-            smc_gain: 2.0,
-            smc_boundary: 0.05,
-            cbf_rate: 20.0,
-            mpc_horizon: 10,
-            mpc_step: 0.01,
-            tuning: Tuning::AsGiven,
-        }
-    }
+    tuning: Tuning = Tuning::AsGiven, any;
 }
 
 /// The most neurons a network may have: checked before anything is
@@ -190,131 +199,81 @@ pub const MAX_NEURONS: usize = 1000;
 /// and must be solved within a control period.
 pub const MAX_MPC_HORIZON: usize = 200;
 
-/// What a value must satisfy; written so that NaN fails every check.
-enum Bound {
-    Positive,
-    NonNegative,
-    OpenUnit,
-    Finite,
+/// The error for `key` = `value`, which must be `need`.
+fn invalid(key: &str, value: impl ToString, need: impl Into<String>) -> ControllerError {
+    ControllerError::InvalidParameter {
+        key: key.to_string(),
+        value: value.to_string(),
+        need: need.into(),
+    }
+}
+
+// The checks a parameter's declaration names; each fails NaN.
+
+fn any<T>(_key: &str, _value: &T) -> Result<(), ControllerError> {
+    Ok(())
+}
+
+fn positive(key: &str, v: &f64) -> Result<(), ControllerError> {
+    match v.is_finite() && *v > 0.0 {
+        true => Ok(()),
+        false => Err(invalid(key, v, "a finite number > 0")),
+    }
+}
+
+fn non_negative(key: &str, v: &f64) -> Result<(), ControllerError> {
+    match v.is_finite() && *v >= 0.0 {
+        true => Ok(()),
+        false => Err(invalid(key, v, "a finite number ≥ 0")),
+    }
+}
+
+fn open_unit(key: &str, v: &f64) -> Result<(), ControllerError> {
+    match *v > 0.0 && *v < 1.0 {
+        true => Ok(()),
+        false => Err(invalid(key, v, "a number in (0, 1)")),
+    }
+}
+
+fn finite(key: &str, v: &f64) -> Result<(), ControllerError> {
+    match v.is_finite() {
+        true => Ok(()),
+        false => Err(invalid(key, v, "a finite number")),
+    }
+}
+
+fn positive_gain(key: &str, g: &Gain) -> Result<(), ControllerError> {
+    g.check_positive(key)
+}
+
+fn in_range(key: &str, v: usize, max: usize) -> Result<(), ControllerError> {
+    match (1..=max).contains(&v) {
+        true => Ok(()),
+        false => Err(invalid(key, v, format!("from 1 to {max}"))),
+    }
+}
+
+fn neuron_count(key: &str, v: &usize) -> Result<(), ControllerError> {
+    in_range(key, *v, MAX_NEURONS)
+}
+
+fn horizon_steps(key: &str, v: &usize) -> Result<(), ControllerError> {
+    in_range(key, *v, MAX_MPC_HORIZON)
 }
 
 impl ControllerParams {
     /// Checks every field; the error names the key (`controller.<key>`).
     pub fn validate(&self) -> Result<(), ControllerError> {
-        use Bound::*;
-        self.k1.check_positive("controller.k1")?;
-        self.k2.check_positive("controller.k2")?;
-        let checks = [
-            ("tc", self.tc, Positive),
-            ("beta", self.beta, Positive),
-            ("sigma_a", self.sigma_a, Positive),
-            ("sigma_c", self.sigma_c, Positive),
-            ("eta_a", self.eta_a, Positive),
-            ("eta_c", self.eta_c, Positive),
-            ("center_min", self.center_min, Finite),
-            ("center_max", self.center_max, Finite),
-            ("width", self.width, Positive),
-            ("a", self.a, Positive),
-            ("psi", self.psi, Positive),
-            ("k_a", self.k_a, NonNegative),
-            ("q_weight", self.q_weight, NonNegative),
-            ("r_weight", self.r_weight, NonNegative),
-            ("breach_epsilon", self.breach_epsilon, OpenUnit),
-            ("model_scale", self.model_scale, Positive),
-            ("rho2_inf", self.rho2_inf, Positive),
-            ("smc_gain", self.smc_gain, NonNegative),
-            ("smc_boundary", self.smc_boundary, Positive),
-            ("cbf_rate", self.cbf_rate, Positive),
-            ("mpc_step", self.mpc_step, Positive),
-        ];
-        for (key, value, bound) in checks {
-            let (ok, need) = match bound {
-                Positive => (
-                    value.is_finite() && value > 0.0,
-                    "a finite number > 0".to_string(),
-                ),
-                NonNegative => (
-                    value.is_finite() && value >= 0.0,
-                    "a finite number ≥ 0".to_string(),
-                ),
-                OpenUnit => (value > 0.0 && value < 1.0, "a number in (0, 1)".to_string()),
-                Finite => (value.is_finite(), "a finite number".to_string()),
-            };
-            if !ok {
-                return Err(ControllerError::InvalidParameter {
-                    key: format!("controller.{key}"),
-                    value: value.to_string(),
-                    need,
-                });
-            }
-        }
-        if !(1..=MAX_NEURONS).contains(&self.neurons) {
-            return Err(ControllerError::InvalidParameter {
-                key: "controller.neurons".into(),
-                value: self.neurons.to_string(),
-                need: format!("from 1 to {MAX_NEURONS}"),
-            });
-        }
-        if !(1..=MAX_MPC_HORIZON).contains(&self.mpc_horizon) {
-            return Err(ControllerError::InvalidParameter {
-                key: "controller.mpc_horizon".into(),
-                value: self.mpc_horizon.to_string(),
-                need: format!("from 1 to {MAX_MPC_HORIZON}"),
-            });
-        }
+        self.check_each()?;
         self.check_keys_belong()?;
         if self.center_min > self.center_max {
-            return Err(ControllerError::InvalidParameter {
-                key: "controller.center_min".into(),
-                value: self.center_min.to_string(),
-                need: format!("≤ controller.center_max ({})", self.center_max),
-            });
+            return Err(invalid(
+                "controller.center_min",
+                self.center_min,
+                format!("≤ controller.center_max ({})", self.center_max),
+            ));
         }
         Ok(())
-    }
-}
-
-impl ControllerParams {
-    /// Every key whose value differs from its default.
-    pub fn changed_keys(&self) -> Vec<&'static str> {
-        let d = Self::default();
-        let changed = [
-            ("law", self.law != d.law),
-            ("tc", self.tc != d.tc),
-            ("k1", self.k1 != d.k1),
-            ("k2", self.k2 != d.k2),
-            ("beta", self.beta != d.beta),
-            ("sigma_a", self.sigma_a != d.sigma_a),
-            ("sigma_c", self.sigma_c != d.sigma_c),
-            ("eta_a", self.eta_a != d.eta_a),
-            ("eta_c", self.eta_c != d.eta_c),
-            ("neurons", self.neurons != d.neurons),
-            ("center_min", self.center_min != d.center_min),
-            ("center_max", self.center_max != d.center_max),
-            ("width", self.width != d.width),
-            ("rbf_layout", self.rbf_layout != d.rbf_layout),
-            ("a", self.a != d.a),
-            ("psi", self.psi != d.psi),
-            ("k_a", self.k_a != d.k_a),
-            ("q_weight", self.q_weight != d.q_weight),
-            ("r_weight", self.r_weight != d.r_weight),
-            ("integrator", self.integrator != d.integrator),
-            ("barrier", self.barrier != d.barrier),
-            ("breach_epsilon", self.breach_epsilon != d.breach_epsilon),
-            ("model_scale", self.model_scale != d.model_scale),
-            ("rho2_inf", self.rho2_inf != d.rho2_inf),
-            ("smc_gain", self.smc_gain != d.smc_gain),
-            ("smc_boundary", self.smc_boundary != d.smc_boundary),
-            ("cbf_rate", self.cbf_rate != d.cbf_rate),
-            ("mpc_horizon", self.mpc_horizon != d.mpc_horizon),
-            ("mpc_step", self.mpc_step != d.mpc_step),
-            ("tuning", self.tuning != d.tuning),
-        ];
-        changed
-            .iter()
-            .filter(|(_, c)| *c)
-            .map(|(k, _)| *k)
-            .collect()
     }
 
     /// A key set away from its default that the chosen law does not take
@@ -336,45 +295,11 @@ impl ControllerParams {
     pub fn for_law(&self, law: LawName) -> Self {
         let mut p = Self {
             law,
-            tc: self.tc,
-            k1: self.k1.clone(),
-            k2: self.k2.clone(),
             ..Self::default()
         };
-        let keep = |key: &str| law.takes(key) && self.law.takes(key);
-        macro_rules! carry {
-            ($($field:ident),*) => {
-                $(if keep(stringify!($field)) { p.$field = self.$field.clone(); })*
-            };
-        }
-        carry!(
-            beta,
-            sigma_a,
-            sigma_c,
-            eta_a,
-            eta_c,
-            neurons,
-            center_min,
-            center_max,
-            width,
-            rbf_layout,
-            a,
-            psi,
-            k_a,
-            q_weight,
-            r_weight,
-            integrator,
-            barrier,
-            breach_epsilon,
-            model_scale,
-            rho2_inf,
-            smc_gain,
-            smc_boundary,
-            cbf_rate,
-            mpc_horizon,
-            mpc_step,
-            tuning
-        );
+        let shared = |key: &str| matches!(key, "tc" | "k1" | "k2");
+        let both = |key: &str| key != "law" && law.takes(key) && self.law.takes(key);
+        p.carry(self, |key| shared(key) || both(key));
         p
     }
 }
@@ -382,6 +307,38 @@ impl ControllerParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every key a law takes is declared, and every declared key is in the
+    /// `[controller]` row of the scenario docs.
+    #[test]
+    fn every_key_is_declared_once_and_documented() {
+        for law in LawName::ALL {
+            for key in law.keys() {
+                assert!(ControllerParams::KEYS.contains(&key), "{law}: {key}");
+            }
+        }
+        let docs = include_str!("../../docs/scenarios-and-robots.md");
+        let row = docs
+            .lines()
+            .find(|l| l.starts_with("| `[controller]` |"))
+            .unwrap();
+        for key in ControllerParams::KEYS {
+            assert!(
+                row.contains(&format!("`{key}`")),
+                "{key} is not in the docs' [controller] row"
+            );
+        }
+        // One key per field, each once.
+        let mut keys = ControllerParams::KEYS.to_vec();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), ControllerParams::KEYS.len());
+        let table: toml::Table =
+            toml::from_str(&toml::to_string(&ControllerParams::default()).unwrap()).unwrap();
+        // Written at its default: every key but `tuning` (unwritten so that
+        // old scenarios keep their identity).
+        assert_eq!(table.len(), ControllerParams::KEYS.len() - 1);
+    }
 
     #[test]
     fn defaults_are_the_papers_and_valid() {
