@@ -330,17 +330,11 @@ impl Scenario {
                 "a rate from 1 to 100000 Hz",
             ));
         }
-        let reference_rate = self.reference.rate_hz.unwrap_or(self.rate_hz);
-        let horizon = self.reference.horizon_s;
-        if !(horizon >= 0.0 && horizon * reference_rate <= trajectory::MAX_HORIZON_SAMPLES) {
+        if let Some(need) = self.reference.horizon_fault(self.rate_hz) {
             return Err(invalid(
                 "reference.horizon_s",
-                horizon,
-                &format!(
-                    "seconds from 0 to {} (at most {} reference samples ahead)",
-                    trajectory::MAX_HORIZON_SAMPLES / reference_rate,
-                    trajectory::MAX_HORIZON_SAMPLES
-                ),
+                self.reference.horizon_s,
+                &need,
             ));
         }
         for (key, v) in [

@@ -87,8 +87,7 @@ impl Plan {
     /// How far ahead of its time the real-time trajectory publishes each
     /// sample, ns (a whole number of reference periods, rounded up).
     pub fn reference_horizon_ns(&self) -> u64 {
-        let h = (self.scenario.reference.horizon_s * 1e9).round() as u64;
-        h.div_ceil(self.reference_period_ns) * self.reference_period_ns
+        self.scenario.reference.horizon_ns(self.reference_period_ns)
     }
 
     /// Time of the newest reference sample at or before `t_ns`: the one a

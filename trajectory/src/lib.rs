@@ -175,6 +175,26 @@ fn default_horizon() -> f64 {
 }
 
 impl ReferenceConfig {
+    /// What `horizon_s` must be when the reference is published at its own
+    /// `rate_hz` or, unset, at `control_rate_hz`; None when it is.
+    pub fn horizon_fault(&self, control_rate_hz: f64) -> Option<String> {
+        let rate = self.rate_hz.unwrap_or(control_rate_hz);
+        let h = self.horizon_s;
+        (!(h >= 0.0 && h * rate <= MAX_HORIZON_SAMPLES)).then(|| {
+            format!(
+                "seconds from 0 to {} (at most {MAX_HORIZON_SAMPLES} reference samples ahead)",
+                MAX_HORIZON_SAMPLES / rate
+            )
+        })
+    }
+
+    /// The horizon as the real-time trajectory publishes ahead, ns: a whole
+    /// number of reference periods of `reference_period_ns`, rounded up.
+    pub fn horizon_ns(&self, reference_period_ns: u64) -> u64 {
+        let h = (self.horizon_s * 1e9).round() as u64;
+        h.div_ceil(reference_period_ns) * reference_period_ns
+    }
+
     /// The paper's reference: q_d1 = sin(2t), q_d2 = cos(t).
     pub fn paper() -> Self {
         Self {
@@ -267,6 +287,26 @@ mod tests {
 
     fn paper() -> Reference {
         Reference::new(&ReferenceConfig::paper(), &EnvelopeConfig::paper()).unwrap()
+    }
+
+    /// The horizon's check and its conversion to whole reference periods
+    /// live here, where the reference is published.
+    #[test]
+    fn the_horizon_is_checked_and_rounded_up_to_whole_periods() {
+        let mut r = ReferenceConfig::paper();
+        assert_eq!(r.horizon_fault(1000.0), None);
+        assert_eq!(r.horizon_ns(1_000_000), 50_000_000);
+        r.horizon_s = 0.0505;
+        assert_eq!(r.horizon_ns(1_000_000), 51_000_000);
+        r.horizon_s = -1.0;
+        assert!(r.horizon_fault(1000.0).is_some());
+        r.horizon_s = f64::NAN;
+        assert!(r.horizon_fault(1000.0).is_some());
+        // At a 100 Hz reference, the samples allow a horizon 10× longer.
+        r.horizon_s = MAX_HORIZON_SAMPLES / 1000.0 * 5.0;
+        assert!(r.horizon_fault(1000.0).is_some());
+        r.rate_hz = Some(100.0);
+        assert_eq!(r.horizon_fault(1000.0), None);
     }
 
     #[test]
