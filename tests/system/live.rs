@@ -422,10 +422,22 @@ fn the_limit_holds_on_the_servers_own_port() {
         .find(|n| n.0 == "logger")
         .unwrap()
         .1;
-    let inner = loopback_listen_ports(logger)
-        .into_iter()
-        .find(|p| *p != port)
-        .expect("the server's loopback port");
+    // The logger opens its inner server after the node is up: poll for
+    // it, with a watchdog (a loaded machine takes longer).
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let inner = loop {
+        if let Some(p) = loopback_listen_ports(logger)
+            .into_iter()
+            .find(|p| *p != port)
+        {
+            break p;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the server's loopback port never opened"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
     let mut sneaky = TcpStream::connect(("127.0.0.1", inner)).unwrap();
     // Watchdog: a cut connection ends the read long before this.
     sneaky
