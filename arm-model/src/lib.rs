@@ -26,6 +26,7 @@
 //! assert!(g[0] > 0.0); // holding the arm level takes a positive shoulder torque
 //! ```
 
+mod collision;
 mod diagnose;
 pub mod dynamics;
 mod error;
@@ -38,6 +39,7 @@ mod xml_depth;
 
 use std::collections::BTreeMap;
 
+pub use collision::{CollisionShape, Geometry};
 pub use error::ModelError;
 pub use inertia::iso;
 
@@ -99,6 +101,10 @@ pub struct LinkInfo {
     /// Inertia tensor about the COM in the inertial frame, kg m²,
     /// as [ixx, ixy, ixz, iyy, iyz, izz].
     pub inertia: [f64; 6],
+    /// Its `<collision>` primitives (and those of links folded into it).
+    pub collisions: Vec<CollisionShape>,
+    /// Collision elements not made into shapes, each with why (meshes).
+    pub skipped_collisions: Vec<String>,
 }
 
 /// A URDF `<mimic joint multiplier offset>`: q = multiplier · q_leader + offset.

@@ -11,8 +11,8 @@ use super::inertia::{
 };
 use super::parse::{joint_info, link_info};
 use super::{
-    ArmModel, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks, MergedLink,
-    MimicJoint,
+    ArmModel, CollisionShape, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks,
+    MergedLink, MimicJoint,
 };
 use crate::ModelError;
 
@@ -52,6 +52,8 @@ pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, M
             mass: 0.0,
             inertial_origin: super::Origin::default(),
             inertia: [0.0; 6],
+            collisions: Vec::new(),
+            skipped_collisions: Vec::new(),
         });
         notes.push(format!(
             "joint '{}' hangs from link '{WORLD}', which the URDF does not define: taken as the fixed world (the root)",
@@ -426,6 +428,16 @@ fn merge_fixed(mut links: Vec<LinkInfo>, mut joints: Vec<JointInfo>) -> Folded {
         let t = iso(&j.origin);
         let child_link = links[child].clone();
         merge_mass(&mut links[parent], &child_link, &t);
+        // The child's contact shapes ride on the parent from now on.
+        for c in &child_link.collisions {
+            links[parent].collisions.push(CollisionShape {
+                origin: origin_of(&(t * iso(&c.origin))),
+                geometry: c.geometry,
+            });
+        }
+        links[parent]
+            .skipped_collisions
+            .extend(child_link.skipped_collisions.iter().cloned());
         for k in &mut joints {
             if k.parent == child {
                 k.parent = parent;

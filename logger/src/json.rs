@@ -193,7 +193,7 @@ impl LogMessage for JointState {
     const ABOUT: &'static str = "The plant's state at step seq (t = seq x period): q, qd true; \
         q_measured, qd_measured as the sensors report them; effects: bits 0 friction, \
         1 payload, 2 disturbance, 3 saturated, 4 sensor_noise, 5 quantised, 6 delayed, \
-        7 command_dropped, 8 command_held, 9 motor_lag, 10 backlash, 11 cogging, 12 elastic.";
+        7 command_dropped, 8 command_held, 9 motor_lag, 10 backlash, 11 cogging, 12 elastic, 13 contact.";
 }
 
 impl LogMessage for ReferenceSample {

@@ -44,13 +44,13 @@ pub use arm_model::{
     MimicJoint, MimicSpec, ModelError, Origin, TWO_LINK_URDF,
 };
 pub use config::{
-    ActuationConfig, ActuatorConfig, DisturbanceConfig, FrictionConfig, Harmonic, JointActuator,
-    PayloadConfig, PerJoint, PlantConfig, SensorConfig, Spring,
+    ActuationConfig, ActuatorConfig, ContactConfig, DisturbanceConfig, FrictionConfig, Harmonic,
+    JointActuator, Obstacle, PayloadConfig, PerJoint, PlantConfig, SensorConfig, ShapeName, Spring,
 };
 pub use effects::Effects;
 pub use engine::EngineName;
 pub use machine::PlantMachine;
-pub use plant::Plant;
+pub use plant::{ContactReading, Plant};
 pub use rig::Rig;
 
 /// Why an arm cannot be built or stepped. Each variant names what is wrong.

@@ -182,6 +182,13 @@ impl Rig {
         if self.plant.saturated() {
             e |= Effects::SATURATED;
         }
+        if self
+            .plant
+            .contact()
+            .is_some_and(|c| c.force > 0.0 || c.points > 0)
+        {
+            e |= Effects::CONTACT;
+        }
         if passage.dropped {
             e |= Effects::COMMAND_DROPPED;
         }

@@ -32,8 +32,10 @@ impl Effects {
     pub const COGGING: u32 = 1 << 11;
     /// Some joint is series elastic (a spring between motor and link).
     pub const ELASTIC: u32 = 1 << 12;
+    /// Some link touched an obstacle (or another link) during the period.
+    pub const CONTACT: u32 = 1 << 13;
 
-    const NAMES: [(u32, &'static str); 13] = [
+    const NAMES: [(u32, &'static str); 14] = [
         (Self::FRICTION, "friction"),
         (Self::PAYLOAD, "payload"),
         (Self::DISTURBANCE, "disturbance"),
@@ -47,6 +49,7 @@ impl Effects {
         (Self::BACKLASH, "backlash"),
         (Self::COGGING, "cogging"),
         (Self::ELASTIC, "elastic"),
+        (Self::CONTACT, "contact"),
     ];
 
     /// Whether every bit of `bits` is set.

@@ -7,8 +7,10 @@ use serde::{Deserialize, Serialize};
 use crate::{EngineName, Locks, PlantError};
 
 mod actuator;
+mod contact;
 
 pub use actuator::{ActuatorConfig, Harmonic, JointActuator, Spring};
+pub use contact::{ContactConfig, Obstacle, ShapeName};
 
 /// How the plant integrates, and the effects it adds on top of the rigid
 /// body dynamics.
@@ -53,6 +55,10 @@ pub struct PlantConfig {
     /// identities keep.
     #[serde(skip_serializing_if = "ActuatorConfig::is_off")]
     pub actuator: ActuatorConfig,
+    /// Contact between the links' `<collision>` primitives and obstacles
+    /// (`engine = "rapier"` only). Unwritten when off.
+    #[serde(skip_serializing_if = "ContactConfig::is_off")]
+    pub contact: ContactConfig,
     /// Joints held still, by URDF name and position (rad or m):
     /// `[plant.lock]` with `finger_joint1 = 0.02`. A locked joint is
     /// simulated as fixed and is not controlled; a joint that mimics it is
@@ -84,6 +90,7 @@ impl Default for PlantConfig {
             sensor: SensorConfig::default(),
             actuation: ActuationConfig::default(),
             actuator: ActuatorConfig::default(),
+            contact: ContactConfig::default(),
             lock: Locks::new(),
             urdf_dynamics: true,
             armature: PerJoint::default(),
@@ -370,6 +377,14 @@ impl PlantConfig {
         self.disturbance.validate()?;
         self.validate_sensor_and_actuation()?;
         self.actuator.validate()?;
+        self.contact.validate()?;
+        if self.engine != EngineName::Rapier && !self.contact.is_off() {
+            return Err(invalid(
+                "plant.contact",
+                "set",
+                "engine = \"rapier\": the articulated engine has no contact solver (add `engine = \"rapier\"` under [plant])",
+            ));
+        }
         if self.engine == EngineName::Rapier && self.actuator.elastic() {
             return Err(invalid(
                 "plant.actuator.stiffness",

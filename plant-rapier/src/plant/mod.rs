@@ -7,12 +7,15 @@ use arm_model::ArmModel;
 
 mod articulated;
 mod build;
+mod contact;
 mod motor;
 mod rapier;
 
 use articulated::{Articulated, Drive, Setup, Springs, Stage};
 use motor::Motors;
 use rapier::RapierArm;
+
+pub use contact::ContactReading;
 
 /// The engine that integrates the rigid-body dynamics.
 enum Engine {
@@ -312,6 +315,16 @@ impl Plant {
     /// The torque from outside the motors, as last set.
     pub fn external_torque(&self) -> &[f64] {
         &self.external
+    }
+
+    /// What contact did over the last step: `None` when the scenario has no
+    /// `[plant.contact]` (or the engine is the articulated one, which has
+    /// none).
+    pub fn contact(&self) -> Option<ContactReading> {
+        match &self.engine {
+            Engine::Articulated(_) => None,
+            Engine::Rapier(r) => r.contact(),
+        }
     }
 
     /// Whether the last step clipped any joint's torque at its effort limit.

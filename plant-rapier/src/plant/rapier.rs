@@ -8,6 +8,7 @@ use rapier3d_f64::prelude::*;
 
 use super::articulated::{Drive, Stage};
 use super::build::{couple_mimics, dof_of, insert_bodies, insert_joints, joint_dynamics, settle};
+use super::contact::{self, ContactReading, Contacts};
 use crate::{PlantConfig, PlantError};
 use arm_model::{ArmModel, Origin};
 
@@ -50,6 +51,10 @@ pub(crate) struct RapierArm {
     q: Vec<f64>,
     qd: Vec<f64>,
     total: Vec<f64>,
+    /// The colliders' bookkeeping when `[plant.contact]` is on.
+    contacts: Option<Contacts>,
+    /// What contact did over the last period.
+    contact: Option<ContactReading>,
 }
 
 pub(super) fn pose(o: &Origin) -> Pose {
@@ -105,6 +110,15 @@ impl RapierArm {
             multibody_joints,
             multibody,
         )?;
+        let contacts = match config.contact.is_off() {
+            true => None,
+            false => Some(contact::insert(
+                &mut world,
+                model,
+                &handles,
+                &config.contact,
+            )?),
+        };
         let n = dofs.len();
         Ok(Self {
             world,
@@ -116,6 +130,8 @@ impl RapierArm {
             q: vec![0.0; n],
             qd: vec![0.0; n],
             total: vec![0.0; n],
+            contact: contacts.as_ref().map(|_| ContactReading::default()),
+            contacts,
         })
     }
 
@@ -183,6 +199,9 @@ impl RapierArm {
     pub(crate) fn step(&mut self, drive: &dyn Drive, dt: f64, substeps: u32) {
         let h = dt / f64::from(substeps);
         self.world.integration_parameters.dt = h;
+        if let Some(c) = &mut self.contacts {
+            c.begin();
+        }
         for k in 0..substeps {
             let (mut q, mut qd) = (std::mem::take(&mut self.q), std::mem::take(&mut self.qd));
             self.state_into(&mut q, &mut qd);
@@ -197,7 +216,16 @@ impl RapierArm {
             self.apply_torques(&total);
             (self.q, self.qd, self.total) = (q, qd, total);
             self.world.step();
+            if let Some(c) = &mut self.contacts {
+                c.after_substep(&self.world.narrow_phase);
+            }
         }
+        self.contact = self.contacts.as_mut().map(|c| c.end(dt));
+    }
+
+    /// What contact did over the last period (`None` without contact).
+    pub(crate) fn contact(&self) -> Option<ContactReading> {
+        self.contact
     }
 
     /// Fixes a point mass to link `link` at `point` in its frame, replacing

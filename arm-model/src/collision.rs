@@ -1,0 +1,98 @@
+//! A link's `<collision>` primitives, read for the contact engine: boxes,
+//! cylinders, spheres and capsules as the URDF gives them; meshes are named
+//! (the plant says it skipped them) since no mesh file is ever opened here.
+
+use super::Origin;
+
+/// One primitive collision shape of a link, in the link's frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CollisionShape {
+    /// Pose of the shape in the link frame.
+    pub origin: Origin,
+    /// The shape itself.
+    pub geometry: Geometry,
+}
+
+/// A URDF collision primitive. Cylinders and capsules lie along their
+/// frame's z axis, as URDF defines them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Geometry {
+    /// Full side lengths, m.
+    Box {
+        /// [x, y, z] side lengths, m.
+        size: [f64; 3],
+    },
+    /// A cylinder along z.
+    Cylinder {
+        /// Radius, m.
+        radius: f64,
+        /// Length along z, m.
+        length: f64,
+    },
+    /// A sphere.
+    Sphere {
+        /// Radius, m.
+        radius: f64,
+    },
+    /// A capsule along z: `length` between the centres of its end caps.
+    Capsule {
+        /// Radius, m.
+        radius: f64,
+        /// Length of the cylindrical part, m.
+        length: f64,
+    },
+}
+
+/// A link's collision elements: the primitives, and what was not turned
+/// into a shape, with why (a mesh, a size that is not a positive number).
+/// Never an error: collisions matter only to a contact scenario, which says
+/// what was skipped; every other run ignores them.
+pub(super) fn collisions(
+    l: &urdf_rs::Link,
+    origin: impl Fn(&urdf_rs::Pose) -> Option<Origin>,
+) -> (Vec<CollisionShape>, Vec<String>) {
+    let mut shapes = Vec::new();
+    let mut skipped = Vec::new();
+    for (i, c) in l.collision.iter().enumerate() {
+        let what = format!("link '{}' collision {}", l.name, i + 1);
+        match (geometry(&c.geometry), origin(&c.origin)) {
+            (Ok(geometry), Some(origin)) => shapes.push(CollisionShape { origin, geometry }),
+            (Err(why), _) => skipped.push(format!("{what}: {why}")),
+            (Ok(_), None) => skipped.push(format!("{what}: its origin is not finite")),
+        }
+    }
+    (shapes, skipped)
+}
+
+fn geometry(g: &urdf_rs::Geometry) -> Result<Geometry, String> {
+    let size = |what: &str, v: f64, zero_ok: bool| {
+        if v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0)) {
+            Ok(v)
+        } else {
+            Err(format!("{what} {v} is not a positive size"))
+        }
+    };
+    Ok(match g {
+        urdf_rs::Geometry::Mesh { filename, .. } => {
+            return Err(format!("mesh '{filename}' (meshes are not contact shapes)"));
+        }
+        urdf_rs::Geometry::Box { size: s } => Geometry::Box {
+            size: [
+                size("box x", s.0[0], false)?,
+                size("box y", s.0[1], false)?,
+                size("box z", s.0[2], false)?,
+            ],
+        },
+        urdf_rs::Geometry::Cylinder { radius, length } => Geometry::Cylinder {
+            radius: size("cylinder radius", *radius, false)?,
+            length: size("cylinder length", *length, false)?,
+        },
+        urdf_rs::Geometry::Sphere { radius } => Geometry::Sphere {
+            radius: size("sphere radius", *radius, false)?,
+        },
+        urdf_rs::Geometry::Capsule { radius, length } => Geometry::Capsule {
+            radius: size("capsule radius", *radius, false)?,
+            length: size("capsule length", *length, true)?,
+        },
+    })
+}

@@ -1,0 +1,161 @@
+//! `[plant.contact]` through Rapier: a pendulum whose tip strikes a wall
+//! rebounds at −e times its speed (restitution), stops at e = 0, sinks into
+//! the wall by under a millimetre, and the state says `contact` only
+//! while it touches; the articulated engine refuses contact by name.
+
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use plant_rapier::{
+    ArmModel, ContactConfig, Effects, EngineName, Obstacle, PlantConfig, PlantError, Rig, ShapeName,
+};
+
+const PERIOD_NS: u64 = 1_000_000;
+
+/// A 1 m pendulum about z with its mass and a 5 cm ball at the tip; no
+/// gravity, so between impacts it turns at constant speed.
+const PENDULUM: &str = r#"<robot name="pendulum">
+  <link name="base"/>
+  <link name="arm">
+    <inertial><mass value="1"/><origin xyz="1 0 0"/>
+      <inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>
+    <collision><origin xyz="1 0 0"/><geometry><sphere radius="0.05"/></geometry></collision>
+  </link>
+  <joint name="j" type="continuous">
+    <parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit effort="1000" velocity="100"/>
+  </joint>
+</robot>"#;
+
+/// A wall filling x < 0 around the tip's path at q = π/2: the ball meets it
+/// when cos q = 0.05, moving along −x, the wall's normal.
+fn wall() -> Obstacle {
+    Obstacle {
+        name: "wall".into(),
+        shape: ShapeName::Box,
+        size: vec![0.2, 1.0, 1.0],
+        xyz: [-0.1, 1.0, 0.0],
+        rpy: [0.0; 3],
+    }
+}
+
+fn rig(engine: EngineName, restitution: f64) -> Result<Rig, PlantError> {
+    let model = ArmModel::from_urdf_str(PENDULUM).unwrap();
+    let config = PlantConfig {
+        engine,
+        gravity: [0.0; 3],
+        substeps: Some(8),
+        contact: ContactConfig {
+            restitution,
+            friction: 0.0,
+            obstacle: vec![wall()],
+            ..ContactConfig::default()
+        },
+        ..PlantConfig::default()
+    };
+    Rig::new(&model, &config, 0, PERIOD_NS)
+}
+
+struct Strike {
+    /// Speed after the impact over the speed before (signed).
+    ratio: f64,
+    /// Periods whose state said `contact`.
+    contact_periods: u32,
+    /// Largest mean contact force over a period, N.
+    peak_force: f64,
+    /// The tip's deepest reach into x < 0.05 (the ball's centre), m.
+    overshoot: f64,
+}
+
+/// Sends the pendulum at 2 rad/s towards the wall and watches 1.5 s.
+fn strike(restitution: f64) -> Strike {
+    let mut r = rig(EngineName::Rapier, restitution).unwrap();
+    let w0 = 2.0;
+    r.set_state(&[0.0], &[w0]).unwrap();
+    let mut out = Strike {
+        ratio: 0.0,
+        contact_periods: 0,
+        peak_force: 0.0,
+        overshoot: 0.0,
+    };
+    let (mut q, mut qd) = ([0.0], [0.0]);
+    for _ in 0..1500 {
+        r.step(Some(&[0.0])).unwrap();
+        r.true_state_into(&mut q, &mut qd);
+        let c = r.plant().contact().unwrap();
+        out.peak_force = out.peak_force.max(c.force);
+        if r.effects().has(Effects::CONTACT) {
+            out.contact_periods += 1;
+        }
+        out.overshoot = out.overshoot.max(0.05 - q[0].cos());
+    }
+    out.ratio = qd[0] / w0;
+    out
+}
+
+#[test]
+fn a_pendulum_rebounds_from_a_wall_at_minus_e_times_its_speed() {
+    for e in [0.0, 0.5, 0.9] {
+        let s = strike(e);
+        eprintln!(
+            "e {e}: ratio {:.4}, overshoot {:.2e} m, {} periods, peak {:.0} N",
+            s.ratio, s.overshoot, s.contact_periods, s.peak_force
+        );
+        assert!(
+            (s.ratio + e).abs() < 0.05,
+            "restitution {e}: speed ratio {} after the strike",
+            s.ratio
+        );
+        assert!(s.contact_periods >= 1, "restitution {e}: no contact seen");
+        assert!(
+            s.overshoot < 1e-3,
+            "restitution {e}: the ball sank {} m into the wall",
+            s.overshoot
+        );
+        // The impulse that turns 2 rad/s (tip 1 kg m² at 1 m) into −2e rad/s
+        // is (1 + e)·2 N s; over the periods it acted, at least that much
+        // mean force in one of them.
+        assert!(
+            s.peak_force * 1e-3 * f64::from(s.contact_periods) >= 0.9 * (1.0 + e) * 2.0,
+            "restitution {e}: peak force {} N over {} periods",
+            s.peak_force,
+            s.contact_periods
+        );
+    }
+}
+
+#[test]
+fn a_pendulum_that_misses_the_wall_feels_nothing() {
+    let mut r = rig(EngineName::Rapier, 0.5).unwrap();
+    // Turning away from the wall, it never reaches q = π/2 within 0.5 s.
+    r.set_state(&[0.0], &[-2.0]).unwrap();
+    for _ in 0..500 {
+        r.step(Some(&[0.0])).unwrap();
+        assert!(!r.effects().has(Effects::CONTACT));
+        assert_eq!(r.plant().contact().unwrap().force, 0.0);
+    }
+    let (mut q, mut qd) = ([0.0], [0.0]);
+    r.true_state_into(&mut q, &mut qd);
+    assert!((qd[0] + 2.0).abs() < 1e-9, "{}", qd[0]);
+}
+
+#[test]
+fn the_articulated_engine_refuses_contact_by_name() {
+    let e = rig(EngineName::Articulated, 0.0).err().unwrap().to_string();
+    assert!(
+        e.contains("plant.contact") && e.contains("engine = \"rapier\""),
+        "{e}"
+    );
+}
+
+#[test]
+fn an_obstacle_of_the_wrong_size_is_refused_by_key() {
+    let mut config = PlantConfig {
+        engine: EngineName::Rapier,
+        ..PlantConfig::default()
+    };
+    let mut o = wall();
+    o.size = vec![0.2, 1.0];
+    config.contact.obstacle = vec![o];
+    let e = config.validate().unwrap_err().to_string();
+    assert!(e.contains("plant.contact.obstacle[0].size"), "{e}");
+}
