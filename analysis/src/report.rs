@@ -373,6 +373,13 @@ fn verdicts(out: &mut String, s: &Summary) {
         "plant effects: {active}; saturated {} steps, commands lost {}, held {}",
         e.saturated_steps, e.dropped_commands, e.held_commands
     );
+    if e.contact_steps > 0 {
+        let _ = writeln!(
+            out,
+            "contact: {} steps touched an obstacle",
+            e.contact_steps
+        );
+    }
 }
 
 /// BASELINES.md's metrics for the whole arm.

@@ -138,6 +138,8 @@ pub struct EffectsSummary {
     pub dropped_commands: u64,
     /// Steps where no new command reached the motors (lost or late).
     pub held_commands: u64,
+    /// Periods in which a link touched an obstacle (`[plant.contact]`).
+    pub contact_steps: u64,
 }
 
 /// Accumulates a [`Summary`] one step at a time.
@@ -175,6 +177,7 @@ pub struct SummaryBuilder {
     first_non_finite: Option<f64>,
     effects_seen: u32,
     saturated: u64,
+    contact: u64,
     dropped: u64,
     held: u64,
     /// The URDF's Newton–Euler model, for G(q) (see [`SummaryBuilder::with_gravity`]).
@@ -219,6 +222,7 @@ impl SummaryBuilder {
             first_non_finite: None,
             effects_seen: 0,
             saturated: 0,
+            contact: 0,
             dropped: 0,
             held: 0,
             gravity: None,
@@ -243,6 +247,7 @@ impl SummaryBuilder {
         let e = Effects(r.effects);
         self.effects_seen |= r.effects;
         self.saturated += u64::from(e.has(Effects::SATURATED));
+        self.contact += u64::from(e.has(Effects::CONTACT));
         self.dropped += u64::from(e.has(Effects::COMMAND_DROPPED));
         self.held += u64::from(e.has(Effects::COMMAND_HELD));
         self.breached += u64::from(r.barrier_breached);
@@ -370,6 +375,7 @@ impl SummaryBuilder {
             effects: EffectsSummary {
                 active: Effects(self.effects_seen).names(),
                 saturated_steps: self.saturated,
+                contact_steps: self.contact,
                 dropped_commands: self.dropped,
                 held_commands: self.held,
             },

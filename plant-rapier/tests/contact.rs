@@ -101,7 +101,7 @@ fn a_pendulum_rebounds_from_a_wall_at_minus_e_times_its_speed() {
             s.ratio, s.overshoot, s.contact_periods, s.peak_force
         );
         assert!(
-            (s.ratio + e).abs() < 0.05,
+            (s.ratio + e).abs() < 1e-3,
             "restitution {e}: speed ratio {} after the strike",
             s.ratio
         );

@@ -37,6 +37,7 @@ pub const SHIPPED: &[Shipped] = shipped![
     "paper_randomised",
     "ur5_randomised",
     "iiwa_actuators",
+    "paper_obstacle",
 ];
 
 impl Shipped {

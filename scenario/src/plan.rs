@@ -362,12 +362,22 @@ pub fn plan(
             return Err(mismatch(key, len));
         }
     }
-    let changes = robot
+    let mut changes: Vec<String> = robot
         .model
         .ignored
         .iter()
         .map(|l| format!("link '{}' dropped from the dynamics: {}", l.name, l.reason))
         .collect();
+    if !scenario.plant.contact.is_off() {
+        changes.extend(
+            robot
+                .model
+                .links
+                .iter()
+                .flat_map(|l| &l.skipped_collisions)
+                .map(|why| format!("contact: {why}: skipped")),
+        );
+    }
     let undrawn = scenario.clone();
     let scenario = crate::drawn(&scenario, dof);
     if scenario != undrawn {

@@ -30,14 +30,33 @@ pub(super) struct Contacts {
     impulse: f64,
 }
 
-/// Adds the arm's colliders and the obstacles to `world`; the skipped
-/// collision elements come back for the plant to report.
+/// Adds the arm's colliders and the obstacles to `world`. A robot with no
+/// primitive to collide is refused: contact could never happen.
 pub(super) fn insert(
     world: &mut PhysicsWorld,
     model: &ArmModel,
     bodies: &[RigidBodyHandle],
     config: &ContactConfig,
 ) -> Result<Contacts, PlantError> {
+    if model.links.iter().all(|l| l.collisions.is_empty()) {
+        let skipped: Vec<&str> = model
+            .links
+            .iter()
+            .flat_map(|l| l.skipped_collisions.iter().map(String::as_str))
+            .take(3)
+            .collect();
+        return Err(PlantError::InvalidConfig {
+            key: "plant.contact".into(),
+            value: "set".into(),
+            need: match skipped.is_empty() {
+                true => "links with <collision> primitives (box, cylinder, sphere, capsule): this robot has none".into(),
+                false => format!(
+                    "links with <collision> primitives (box, cylinder, sphere, capsule): this robot has none usable ({}, …)",
+                    skipped.join("; ")
+                ),
+            },
+        });
+    }
     let arm_filter = if config.self_contact {
         ARM | OBSTACLES
     } else {
