@@ -3,7 +3,10 @@
 //! topics with the same schemas (and one Foxglove layout serves both).
 //! Every channel carries CDR messages with a `ros2msg` schema ([`crate::ros2`]).
 
-use wire::{Command, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample, Timing};
+use wire::{
+    Command, ContactState, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample,
+    Timing,
+};
 
 use crate::LogMessage;
 use crate::ros2;
@@ -61,6 +64,7 @@ pub fn channels() -> Vec<ChannelSpec> {
         ChannelSpec::of::<ControllerDiagnostics>(),
         ChannelSpec::of::<Timing>(),
         ChannelSpec::of::<OwnDiagnostics>(),
+        ChannelSpec::of::<ContactState>(),
         ChannelSpec::standard(
             JOINT_STATES_TOPIC,
             ros2::JOINT_STATE,

@@ -11,7 +11,7 @@
 
 use serde_json::{Map, Value, json};
 use wire::{
-    Bound, Command, ControllerDiagnostics, FieldRef, FieldSource, Header, JointState,
+    Bound, Command, ContactState, ControllerDiagnostics, FieldRef, FieldSource, Header, JointState,
     OwnDiagnostics, ReferenceSample, Timing,
 };
 
@@ -211,6 +211,12 @@ impl LogMessage for ControllerDiagnostics {
 impl LogMessage for OwnDiagnostics {
     const ABOUT: &'static str = "An external controller's own diagnostics at step seq: the values \
         of what it declared, in the order the run's metadata (controller_diagnostics) lists them.";
+}
+
+impl LogMessage for ContactState {
+    const ABOUT: &'static str = "What contact did over the period that led to the state with the \
+        same seq: contact points, the mean contact force on the arm (N) and the deepest point \
+        (world frame, m). Only a plant with [plant.contact] publishes it.";
 }
 
 impl LogMessage for Timing {

@@ -10,7 +10,10 @@ use std::time::Duration;
 
 use bus::{NodeError, NodeLink, TopicSubscriber};
 use serde::{Deserialize, Serialize};
-use wire::{Command, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample, Timing};
+use wire::{
+    Command, ContactState, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample,
+    Timing,
+};
 
 use crate::live::{LiveConfig, LiveError};
 use crate::outputs::Outputs;
@@ -118,6 +121,7 @@ struct Subs {
     diag: Sub<ControllerDiagnostics>,
     own: Sub<OwnDiagnostics>,
     timing: Sub<Timing>,
+    contact: Sub<ContactState>,
 }
 
 impl Subs {
@@ -128,6 +132,7 @@ impl Subs {
         // logger counted them as dropped. Drained first, no run of 32 lost
         // any. The cause inside iceoryx2 is not found yet.
         self.timing.drain(|m| out.take(m))?;
+        self.contact.drain(|m| out.take(m))?;
         self.state.drain(|m| out.take_state(m))?;
         self.reference.drain(|m| out.take(m))?;
         self.command.drain(|m| out.take_command(m))?;
@@ -143,6 +148,7 @@ impl Subs {
         self.diag.stats(&mut out);
         self.own.stats(&mut out);
         self.timing.stats(&mut out);
+        self.contact.stats(&mut out);
         out
     }
 }
@@ -169,6 +175,7 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
         diag: Sub::new(link)?,
         own: Sub::new(link)?,
         timing: Sub::new(link)?,
+        contact: Sub::new(link)?,
     };
     let model = arm_model::ArmModel::from_urdf_str_locked(&config.urdf, &config.lock)?;
     // The live view first: a taken port fails the run before anything is

@@ -8,7 +8,10 @@
 use std::path::Path;
 
 use logger::{LogMessage, ros2};
-use wire::{Command, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample, Timing};
+use wire::{
+    Command, ContactState, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample,
+    Timing,
+};
 
 fn check<M: LogMessage>(stale: &mut Vec<String>) {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("msg/testbed_msgs/msg");
@@ -35,6 +38,7 @@ fn the_shipped_msg_files_are_the_generated_ones() {
     check::<ControllerDiagnostics>(&mut stale);
     check::<Timing>(&mut stale);
     check::<OwnDiagnostics>(&mut stale);
+    check::<ContactState>(&mut stale);
     assert!(
         stale.is_empty(),
         "stale: {stale:?}; rewrite them: TESTBED_WRITE_MSG=1 cargo test -p logger --test msg_files"
@@ -61,7 +65,7 @@ fn the_package_has_every_logged_type() {
             "CMakeLists.txt lacks {file}"
         );
     }
-    assert_eq!(seen, 6);
+    assert_eq!(seen, 7);
 }
 
 /// #39 row 13: every channel carries the QoS profile rosbag2 writes.

@@ -2,7 +2,7 @@
 //! node, `testbed sim` and the benchmarks all drive this one machine, so a
 //! lockstep run and an in-process one compute the same bits.
 
-use wire::{Command, Header, JointState, MAX_DOF, NONE_U64, STATE_FINAL, joints};
+use wire::{Command, ContactState, Header, JointState, MAX_DOF, NONE_U64, STATE_FINAL, joints};
 
 use crate::{ArmModel, PlantConfig, PlantError, Rig};
 
@@ -115,6 +115,31 @@ impl PlantMachine {
             // Clock data: the node stamps it.
             applied_wall_ns: 0,
         }
+    }
+
+    /// Whether the plant simulates contact (and so publishes
+    /// [`PlantMachine::contact`] beside each state).
+    pub fn has_contact(&self) -> bool {
+        self.rig.plant().contact().is_some()
+    }
+
+    /// What contact did over the period that led to state k, stamped as
+    /// that state; `None` without `[plant.contact]`.
+    pub fn contact(&self, k: u64, wall_ns: u64) -> Option<ContactState> {
+        let c = self.rig.plant().contact()?;
+        Some(ContactState {
+            header: Header {
+                seq: k,
+                t_ns: k * self.period_ns,
+                wall_ns,
+            },
+            points: c.points,
+            reserved: 0,
+            force: c.force,
+            point_x: c.point[0],
+            point_y: c.point[1],
+            point_z: c.point[2],
+        })
     }
 
     /// Steps one period with `cmd` (None: no new command, the last is held).

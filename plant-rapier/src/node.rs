@@ -8,7 +8,7 @@ use std::time::Duration;
 use bus::clock;
 use bus::{NodeError, NodeLink, TopicPublisher, TopicSubscriber, monotonic_ns};
 use serde::{Deserialize, Serialize};
-use wire::{Command, JointState, Mode, NODE_RUNNING, Timing, Topic};
+use wire::{Command, ContactState, JointState, Mode, NODE_RUNNING, Timing, Topic};
 
 use crate::{ArmModel, PlantConfig, PlantError, PlantMachine};
 
@@ -78,6 +78,22 @@ struct Ports {
     state: TopicPublisher<JointState>,
     timing: TopicPublisher<Timing>,
     command: TopicSubscriber<Command>,
+    /// Opened only when the plant simulates contact.
+    contact: Option<TopicPublisher<ContactState>>,
+}
+
+impl Ports {
+    /// State k, and what contact did on the way to it when the plant has
+    /// contact (sent first, so the logger has it when the state arrives).
+    fn send_state(&self, m: &PlantMachine, state: JointState) -> Result<(), LoopError> {
+        if let Some(p) = &self.contact
+            && let Some(c) = m.contact(state.header.seq, state.header.wall_ns)
+        {
+            p.send(c)?;
+        }
+        self.state.send(state)?;
+        Ok(())
+    }
 }
 
 /// Runs the plant node to the end of the run.
@@ -95,6 +111,10 @@ pub fn run(
         state: link.bus.publisher(Topic::JointState, mode.delivery())?,
         timing: link.bus.publisher(Topic::Timing, mode.delivery())?,
         command: link.bus.subscriber(Topic::Command)?,
+        contact: match m.has_contact() {
+            true => Some(link.bus.publisher(Topic::Contact, mode.delivery())?),
+            false => None,
+        },
     };
     let epoch = link.ready_and_wait_for_start()?;
     match mode {
@@ -144,7 +164,7 @@ impl From<PlantError> for LoopError {
 
 fn lockstep(link: &mut NodeLink, ports: &Ports, m: &mut PlantMachine) -> Result<(), LoopError> {
     let mut state = m.state(0, monotonic_ns());
-    ports.state.send(state)?;
+    ports.send_state(m, state)?;
     for k in 0..m.steps() {
         let cmd = wait_for_command(link, &ports.command, k)?;
         let taken_wall = monotonic_ns();
@@ -162,7 +182,7 @@ fn lockstep(link: &mut NodeLink, ports: &Ports, m: &mut PlantMachine) -> Result<
         })?;
         state = m.state(k + 1, monotonic_ns());
         state.applied_wall_ns = taken_wall;
-        ports.state.send(state)?;
+        ports.send_state(m, state)?;
         if (k + 1) % PROGRESS_EVERY == 0 {
             link.report(NODE_RUNNING, k + 1)?;
             link.check()?;
@@ -219,7 +239,7 @@ fn realtime(
     let floor = clock::TimerFloor::start(epoch, m.period_ns(), m.steps());
     clock::sleep_until(epoch);
     let mut state = m.state(0, monotonic_ns());
-    ports.state.send(state)?;
+    ports.send_state(m, state)?;
     let mut last_wake = monotonic_ns();
     let mut held = Held::default();
     for k in 1..=m.steps() {
@@ -266,7 +286,7 @@ fn realtime(
         })?;
         state = m.state(k, monotonic_ns());
         state.applied_wall_ns = held.taken_wall_ns;
-        ports.state.send(state)?;
+        ports.send_state(m, state)?;
         last_wake = wake;
         if k % 32 == 0 {
             link.check()?;

@@ -207,6 +207,26 @@ class Timing(ctypes.Structure):
         return "testbed.Timing.v2"
 
 
+class ContactState(ctypes.Structure):
+    _fields_ = [
+        ("header", Header),
+        ("points", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("force", ctypes.c_double),
+        ("point_x", ctypes.c_double),
+        ("point_y", ctypes.c_double),
+        ("point_z", ctypes.c_double),
+    ]
+    SIZE = 64
+    ALIGN = 8
+    OFFSETS = {"header": 0, "points": 24, "reserved": 28, "force": 32, "point_x": 40, "point_y": 48, "point_z": 56}
+    JOINT_FIELDS = ()
+
+    @staticmethod
+    def type_name() -> str:
+        return "testbed.ContactState.v1"
+
+
 class Control(ctypes.Structure):
     _fields_ = [
         ("header", Header),
@@ -252,11 +272,12 @@ TOPICS = {
     "diagnostics": ("testbed/diagnostics", ControllerDiagnostics, 1, 2, False),
     "own_diagnostics": ("testbed/own_diagnostics", OwnDiagnostics, 1, 2, False),
     "timing": ("testbed/timing", Timing, 1, 2, False),
+    "contact": ("testbed/contact", ContactState, 1, 2, False),
     "control": ("testbed/control", Control, 1, 2, True),
     "status": ("testbed/status", NodeStatus, 8, 8, True),
 }
 
-STRUCTURES = ("Header", "JointState", "ReferenceSample", "Command", "ControllerDiagnostics", "OwnDiagnostics", "Timing", "Control", "NodeStatus")
+STRUCTURES = ("Header", "JointState", "ReferenceSample", "Command", "ControllerDiagnostics", "OwnDiagnostics", "Timing", "ContactState", "Control", "NodeStatus")
 
 
 def _check_layouts() -> None:

@@ -162,6 +162,29 @@ fn a_contact_scenario_runs_the_same_in_sim_and_lockstep() {
         verify["effects"]["contact_steps"],
         run["effects"]["contact_steps"]
     );
+    // The log's /contact: one sample per state, the force where the state
+    // says contact, the point on the table's top (z = -0.5 m) under the arm.
+    use logger::LogMessage;
+    let (mut samples, mut touching) = (0u64, 0u64);
+    let mut on_message = |topic: &str, enc: logger::Encoding, data: &[u8]| {
+        if topic == wire::ContactState::LOG_TOPIC {
+            let c = wire::ContactState::decode_as(enc, data)?;
+            samples += 1;
+            if c.points > 0 {
+                touching += 1;
+                assert!(c.force.is_finite() && c.force >= 0.0, "{c:?}");
+                assert!((c.point_z + 0.5).abs() < 0.05 && c.point_x > 0.0, "{c:?}");
+            }
+        }
+        Ok(())
+    };
+    logger::read_log(
+        std::path::Path::new(run["log"].as_str().unwrap()),
+        Some(&mut on_message),
+    )
+    .unwrap();
+    assert_eq!(samples, run["steps"].as_u64().unwrap() + 1);
+    assert!(touching > 100, "{touching} samples in contact");
 }
 
 /// A reference published at 100 Hz under a 1 kHz loop, in real time: the

@@ -4,8 +4,8 @@
 //! generator all take the pairing from here.
 
 use crate::{
-    Command, Control, ControllerDiagnostics, JointState, MessageFields, NodeStatus, OwnDiagnostics,
-    ReferenceSample, Timing, Topic,
+    Command, ContactState, Control, ControllerDiagnostics, JointState, MessageFields, NodeStatus,
+    OwnDiagnostics, ReferenceSample, Timing, Topic,
 };
 
 /// A message bound to its topic and its log channel.
@@ -46,6 +46,7 @@ bind! {
     ControllerDiagnostics => Diagnostics, Some("/controller/diagnostics"), "testbed.ControllerDiagnostics";
     OwnDiagnostics => OwnDiagnostics, Some("/controller/own_diagnostics"), "testbed.OwnDiagnostics";
     Timing => Timing, Some("/timing"), "testbed.Timing";
+    ContactState => Contact, Some("/contact"), "testbed.ContactState";
     Control => Control, None, "testbed.Control";
     NodeStatus => Status, None, "testbed.NodeStatus";
 }

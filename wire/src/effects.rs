@@ -82,6 +82,6 @@ mod tests {
         assert_eq!(e.names(), ["friction", "command_held"]);
         assert!(e.has(Effects::FRICTION));
         assert!(!e.has(Effects::PAYLOAD));
-        assert_eq!(Effects::all_names().count(), 13);
+        assert_eq!(Effects::all_names().count(), 14);
     }
 }

@@ -125,6 +125,7 @@ pub fn all_layouts() -> Vec<TypeLayout> {
         TypeLayout::of::<crate::ControllerDiagnostics>("ControllerDiagnostics"),
         TypeLayout::of::<crate::OwnDiagnostics>("OwnDiagnostics"),
         TypeLayout::of::<crate::Timing>("Timing"),
+        TypeLayout::of::<crate::ContactState>("ContactState"),
         TypeLayout::of::<crate::Control>("Control"),
         TypeLayout::of::<crate::NodeStatus>("NodeStatus"),
     ]

@@ -3,7 +3,8 @@
 //! Where it sits: between every pair of processes. The plant publishes
 //! [`JointState`], the trajectory [`ReferenceSample`], the controller
 //! [`Command`] and [`ControllerDiagnostics`] (an external controller also
-//! its [`OwnDiagnostics`]), the plant [`Timing`]; the
+//! its [`OwnDiagnostics`]), the plant [`Timing`] (and [`ContactState`] when
+//! its links touch obstacles); the
 //! launcher sends [`Control`] and every node reports [`NodeStatus`]. All are
 //! fixed-size `#[repr(C)]` values exchanged zero-copy over iceoryx2 shared
 //! memory, each topic paired with an event service so receivers sleep until

@@ -222,6 +222,31 @@ crate::data_message! {
 }
 
 crate::data_message! {
+    /// What contact did over the period that led to the state with the same
+    /// `header.seq` (published only by a plant with `[plant.contact]`).
+    #[type_name("testbed.ContactState.v1")]
+    pub struct ContactState {
+        /// seq = k, t_ns = t_k.
+        header: Header,
+        /// Contact points at the period's last substep.
+        points: u32 => U32,
+        /// Padding (keeps the layout explicit).
+        reserved: u32 => Pad,
+        /// Mean contact force on the arm over the period: the contact
+        /// solver's normal impulses summed over contacts and substeps, over
+        /// the period, N.
+        force: f64 => F64,
+        /// The deepest contact point at the period's last substep, world
+        /// frame, m (0 with no contact).
+        point_x: f64 => F64,
+        /// Its y, m.
+        point_y: f64 => F64,
+        /// Its z, m.
+        point_z: f64 => F64,
+    }
+}
+
+crate::data_message! {
     /// Timing of one plant cycle (published by the plant, which is the clock).
     #[type_name("testbed.Timing.v2")]
     pub struct Timing {

@@ -20,6 +20,8 @@ pub enum Topic {
     OwnDiagnostics,
     /// Plant → logger: [`crate::Timing`].
     Timing,
+    /// Plant → logger: [`crate::ContactState`] (contact scenarios only).
+    Contact,
     /// Launcher → nodes: [`crate::Control`].
     Control,
     /// Nodes → launcher: [`crate::NodeStatus`].
@@ -28,13 +30,14 @@ pub enum Topic {
 
 impl Topic {
     /// Every topic.
-    pub const ALL: [Topic; 8] = [
+    pub const ALL: [Topic; 9] = [
         Topic::JointState,
         Topic::Reference,
         Topic::Command,
         Topic::Diagnostics,
         Topic::OwnDiagnostics,
         Topic::Timing,
+        Topic::Contact,
         Topic::Control,
         Topic::Status,
     ];
@@ -48,6 +51,7 @@ impl Topic {
             Topic::Diagnostics => "testbed/diagnostics",
             Topic::OwnDiagnostics => "testbed/own_diagnostics",
             Topic::Timing => "testbed/timing",
+            Topic::Contact => "testbed/contact",
             Topic::Control => "testbed/control",
             Topic::Status => "testbed/status",
         }

@@ -21,6 +21,8 @@ pub struct ContactReading {
     pub force: f64,
     /// Contact points at the period's last substep.
     pub points: u32,
+    /// The deepest of them, world frame, m (0 with none).
+    pub point: [f64; 3],
 }
 
 /// The colliders of one arm and what they met.
@@ -135,17 +137,28 @@ impl Contacts {
     }
 
     /// Reads what the solver did at the substep just taken.
-    pub(super) fn after_substep(&mut self, narrow_phase: &NarrowPhase) {
+    pub(super) fn after_substep(&mut self, narrow_phase: &NarrowPhase, colliders: &ColliderSet) {
         let mut points = 0u32;
+        let mut deepest = (f64::INFINITY, [0.0; 3]);
         for pair in narrow_phase.contact_pairs() {
             self.impulse += pair.total_impulse_magnitude();
+            let Some(c1) = colliders.get(pair.collider1) else {
+                continue;
+            };
             for m in pair.manifolds() {
                 // Points within the contact skin count; Rapier measures
                 // them before its solver moves the bodies.
-                points += m.points.iter().filter(|p| p.dist <= 0.0).count() as u32;
+                for p in m.points.iter().filter(|p| p.dist <= 0.0) {
+                    points += 1;
+                    if p.dist < deepest.0 {
+                        let w = c1.position() * p.local_p1;
+                        deepest = (p.dist, [w.x, w.y, w.z]);
+                    }
+                }
             }
         }
         self.reading.points = points;
+        self.reading.point = deepest.1;
     }
 
     /// Ends a period of length `dt`: the reading for it.

@@ -217,7 +217,7 @@ impl RapierArm {
             (self.q, self.qd, self.total) = (q, qd, total);
             self.world.step();
             if let Some(c) = &mut self.contacts {
-                c.after_substep(&self.world.narrow_phase);
+                c.after_substep(&self.world.narrow_phase, &self.world.colliders);
             }
         }
         self.contact = self.contacts.as_mut().map(|c| c.end(dt));
