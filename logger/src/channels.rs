@@ -9,6 +9,7 @@ use wire::{
 };
 
 use crate::LogMessage;
+use crate::obstacles::CONTACT_MARKER_TOPIC;
 use crate::ros2;
 use crate::scene::{SCENE_TOPIC, TRANSFORMS_TOPIC};
 
@@ -77,5 +78,10 @@ pub fn channels() -> Vec<ChannelSpec> {
         ),
         ChannelSpec::standard(TRANSFORMS_TOPIC, ros2::TF_MESSAGE, ros2::tf_schema()),
         ChannelSpec::standard(SCENE_TOPIC, ros2::MARKER_ARRAY, ros2::marker_array_schema()),
+        ChannelSpec::standard(
+            CONTACT_MARKER_TOPIC,
+            ros2::MARKER_ARRAY,
+            ros2::marker_array_schema(),
+        ),
     ]
 }

@@ -34,6 +34,7 @@ mod layout;
 pub mod live;
 mod mcap_out;
 pub mod node;
+pub mod obstacles;
 mod outputs;
 mod reader;
 mod records;

@@ -38,6 +38,9 @@ pub struct LoggerNodeConfig {
     /// Serve the run live to Foxglove (`testbed run --live`).
     #[serde(default)]
     pub live: Option<LiveConfig>,
+    /// A contact scenario's obstacles, for the 3D view.
+    #[serde(default)]
+    pub obstacles: Vec<crate::obstacles::DrawnObstacle>,
 }
 
 /// Why the logger node stopped.
@@ -132,7 +135,7 @@ impl Subs {
         // logger counted them as dropped. Drained first, no run of 32 lost
         // any. The cause inside iceoryx2 is not found yet.
         self.timing.drain(|m| out.take(m))?;
-        self.contact.drain(|m| out.take(m))?;
+        self.contact.drain(|m| out.take_contact(m))?;
         self.state.drain(|m| out.take_state(m))?;
         self.reference.drain(|m| out.take(m))?;
         self.command.drain(|m| out.take_command(m))?;
@@ -199,7 +202,7 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_nanos() as u64);
     let log = LogWriter::create_with(&config.out, &meta, &config.urdf, config.compression)?;
-    let mut out = Outputs::open(log, &model, live)?;
+    let mut out = Outputs::open(log, &model, &config.obstacles, live)?;
 
     let started = link.ready_and_wait_for_start();
     let result: Result<(), LoggerNodeError> = match started {

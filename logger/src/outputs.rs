@@ -5,7 +5,9 @@
 use std::collections::BTreeMap;
 
 use arm_model::ArmModel;
-use wire::{Command, JointState};
+use wire::{Command, ContactState, JointState};
+
+use crate::obstacles::{CONTACT_MARKER_TOPIC, DrawnObstacle, contact_marker};
 
 use crate::live::LiveView;
 use crate::scene::{ArmScene, SCENE_TOPIC, TRANSFORMS_TOPIC};
@@ -41,6 +43,7 @@ pub(crate) struct Outputs {
     next_scene_ns: u64,
     next_state_view_ns: u64,
     next_command_view_ns: u64,
+    next_contact_view_ns: u64,
     /// A derived message's CDR, reused.
     buf: Vec<u8>,
 }
@@ -51,6 +54,7 @@ impl Outputs {
     pub(crate) fn open(
         mut log: LogWriter,
         model: &ArmModel,
+        obstacles: &[DrawnObstacle],
         live: Option<Box<dyn LiveView>>,
     ) -> Result<Self, LogError> {
         for spec in channels() {
@@ -67,7 +71,7 @@ impl Outputs {
         Ok(Self {
             log,
             live,
-            arm: ArmScene::new(model),
+            arm: ArmScene::new(model).with_obstacles(obstacles),
             dof: model.dof(),
             names,
             view_names,
@@ -77,6 +81,7 @@ impl Outputs {
             next_scene_ns: 0,
             next_state_view_ns: 0,
             next_command_view_ns: 0,
+            next_contact_view_ns: 0,
             buf: Vec::with_capacity(4096),
         })
     }
@@ -86,6 +91,22 @@ impl Outputs {
         let data = self.log.write(msg)?;
         if let Some(live) = self.live.as_mut() {
             live.offer(M::LOG_TOPIC, msg.header().t_ns, data);
+        }
+        Ok(())
+    }
+
+    /// What contact did: the sample, then, while the arm touches
+    /// something, the contact point on `/arm/contact` at most every 20 ms
+    /// of sim time (each marker lasting two of those, so it goes when the
+    /// contact does).
+    pub(crate) fn take_contact(&mut self, c: &ContactState) -> Result<(), LogError> {
+        self.take(c)?;
+        let (t, wall) = (c.header.t_ns, c.header.wall_ns);
+        if c.points > 0 && c.force.is_finite() && t >= self.next_contact_view_ns {
+            self.next_contact_view_ns = t.saturating_add(VIEWS_EVERY_NS);
+            self.buf.clear();
+            contact_marker(&mut self.buf, t, c, 2 * VIEWS_EVERY_NS);
+            self.emit(CONTACT_MARKER_TOPIC, t, wall)?;
         }
         Ok(())
     }

@@ -418,6 +418,8 @@ pub struct Marker {
     pub scale: [f64; 3],
     /// r, g, b, a.
     pub color: [f32; 4],
+    /// How long it shows after its stamp, ns (0: until replaced).
+    pub lifetime_ns: u64,
 }
 
 /// A `visualization_msgs/msg/MarkerArray` of `markers`, stamped `t_ns`.
@@ -436,7 +438,7 @@ pub fn marker_array(out: &mut Vec<u8>, t_ns: u64, markers: &[Marker]) {
         for c in m.color {
             w.f32(c);
         }
-        w.time(0);
+        w.time(m.lifetime_ns);
         w.u8(1);
         w.len(0);
         w.len(0);

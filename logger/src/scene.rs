@@ -11,6 +11,7 @@ use arm_model::dynamics::Dynamics;
 use arm_model::{ArmModel, iso};
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
+use crate::obstacles::DrawnObstacle;
 use crate::ros2::{self, Marker, Pose};
 
 /// Topic of the link frames (ROS 2's).
@@ -39,6 +40,8 @@ pub struct ArmScene {
     folded: Vec<(String, usize, Isometry3<f64>)>,
     bones: Vec<Bone>,
     radius: f64,
+    /// A contact scenario's obstacles, drawn in the world frame.
+    obstacles: Vec<DrawnObstacle>,
 }
 
 /// One transform of `/tf`: the parent frame, the child frame, the child's
@@ -85,7 +88,14 @@ impl ArmScene {
             folded,
             bones,
             radius: (0.08 * longest).clamp(0.005, 0.05),
+            obstacles: Vec::new(),
         }
+    }
+
+    /// The scene with a contact scenario's obstacles drawn beside the arm.
+    pub fn with_obstacles(mut self, obstacles: &[DrawnObstacle]) -> Self {
+        self.obstacles = obstacles.to_vec();
+        self
     }
 
     /// Every link's frame in its parent's at joint positions `q` (one
@@ -130,6 +140,7 @@ impl ArmScene {
                 pose: parts(&Isometry3::identity()),
                 scale: [1.5 * d; 3],
                 color: [0.2, 0.2, 0.2, 1.0],
+                lifetime_ns: 0,
             });
             for (k, b) in self.bones.iter().filter(|b| b.link == i).enumerate() {
                 out.push(Marker {
@@ -139,8 +150,12 @@ impl ArmScene {
                     pose: parts(&cylinder_pose(b.to)),
                     scale: [d, d, b.to.norm()],
                     color: color(i),
+                    lifetime_ns: 0,
                 });
             }
+        }
+        for (i, o) in self.obstacles.iter().enumerate() {
+            out.push(o.marker(i as i32));
         }
         out
     }
@@ -167,7 +182,7 @@ fn cylinder_pose(to: Vector3<f64>) -> Isometry3<f64> {
 }
 
 /// A rigid transform as translation and quaternion (x, y, z, w).
-fn parts(p: &Isometry3<f64>) -> Pose {
+pub(crate) fn parts(p: &Isometry3<f64>) -> Pose {
     let (t, r) = (p.translation.vector, p.rotation);
     ([t.x, t.y, t.z], [r.i, r.j, r.k, r.w])
 }

@@ -165,8 +165,9 @@ fn a_contact_scenario_runs_the_same_in_sim_and_lockstep() {
     // The log's /contact: one sample per state, the force where the state
     // says contact, the point on the table's top (z = -0.5 m) under the arm.
     use logger::LogMessage;
-    let (mut samples, mut touching) = (0u64, 0u64);
+    let (mut samples, mut touching, mut markers) = (0u64, 0u64, 0u64);
     let mut on_message = |topic: &str, enc: logger::Encoding, data: &[u8]| {
+        markers += u64::from(topic == logger::obstacles::CONTACT_MARKER_TOPIC);
         if topic == wire::ContactState::LOG_TOPIC {
             let c = wire::ContactState::decode_as(enc, data)?;
             samples += 1;
@@ -185,6 +186,11 @@ fn a_contact_scenario_runs_the_same_in_sim_and_lockstep() {
     .unwrap();
     assert_eq!(samples, run["steps"].as_u64().unwrap() + 1);
     assert!(touching > 100, "{touching} samples in contact");
+    // The 3D view's contact point: every 20 ms of sim time in contact.
+    assert!(
+        markers >= touching / 20 && markers <= touching / 20 + 10,
+        "{markers} contact markers for {touching} samples in contact"
+    );
 }
 
 /// A reference published at 100 Hz under a 1 kHz loop, in real time: the

@@ -89,7 +89,22 @@ pub fn logger(
         lock: plan.scenario.plant.lock.clone(),
         compression: opts.compression,
         live: opts.live.cloned(),
+        obstacles: drawn_obstacles(&plan.scenario.plant.contact),
     }
+}
+
+/// The scenario's obstacles as the 3D view draws them (checked with the
+/// scenario: one that does not check is not drawn).
+fn drawn_obstacles(contact: &plant_rapier::ContactConfig) -> Vec<logger::obstacles::DrawnObstacle> {
+    contact
+        .obstacle
+        .iter()
+        .enumerate()
+        .filter_map(|(i, o)| {
+            let g = o.geometry(i).ok()?;
+            Some(logger::obstacles::DrawnObstacle::new(&o.origin(), &g))
+        })
+        .collect()
 }
 
 /// The `testbed.run` record of a run of `plan` logged to `out`.

@@ -211,7 +211,8 @@ fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
     }
     // One analysis path: the summary comes from the log just written.
     let analysis = analyse_log(&files.log, opts.csv.as_deref())?;
-    transport::check_log(&analysis, opts.mode)?;
+    let contact = !opts.plan.scenario.plant.contact.is_off();
+    transport::check_log(&analysis, opts.mode, contact)?;
     Ok(RunOutcome {
         analysis,
         run_dir: files.run_dir,

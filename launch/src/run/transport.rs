@@ -49,12 +49,18 @@ fn is_transport_failure(e: &RunError) -> bool {
 
 /// The transport's failure a finished log shows, if any: in lockstep any
 /// step missing; in real time, where samples may be dropped, a topic the
-/// logger never received at all.
-pub(super) fn check_log(analysis: &LogAnalysis, mode: Mode) -> Result<(), RunError> {
-    // Own diagnostics come only from a controller that declared some.
-    let own = <wire::OwnDiagnostics as wire::Bound>::CHANNEL
-        .map(|c| format!("{}.received", c.trim_start_matches('/')));
-    let expected = |k: &str| !analysis.own_diagnostics.is_empty() || own.as_deref() != Some(k);
+/// logger never received at all. `contact`: the plant simulates contact
+/// (and so publishes its contact samples).
+pub(super) fn check_log(analysis: &LogAnalysis, mode: Mode, contact: bool) -> Result<(), RunError> {
+    let key = |c: Option<&str>| c.map(|c| format!("{}.received", c.trim_start_matches('/')));
+    // Own diagnostics come only from a controller that declared some,
+    // contact samples only from a plant with contact.
+    let own = key(<wire::OwnDiagnostics as wire::Bound>::CHANNEL);
+    let touch = key(<wire::ContactState as wire::Bound>::CHANNEL);
+    let expected = |k: &str| {
+        (!analysis.own_diagnostics.is_empty() || own.as_deref() != Some(k))
+            && (contact || touch.as_deref() != Some(k))
+    };
     let topic_never_came = analysis.expected_rows > 0
         && analysis
             .contents
