@@ -44,8 +44,9 @@ pub use arm_model::{
     MimicJoint, MimicSpec, ModelError, Origin, TWO_LINK_URDF,
 };
 pub use config::{
-    ActuationConfig, ActuatorConfig, ContactConfig, DisturbanceConfig, FrictionConfig, Harmonic,
-    JointActuator, Obstacle, PayloadConfig, PerJoint, PlantConfig, SensorConfig, ShapeName, Spring,
+    ActuationConfig, ActuatorConfig, ContactConfig, ContactObject, DisturbanceConfig,
+    FrictionConfig, Harmonic, JointActuator, Obstacle, PayloadConfig, PerJoint, PlantConfig,
+    SensorConfig, ShapeName, Spring,
 };
 pub use effects::Effects;
 pub use engine::EngineName;

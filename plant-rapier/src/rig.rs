@@ -21,6 +21,16 @@ struct Payload {
     attached: bool,
 }
 
+/// When a contact object is grasped and let go, in periods.
+struct Grasp {
+    /// First period that starts with it grasped.
+    grasp_k: u64,
+    /// First period that starts with it free again.
+    release_k: Option<u64>,
+    held: bool,
+    released: bool,
+}
+
 /// The plant, its actuators, its sensors and its disturbance, stepped one
 /// control period at a time. Everything random comes from `seed`, so the
 /// same calls give the same numbers, bit for bit.
@@ -34,6 +44,7 @@ pub struct Rig {
     sensor: Sensor,
     disturbance: Disturbance,
     payload: Option<Payload>,
+    grasps: Vec<Grasp>,
     /// Effects over the last period (and the sensors'), see [`Effects`].
     effects: u32,
     static_effects: u32,
@@ -102,7 +113,7 @@ impl Rig {
                     link,
                     point: [at.x, at.y, at.z],
                     mass: p.mass,
-                    attach_k: (p.attach_at_s * 1e9 / period_ns as f64).ceil() as u64,
+                    attach_k: periods(p.attach_at_s, period_ns),
                     attached: false,
                 })
             }
@@ -120,6 +131,17 @@ impl Rig {
             sensor,
             disturbance,
             payload,
+            grasps: config
+                .contact
+                .object
+                .iter()
+                .map(|o| Grasp {
+                    grasp_k: periods(o.grasp_at_s, period_ns),
+                    release_k: o.release_at_s.map(|s| periods(s, period_ns)),
+                    held: false,
+                    released: false,
+                })
+                .collect(),
             effects: static_effects,
             static_effects,
         };
@@ -170,6 +192,7 @@ impl Rig {
             });
         }
         let t = self.k as f64 * self.period_ns as f64 / 1e9;
+        let held = self.hold_due_objects()?;
         let passage = self.actuator.pass(command);
         let d = self.disturbance.advance(t);
         self.plant.set_external_torque(d)?;
@@ -195,8 +218,28 @@ impl Rig {
         if passage.held {
             e |= Effects::COMMAND_HELD;
         }
+        if held {
+            e |= Effects::PAYLOAD;
+        }
         self.effects = e;
         self.attach_due_payload()
+    }
+
+    /// Grasps and lets go the contact objects due as period k starts (not
+    /// before: the arm is put at its initial state after the rig is made);
+    /// whether any is held.
+    fn hold_due_objects(&mut self) -> Result<bool, PlantError> {
+        for (i, g) in self.grasps.iter_mut().enumerate() {
+            if !g.held && !g.released && self.k >= g.grasp_k {
+                self.plant.hold_object(i, true)?;
+                g.held = true;
+            }
+            if g.held && g.release_k.is_some_and(|r| self.k >= r) {
+                self.plant.hold_object(i, false)?;
+                (g.held, g.released) = (false, true);
+            }
+        }
+        Ok(self.grasps.iter().any(|g| g.held))
     }
 
     /// Picks the payload up when the next period starts at or after its time.
@@ -231,4 +274,9 @@ impl Rig {
     pub fn payload_attached(&self) -> bool {
         self.payload.as_ref().is_some_and(|p| p.attached)
     }
+}
+
+/// The first period that starts at or after `s` seconds.
+fn periods(s: f64, period_ns: u64) -> u64 {
+    (s * 1e9 / period_ns as f64).ceil() as u64
 }

@@ -24,6 +24,8 @@ pub struct ContactConfig {
     pub self_contact: bool,
     /// Fixed bodies in the workspace.
     pub obstacle: Vec<Obstacle>,
+    /// Free bodies the arm grasps and releases (a pick and place).
+    pub object: Vec<ContactObject>,
 }
 
 impl Default for ContactConfig {
@@ -33,8 +35,39 @@ impl Default for ContactConfig {
             friction: 0.5,
             self_contact: false,
             obstacle: Vec::new(),
+            object: Vec::new(),
         }
     }
+}
+
+/// A free rigid body that a link grasps at one time and releases at
+/// another: it rests on the obstacles before, rides on the link (its mass
+/// and inertia part of the link's) while grasped, and falls after.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactObject {
+    /// A name for errors (default: "object N").
+    #[serde(default)]
+    pub name: String,
+    /// `box`, `sphere`, `cylinder` or `capsule`, sized as an obstacle is.
+    pub shape: ShapeName,
+    /// As an obstacle's `size`, m.
+    pub size: Vec<f64>,
+    /// Mass, kg (a uniform solid of that shape).
+    pub mass: f64,
+    /// Where its centre starts, world frame, m.
+    #[serde(default)]
+    pub xyz: [f64; 3],
+    /// Its starting orientation, fixed-axis roll, pitch, yaw, rad.
+    #[serde(default)]
+    pub rpy: [f64; 3],
+    /// The URDF link that grasps it.
+    pub link: String,
+    /// When the link grasps it, wherever it then is relative to the link, s.
+    pub grasp_at_s: f64,
+    /// When the link lets it go, s (default: never).
+    #[serde(default)]
+    pub release_at_s: Option<f64>,
 }
 
 /// A fixed obstacle: a primitive shape at a pose in the world frame.
@@ -76,7 +109,7 @@ impl ContactConfig {
     /// Whether contact is simulated at all (the key is then not written, so
     /// that scenarios' identities keep).
     pub fn is_off(&self) -> bool {
-        self.obstacle.is_empty() && !self.self_contact
+        self.obstacle.is_empty() && self.object.is_empty() && !self.self_contact
     }
 
     /// Checks every entry; errors name the key.
@@ -95,12 +128,20 @@ impl ContactConfig {
                 "a coefficient from 0 to 100",
             ));
         }
-        if self.obstacle.len() > MAX_OBSTACLES {
-            return Err(invalid(
-                "plant.contact.obstacle",
-                format!("{} obstacles", self.obstacle.len()),
-                format!("at most {MAX_OBSTACLES}"),
-            ));
+        for (key, n) in [
+            ("plant.contact.obstacle", self.obstacle.len()),
+            ("plant.contact.object", self.object.len()),
+        ] {
+            if n > MAX_OBSTACLES {
+                return Err(invalid(
+                    key,
+                    format!("{n} entries"),
+                    format!("at most {MAX_OBSTACLES}"),
+                ));
+            }
+        }
+        for (i, o) in self.object.iter().enumerate() {
+            o.validate(i)?;
         }
         for (i, o) in self.obstacle.iter().enumerate() {
             o.geometry(i)?;
@@ -119,24 +160,11 @@ const MAX_OBSTACLES: usize = 1000;
 impl Obstacle {
     /// The obstacle's shape, checked; `i` is its index for errors.
     pub fn geometry(&self, i: usize) -> Result<Geometry, PlantError> {
-        let key = format!("plant.contact.obstacle[{i}].size");
-        let want = match self.shape {
-            ShapeName::Box => "three side lengths > 0, m",
-            ShapeName::Sphere => "one radius > 0, m",
-            ShapeName::Cylinder | ShapeName::Capsule => "a radius and a length > 0, m",
-        };
-        let s = &self.size;
-        let bad = || invalid(&key, format!("{s:?}"), want);
-        if s.iter().any(|v| !(v.is_finite() && *v > 0.0 && *v <= 1e3)) {
-            return Err(bad());
-        }
-        Ok(match (self.shape, s.as_slice()) {
-            (ShapeName::Box, &[x, y, z]) => Geometry::Box { size: [x, y, z] },
-            (ShapeName::Sphere, &[radius]) => Geometry::Sphere { radius },
-            (ShapeName::Cylinder, &[radius, length]) => Geometry::Cylinder { radius, length },
-            (ShapeName::Capsule, &[radius, length]) => Geometry::Capsule { radius, length },
-            _ => return Err(bad()),
-        })
+        geometry(
+            self.shape,
+            &self.size,
+            &format!("plant.contact.obstacle[{i}].size"),
+        )
     }
 
     /// Where the obstacle sits in the world.
@@ -155,4 +183,74 @@ impl Obstacle {
             self.name.clone()
         }
     }
+}
+
+impl ContactObject {
+    /// The object's shape, checked; `i` is its index for errors.
+    pub fn geometry(&self, i: usize) -> Result<Geometry, PlantError> {
+        geometry(
+            self.shape,
+            &self.size,
+            &format!("plant.contact.object[{i}].size"),
+        )
+    }
+
+    /// Where the object starts in the world.
+    pub fn origin(&self) -> Origin {
+        Origin {
+            xyz: self.xyz,
+            rpy: self.rpy,
+        }
+    }
+
+    fn validate(&self, i: usize) -> Result<(), PlantError> {
+        let key = |k: &str| format!("plant.contact.object[{i}].{k}");
+        self.geometry(i)?;
+        if !(self.mass.is_finite() && self.mass > 0.0 && self.mass <= 1e4) {
+            return Err(invalid(&key("mass"), self.mass, "a mass in (0, 10000] kg"));
+        }
+        if let Some(v) = self.xyz.iter().chain(&self.rpy).find(|v| !v.is_finite()) {
+            return Err(invalid(&key("xyz/rpy"), v, "finite numbers"));
+        }
+        if !(self.grasp_at_s.is_finite() && self.grasp_at_s >= 0.0 && self.grasp_at_s <= 1e6) {
+            return Err(invalid(
+                &key("grasp_at_s"),
+                self.grasp_at_s,
+                "a time from 0 to 10^6 s",
+            ));
+        }
+        if let Some(r) = self.release_at_s
+            && !(r.is_finite() && r > self.grasp_at_s && r <= 1e6)
+        {
+            return Err(invalid(
+                &key("release_at_s"),
+                r,
+                format!(
+                    "a time after grasp_at_s ({} s), up to 10^6 s",
+                    self.grasp_at_s
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A shape from its name and sizes; `key` names the sizes for errors.
+fn geometry(shape: ShapeName, s: &[f64], key: &str) -> Result<Geometry, PlantError> {
+    let want = match shape {
+        ShapeName::Box => "three side lengths > 0, m",
+        ShapeName::Sphere => "one radius > 0, m",
+        ShapeName::Cylinder | ShapeName::Capsule => "a radius and a length > 0, m",
+    };
+    let bad = || invalid(key, format!("{s:?}"), want);
+    if s.iter().any(|v| !(v.is_finite() && *v > 0.0 && *v <= 1e3)) {
+        return Err(bad());
+    }
+    Ok(match (shape, s) {
+        (ShapeName::Box, &[x, y, z]) => Geometry::Box { size: [x, y, z] },
+        (ShapeName::Sphere, &[radius]) => Geometry::Sphere { radius },
+        (ShapeName::Cylinder, &[radius, length]) => Geometry::Cylinder { radius, length },
+        (ShapeName::Capsule, &[radius, length]) => Geometry::Capsule { radius, length },
+        _ => return Err(bad()),
+    })
 }

@@ -10,7 +10,7 @@ mod actuator;
 mod contact;
 
 pub use actuator::{ActuatorConfig, Harmonic, JointActuator, Spring};
-pub use contact::{ContactConfig, Obstacle, ShapeName};
+pub use contact::{ContactConfig, ContactObject, Obstacle, ShapeName};
 
 /// How the plant integrates, and the effects it adds on top of the rigid
 /// body dynamics.

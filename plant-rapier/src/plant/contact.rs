@@ -9,9 +9,12 @@ use rapier3d_f64::prelude::*;
 use super::rapier::pose;
 use crate::{ContactConfig, PlantError};
 
-/// Arm colliders are in group 1, obstacles in group 2.
+/// Arm colliders are in group 1, obstacles in group 2, free objects in 3:
+/// the arm meets obstacles, objects rest on obstacles; an object meets
+/// the arm only as part of it, once grasped.
 const ARM: Group = Group::GROUP_1;
 const OBSTACLES: Group = Group::GROUP_2;
+const OBJECTS: Group = Group::GROUP_3;
 
 /// What contact did over the last period.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -30,6 +33,17 @@ pub(super) struct Contacts {
     reading: ContactReading,
     /// Impulse summed over the period's substeps so far, N s.
     impulse: f64,
+    /// The arm's link bodies: a contact counts when one side rides on them.
+    arm: Vec<RigidBodyHandle>,
+    /// The objects a link grasps and releases.
+    objects: Vec<Held>,
+}
+
+/// A free object and the link that grasps it.
+struct Held {
+    body: RigidBodyHandle,
+    collider: ColliderHandle,
+    link: RigidBodyHandle,
 }
 
 /// Adds the arm's colliders and the obstacles to `world`. A robot with no
@@ -37,7 +51,7 @@ pub(super) struct Contacts {
 pub(super) fn insert(
     world: &mut PhysicsWorld,
     model: &ArmModel,
-    bodies: &[RigidBodyHandle],
+    bodies_of_arm: &[RigidBodyHandle],
     config: &ContactConfig,
 ) -> Result<Contacts, PlantError> {
     if model.links.iter().all(|l| l.collisions.is_empty()) {
@@ -70,7 +84,7 @@ pub(super) fn insert(
             .friction(config.friction)
             .friction_combine_rule(CoefficientCombineRule::Max)
     };
-    for (link, &body) in model.links.iter().zip(bodies) {
+    for (link, &body) in model.links.iter().zip(bodies_of_arm) {
         for c in &link.collisions {
             let collider = material(shape(&c.geometry))
                 .position(pose(&c.origin))
@@ -95,7 +109,7 @@ pub(super) fn insert(
         let collider = material(shape(&o.geometry(i)?))
             .collision_groups(InteractionGroups::new(
                 OBSTACLES,
-                ARM,
+                ARM | OBJECTS,
                 InteractionTestMode::And,
             ))
             .build();
@@ -104,9 +118,47 @@ pub(super) fn insert(
         } = world;
         colliders.insert_with_parent(collider, fixed, bodies);
     }
+    let mut objects = Vec::with_capacity(config.object.len());
+    for (i, o) in config.object.iter().enumerate() {
+        let (link, _) = model
+            .locate_link(&o.link)
+            .ok_or_else(|| PlantError::InvalidConfig {
+                key: format!("plant.contact.object[{i}].link"),
+                value: format!("\"{}\"", o.link),
+                need: format!(
+                    "one of the robot's links ({})",
+                    model.link_names().join(", ")
+                ),
+            })?;
+        let body = world.bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .pose(pose(&o.origin()))
+                .can_sleep(false)
+                .build(),
+        );
+        let collider = material(shape(&o.geometry(i)?))
+            .mass(o.mass)
+            .collision_groups(InteractionGroups::new(
+                OBJECTS,
+                OBSTACLES,
+                InteractionTestMode::And,
+            ))
+            .build();
+        let PhysicsWorld {
+            colliders, bodies, ..
+        } = world;
+        let collider = colliders.insert_with_parent(collider, body, bodies);
+        objects.push(Held {
+            body,
+            collider,
+            link: bodies_of_arm[link],
+        });
+    }
     Ok(Contacts {
         reading: ContactReading::default(),
         impulse: 0.0,
+        arm: bodies_of_arm.to_vec(),
+        objects,
     })
 }
 
@@ -141,10 +193,16 @@ impl Contacts {
         let mut points = 0u32;
         let mut deepest = (f64::INFINITY, [0.0; 3]);
         for pair in narrow_phase.contact_pairs() {
-            self.impulse += pair.total_impulse_magnitude();
-            let Some(c1) = colliders.get(pair.collider1) else {
+            let (Some(c1), Some(c2)) =
+                (colliders.get(pair.collider1), colliders.get(pair.collider2))
+            else {
                 continue;
             };
+            let on_arm = |c: &Collider| c.parent().is_some_and(|p| self.arm.contains(&p));
+            if !(on_arm(c1) || on_arm(c2)) {
+                continue; // an object resting on an obstacle
+            }
+            self.impulse += pair.total_impulse_magnitude();
             for m in pair.manifolds() {
                 // Points within the contact skin count; Rapier measures
                 // them before its solver moves the bodies.
@@ -159,6 +217,68 @@ impl Contacts {
         }
         self.reading.points = points;
         self.reading.point = deepest.1;
+    }
+
+    /// Object `i` joins its link where it now is: its collider (and so its
+    /// mass and inertia) rides on the link's body; its own body rests.
+    pub(super) fn grasp(&self, i: usize, world: &mut PhysicsWorld) -> Result<(), PlantError> {
+        let h = self.held(i)?;
+        let PhysicsWorld {
+            colliders, bodies, ..
+        } = world;
+        let (Some(c), Some(link)) = (colliders.get(h.collider), bodies.get(h.link)) else {
+            return Err(PlantError::Engine(format!(
+                "object {i} or its link vanished"
+            )));
+        };
+        let relative = link.position().inverse() * *c.position();
+        colliders.set_parent(h.collider, Some(h.link), bodies);
+        if let Some(c) = colliders.get_mut(h.collider) {
+            c.set_position_wrt_parent(relative);
+        }
+        if let Some(b) = bodies.get_mut(h.body) {
+            b.set_enabled(false);
+        }
+        Ok(())
+    }
+
+    /// Object `i` leaves its link as a free body, moving as the link's
+    /// material at its place did.
+    pub(super) fn release(&self, i: usize, world: &mut PhysicsWorld) -> Result<(), PlantError> {
+        let h = self.held(i)?;
+        let PhysicsWorld {
+            colliders, bodies, ..
+        } = world;
+        let (Some(c), Some(link)) = (colliders.get(h.collider), bodies.get(h.link)) else {
+            return Err(PlantError::Engine(format!(
+                "object {i} or its link vanished"
+            )));
+        };
+        let at = *c.position();
+        let (v, w) = (link.velocity_at_point(at.translation), link.angvel());
+        if let Some(b) = bodies.get_mut(h.body) {
+            b.set_enabled(true);
+            b.set_position(at, true);
+            b.set_linvel(v, true);
+            b.set_angvel(w, true);
+        }
+        colliders.set_parent(h.collider, Some(h.body), bodies);
+        if let Some(c) = colliders.get_mut(h.collider) {
+            c.set_position_wrt_parent(Pose::IDENTITY);
+        }
+        Ok(())
+    }
+
+    /// Where object `i`'s centre is, world frame.
+    pub(super) fn object_position(&self, i: usize, colliders: &ColliderSet) -> Option<Vector> {
+        let h = self.objects.get(i)?;
+        Some(colliders.get(h.collider)?.position().translation)
+    }
+
+    fn held(&self, i: usize) -> Result<&Held, PlantError> {
+        self.objects
+            .get(i)
+            .ok_or_else(|| PlantError::Engine(format!("no object {i}")))
     }
 
     /// Ends a period of length `dt`: the reading for it.

@@ -327,6 +327,26 @@ impl Plant {
         }
     }
 
+    /// Where `[[plant.contact.object]]` `i` is, world frame, m (`None`: no
+    /// such object).
+    pub fn object_position(&self, i: usize) -> Option<[f64; 3]> {
+        match &self.engine {
+            Engine::Articulated(_) => None,
+            Engine::Rapier(r) => r.object_position(i),
+        }
+    }
+
+    /// `[[plant.contact.object]]` `i` is grasped by its link (`on`) or let
+    /// go (only a plant with contact has objects).
+    pub fn hold_object(&mut self, i: usize, on: bool) -> Result<(), PlantError> {
+        match &mut self.engine {
+            Engine::Articulated(_) => Err(PlantError::Engine(
+                "the articulated engine has no contact objects".into(),
+            )),
+            Engine::Rapier(r) => r.hold(i, on),
+        }
+    }
+
     /// Whether the last step clipped any joint's torque at its effort limit.
     pub fn saturated(&self) -> bool {
         self.saturated

@@ -223,6 +223,27 @@ impl RapierArm {
         self.contact = self.contacts.as_mut().map(|c| c.end(dt));
     }
 
+    /// The link named in `[[plant.contact.object]]` `i` grasps it (`on`) or
+    /// lets it go.
+    pub(crate) fn hold(&mut self, i: usize, on: bool) -> Result<(), PlantError> {
+        let Some(c) = &self.contacts else {
+            return Err(PlantError::Engine("no contact objects".into()));
+        };
+        match on {
+            true => c.grasp(i, &mut self.world),
+            false => c.release(i, &mut self.world),
+        }
+    }
+
+    /// Where contact object `i` is, world frame.
+    pub(crate) fn object_position(&self, i: usize) -> Option<[f64; 3]> {
+        let p = self
+            .contacts
+            .as_ref()?
+            .object_position(i, &self.world.colliders)?;
+        Some([p.x, p.y, p.z])
+    }
+
     /// What contact did over the last period (`None` without contact).
     pub(crate) fn contact(&self) -> Option<ContactReading> {
         self.contact
