@@ -38,6 +38,7 @@ pub const SHIPPED: &[Shipped] = shipped![
     "ur5_randomised",
     "iiwa_actuators",
     "paper_obstacle",
+    "paper_pick_place",
 ];
 
 impl Shipped {

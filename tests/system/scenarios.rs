@@ -53,6 +53,7 @@ fn every_shipped_scenario_keeps_its_envelope() {
             "ur5_randomised" => &["disturbance"],
             "iiwa_actuators" => &["motor_lag", "backlash", "cogging", "elastic"],
             "paper_obstacle" => &["contact"],
+            "paper_pick_place" => &["contact", "payload"],
             _ => &[],
         };
         for w in want {
@@ -126,6 +127,28 @@ fn seeded_effects_reproduce_exactly_across_processes_and_seeds_differ() {
     // command dropped, command held, motor lag, backlash, cogging, elastic.
     let all = 0b1_1111_1111_0111;
     assert_eq!(seen & all, all, "{seen:b}");
+}
+
+/// #38 item 2: a pick and place (grasp and release included) runs the same
+/// bits in `sim` and in lockstep.
+#[test]
+fn a_pick_and_place_runs_the_same_in_sim_and_lockstep() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["--scenario", "paper_pick_place", "--duration", "6"];
+    let sim = csv_of(&[&["sim"][..], &args].concat(), dir.path(), "sim.csv");
+    let lockstep_csv = dir.path().join("lockstep.csv");
+    ok(testbed()
+        .args(["run", "--mode", "lockstep", "--json"])
+        .args(args)
+        .arg("--runs-dir")
+        .arg(dir.path().join("runs"))
+        .arg("--csv")
+        .arg(&lockstep_csv));
+    assert_same_csv(
+        "sim vs lockstep",
+        &sim,
+        &std::fs::read(&lockstep_csv).unwrap(),
+    );
 }
 
 /// #38 item 2: the arm striking a table runs the same bits in `sim` and in
