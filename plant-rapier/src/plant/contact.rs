@@ -54,6 +54,66 @@ pub(super) fn insert(
     bodies_of_arm: &[RigidBodyHandle],
     config: &ContactConfig,
 ) -> Result<Contacts, PlantError> {
+    refuse_without_shapes(model)?;
+    let arm_filter = if config.self_contact {
+        ARM | OBSTACLES
+    } else {
+        OBSTACLES
+    };
+    let material = |b: ColliderBuilder| {
+        b.restitution(config.restitution)
+            .restitution_combine_rule(CoefficientCombineRule::Max)
+            .friction(config.friction)
+            .friction_combine_rule(CoefficientCombineRule::Max)
+    };
+    for (link, &body) in model.links.iter().zip(bodies_of_arm) {
+        for c in &link.collisions {
+            // Massless: the URDF's <inertial> alone gives the dynamics.
+            let b = material(shape(&c.geometry))
+                .position(pose(&c.origin))
+                .density(0.0);
+            attach(world, b, body, (ARM, arm_filter));
+        }
+    }
+    for (i, o) in config.obstacle.iter().enumerate() {
+        let fixed = RigidBodyBuilder::fixed().pose(pose(&o.origin()));
+        let fixed = world.bodies.insert(fixed.build());
+        let b = material(shape(&o.geometry(i)?));
+        attach(world, b, fixed, (OBSTACLES, ARM | OBJECTS));
+    }
+    let mut objects = Vec::with_capacity(config.object.len());
+    for (i, o) in config.object.iter().enumerate() {
+        let (link, _) = model
+            .locate_link(&o.link)
+            .ok_or_else(|| PlantError::InvalidConfig {
+                key: format!("plant.contact.object[{i}].link"),
+                value: format!("\"{}\"", o.link),
+                need: format!(
+                    "one of the robot's links ({})",
+                    model.link_names().join(", ")
+                ),
+            })?;
+        let free = RigidBodyBuilder::dynamic()
+            .pose(pose(&o.origin()))
+            .can_sleep(false);
+        let body = world.bodies.insert(free.build());
+        let b = material(shape(&o.geometry(i)?)).mass(o.mass);
+        objects.push(Held {
+            body,
+            collider: attach(world, b, body, (OBJECTS, OBSTACLES)),
+            link: bodies_of_arm[link],
+        });
+    }
+    Ok(Contacts {
+        reading: ContactReading::default(),
+        impulse: 0.0,
+        arm: bodies_of_arm.to_vec(),
+        objects,
+    })
+}
+
+/// A robot none of whose links has a primitive could never touch anything.
+fn refuse_without_shapes(model: &ArmModel) -> Result<(), PlantError> {
     if model.links.iter().all(|l| l.collisions.is_empty()) {
         let skipped: Vec<&str> = model
             .links
@@ -73,93 +133,27 @@ pub(super) fn insert(
             },
         });
     }
-    let arm_filter = if config.self_contact {
-        ARM | OBSTACLES
-    } else {
-        OBSTACLES
-    };
-    let material = |b: ColliderBuilder| {
-        b.restitution(config.restitution)
-            .restitution_combine_rule(CoefficientCombineRule::Max)
-            .friction(config.friction)
-            .friction_combine_rule(CoefficientCombineRule::Max)
-    };
-    for (link, &body) in model.links.iter().zip(bodies_of_arm) {
-        for c in &link.collisions {
-            let collider = material(shape(&c.geometry))
-                .position(pose(&c.origin))
-                // Massless: the URDF's <inertial> alone gives the dynamics.
-                .density(0.0)
-                .collision_groups(InteractionGroups::new(
-                    ARM,
-                    arm_filter,
-                    InteractionTestMode::And,
-                ))
-                .build();
-            let PhysicsWorld {
-                colliders, bodies, ..
-            } = world;
-            colliders.insert_with_parent(collider, body, bodies);
-        }
-    }
-    for (i, o) in config.obstacle.iter().enumerate() {
-        let fixed = world
-            .bodies
-            .insert(RigidBodyBuilder::fixed().pose(pose(&o.origin())).build());
-        let collider = material(shape(&o.geometry(i)?))
-            .collision_groups(InteractionGroups::new(
-                OBSTACLES,
-                ARM | OBJECTS,
-                InteractionTestMode::And,
-            ))
-            .build();
-        let PhysicsWorld {
-            colliders, bodies, ..
-        } = world;
-        colliders.insert_with_parent(collider, fixed, bodies);
-    }
-    let mut objects = Vec::with_capacity(config.object.len());
-    for (i, o) in config.object.iter().enumerate() {
-        let (link, _) = model
-            .locate_link(&o.link)
-            .ok_or_else(|| PlantError::InvalidConfig {
-                key: format!("plant.contact.object[{i}].link"),
-                value: format!("\"{}\"", o.link),
-                need: format!(
-                    "one of the robot's links ({})",
-                    model.link_names().join(", ")
-                ),
-            })?;
-        let body = world.bodies.insert(
-            RigidBodyBuilder::dynamic()
-                .pose(pose(&o.origin()))
-                .can_sleep(false)
-                .build(),
-        );
-        let collider = material(shape(&o.geometry(i)?))
-            .mass(o.mass)
-            .collision_groups(InteractionGroups::new(
-                OBJECTS,
-                OBSTACLES,
-                InteractionTestMode::And,
-            ))
-            .build();
-        let PhysicsWorld {
-            colliders, bodies, ..
-        } = world;
-        let collider = colliders.insert_with_parent(collider, body, bodies);
-        objects.push(Held {
-            body,
-            collider,
-            link: bodies_of_arm[link],
-        });
-    }
-    Ok(Contacts {
-        reading: ContactReading::default(),
-        impulse: 0.0,
-        arm: bodies_of_arm.to_vec(),
-        objects,
-    })
+    Ok(())
+}
+
+/// Puts the collider `b` on `body` in the collision groups `(member, filter)`.
+fn attach(
+    world: &mut PhysicsWorld,
+    b: ColliderBuilder,
+    body: RigidBodyHandle,
+    (member, filter): (Group, Group),
+) -> ColliderHandle {
+    let collider = b
+        .collision_groups(InteractionGroups::new(
+            member,
+            filter,
+            InteractionTestMode::And,
+        ))
+        .build();
+    let PhysicsWorld {
+        colliders, bodies, ..
+    } = world;
+    colliders.insert_with_parent(collider, body, bodies)
 }
 
 /// A URDF primitive as a Rapier shape; cylinders and capsules along z.
