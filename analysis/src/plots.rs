@@ -66,9 +66,9 @@ pub fn category(names: &[String], x: f64) -> String {
     }
 }
 
-/// A drawing error as the text [`PlotError`] carries.
-pub fn err(e: impl std::fmt::Display) -> String {
-    e.to_string()
+/// A drawing error (plotters' own, or a file's) as a [`PlotError`].
+pub fn err(e: impl std::fmt::Display) -> PlotError {
+    PlotError(e.to_string())
 }
 
 fn decimate(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
@@ -87,7 +87,7 @@ fn draw_panels<DB: DrawingBackend>(
     t: &[f64],
     panels: &[Panel<'_>],
     vline: Option<f64>,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     root.fill(&WHITE).map_err(err)?;
     let root = root.titled(title, (FAMILY, 22)).map_err(err)?;
     let areas = root.split_evenly((panels.len(), 1));
@@ -168,7 +168,7 @@ pub fn save(
     t: &[f64],
     panels: &[Panel<'_>],
     vline: Option<f64>,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let h = 260 * panels.len() as u32 + 60;
     let png = dir.join(format!("{name}.png"));
     draw_panels(
@@ -178,7 +178,7 @@ pub fn save(
         panels,
         vline,
     )
-    .map_err(|e| format!("{}: {e}", png.display()))?;
+    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
     let svg = dir.join(format!("{name}.svg"));
     draw_panels(
         &SVGBackend::new(&svg, (1000, h)).into_drawing_area(),
@@ -187,7 +187,7 @@ pub fn save(
         panels,
         vline,
     )
-    .map_err(|e| format!("{}: {e}", svg.display()))
+    .map_err(|e| PlotError(format!("{}: {e}", svg.display())))
 }
 
 fn bounds(a: &[f64], b: &[f64], sign: f64) -> Vec<f64> {
@@ -199,13 +199,19 @@ fn bounds(a: &[f64], b: &[f64], sign: f64) -> Vec<f64> {
 #[error("{0}")]
 pub struct PlotError(pub String);
 
-/// Writes every figure into `dir` (created if needed); returns how many.
-pub fn write_all(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, PlotError> {
-    write_figures(dir, s, plan).map_err(PlotError)
+impl From<&str> for PlotError {
+    fn from(why: &str) -> Self {
+        Self(why.to_string())
+    }
 }
 
-fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+/// Writes every figure into `dir` (created if needed); returns how many.
+pub fn write_all(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, PlotError> {
+    write_figures(dir, s, plan)
+}
+
+fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, PlotError> {
+    std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
     // Registering twice is harmless; the bytes are a valid font by construction.
     let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
     let names = plan.robot.model.joint_names();
@@ -240,7 +246,7 @@ fn line(label: String, y: &[f64], i: usize, dashed: bool) -> Line<'_> {
 pub const RED: RGBColor = RGBColor(214, 39, 40);
 
 /// Fig. 1: q with q_d ± k_c.
-fn positions(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), String> {
+fn positions(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), PlotError> {
     let n = names.len();
     let mut upper = Vec::new();
     let mut lower = Vec::new();
@@ -283,7 +289,7 @@ fn positions(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), St
 }
 
 /// Fig. 2: q̇ and q̇_d.
-fn velocities(dir: &Path, s: &Series, names: &[String], _tc: f64) -> Result<(), String> {
+fn velocities(dir: &Path, s: &Series, names: &[String], _tc: f64) -> Result<(), PlotError> {
     let n = names.len();
     let velocities: Vec<Panel<'_>> = (0..n)
         .map(|i| Panel {
@@ -307,7 +313,7 @@ fn velocities(dir: &Path, s: &Series, names: &[String], _tc: f64) -> Result<(), 
 }
 
 /// Fig. 3: Z1 with ± k_c.
-fn errors(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), String> {
+fn errors(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), PlotError> {
     let n = names.len();
     let neg_kc: Vec<Vec<f64>> =
         s.kc.iter()
@@ -348,7 +354,12 @@ fn errors(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<(), Strin
 /// |Z1|/k_c after T_c, per joint, against the constraint's 1: how close
 /// the error comes to its envelope, on a scale where a 0.03 rad error is
 /// not a flat line beside a 0.5 rad bound. None before T_c to draw: false.
-fn error_over_envelope(dir: &Path, s: &Series, names: &[String], tc: f64) -> Result<bool, String> {
+fn error_over_envelope(
+    dir: &Path,
+    s: &Series,
+    names: &[String],
+    tc: f64,
+) -> Result<bool, PlotError> {
     let from = s.t.partition_point(|t| *t < tc);
     if s.t.len().saturating_sub(from) < 2 {
         return Ok(false);
@@ -389,7 +400,12 @@ fn error_over_envelope(dir: &Path, s: &Series, names: &[String], tc: f64) -> Res
 }
 
 /// Figs. 4 and 5: the actor's weight norms and the torques.
-fn weights_and_torques(dir: &Path, s: &Series, names: &[String], _tc: f64) -> Result<(), String> {
+fn weights_and_torques(
+    dir: &Path,
+    s: &Series,
+    names: &[String],
+    _tc: f64,
+) -> Result<(), PlotError> {
     let n = names.len();
     let weights = vec![Panel {
         title: "actor weight norms".into(),
@@ -419,22 +435,22 @@ fn weights_and_torques(dir: &Path, s: &Series, names: &[String], _tc: f64) -> Re
 }
 
 /// Histograms of period jitter and round trip.
-fn timing_figure(dir: &Path, s: &Series) -> Result<(), String> {
+fn timing_figure(dir: &Path, s: &Series) -> Result<(), PlotError> {
     let png = dir.join("fig6_timing.png");
     draw_timing(
         &BitMapBackend::new(&png, (1000, 640)).into_drawing_area(),
         s,
     )
-    .map_err(|e| format!("{}: {e}", png.display()))?;
+    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
     let svg = dir.join("fig6_timing.svg");
     draw_timing(&SVGBackend::new(&svg, (1000, 640)).into_drawing_area(), s)
-        .map_err(|e| format!("{}: {e}", svg.display()))
+        .map_err(|e| PlotError(format!("{}: {e}", svg.display())))
 }
 
 fn draw_timing<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     s: &Series,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     root.fill(&WHITE).map_err(err)?;
     let root = root.titled("Timing", (FAMILY, 22)).map_err(err)?;
     let areas = root.split_evenly((2, 1));
@@ -451,7 +467,7 @@ fn histogram<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     title: &str,
     data: &[f64],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     const BINS: usize = 60;
     let mut sorted: Vec<f64> = data.iter().copied().filter(|x| x.is_finite()).collect();
     sorted.sort_by(f64::total_cmp);

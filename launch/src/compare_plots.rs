@@ -16,21 +16,21 @@ use analysis::plots::{COLORS, FAMILY, FONT, Line, Panel, PlotError, RED, categor
 pub fn write_all(dir: &Path, c: &Comparison, plan: &Plan) -> Result<usize, PlotError> {
     std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
     let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
-    errors(dir, c, plan).map_err(PlotError)?;
-    crate::compare_ratio_plot::write(dir, c, plan).map_err(PlotError)?;
-    bars(dir, c).map_err(PlotError)?;
+    errors(dir, c, plan)?;
+    crate::compare_ratio_plot::write(dir, c, plan)?;
+    bars(dir, c)?;
     Ok(3)
 }
 
 /// The first seed's e = q − q_d of every law, one panel per joint.
-fn errors(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), String> {
+fn errors(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), PlotError> {
     let curves: Vec<(&LawRow, &crate::compare::LawSeries)> = c
         .laws
         .iter()
         .filter_map(|row| Some((row, row.runs.first()?.series.as_ref()?)))
         .collect();
     let Some((_, first)) = curves.first() else {
-        return Err("no law kept its curves".into());
+        return Err(PlotError("no law kept its curves".into()));
     };
     let names = plan.robot.model.joint_names();
     let neg_kc: Vec<Vec<f64>> = first
@@ -83,22 +83,22 @@ fn errors(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), String> {
 }
 
 /// Effort after T_c and violation time per law (medians over seeds).
-fn bars(dir: &Path, c: &Comparison) -> Result<(), String> {
+fn bars(dir: &Path, c: &Comparison) -> Result<(), PlotError> {
     let png = dir.join("compare_bars.png");
     draw_bars(
         &BitMapBackend::new(&png, (1000, 700)).into_drawing_area(),
         c,
     )
-    .map_err(|e| format!("{}: {e}", png.display()))?;
+    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
     let svg = dir.join("compare_bars.svg");
     draw_bars(&SVGBackend::new(&svg, (1000, 700)).into_drawing_area(), c)
-        .map_err(|e| format!("{}: {e}", svg.display()))
+        .map_err(|e| PlotError(format!("{}: {e}", svg.display())))
 }
 
 fn draw_bars<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     c: &Comparison,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     root.fill(&WHITE).map_err(err)?;
     let title = if c.seeds > 1 {
         format!(
@@ -152,7 +152,7 @@ fn bar_panel<DB: DrawingBackend>(
     caption: &str,
     c: &Comparison,
     bars: &[Bar],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let top = bars
         .iter()
         .flat_map(|b| [b.median, if c.seeds > 1 { b.high } else { 0.0 }])
@@ -253,7 +253,7 @@ fn draw_tradeoff<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     t: &crate::compare_tradeoff::Tradeoff,
     scenario: &str,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     use crate::compare_tradeoff::TradeoffPoint as P;
     root.fill(&WHITE).map_err(err)?;
     let scales: Vec<String> = t.scales.iter().map(|s| format!("{s}")).collect();
@@ -290,7 +290,7 @@ fn tradeoff_panel<DB: DrawingBackend>(
     t: &crate::compare_tradeoff::Tradeoff,
     (cost, on_front): CostOf,
     x_desc: &str,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let xy = |p: &crate::compare_tradeoff::TradeoffPoint| {
         cost(p).zip(p.iae).filter(|(e, i)| *e > 0.0 && *i > 0.0)
     };

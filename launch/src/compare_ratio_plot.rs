@@ -10,10 +10,10 @@ use plotters::prelude::*;
 use scenario::Plan;
 
 use crate::compare::{Comparison, LawRow, LawSeries};
-use analysis::plots::{COLORS, FAMILY, RED, err};
+use analysis::plots::{COLORS, FAMILY, PlotError, RED, err};
 
 /// Writes `compare_error_ratio.png` and `.svg` into `dir`.
-pub fn write(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), String> {
+pub fn write(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), PlotError> {
     let (w, h) = size(c.laws.len());
     let png = dir.join("compare_error_ratio.png");
     draw(
@@ -21,10 +21,10 @@ pub fn write(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), String> {
         c,
         plan,
     )
-    .map_err(|e| format!("{}: {e}", png.display()))?;
+    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
     let svg = dir.join("compare_error_ratio.svg");
     draw(&SVGBackend::new(&svg, (w, h)).into_drawing_area(), c, plan)
-        .map_err(|e| format!("{}: {e}", svg.display()))
+        .map_err(|e| PlotError(format!("{}: {e}", svg.display())))
 }
 
 /// Columns and rows of the grid for `n` panels.
@@ -63,7 +63,7 @@ fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     c: &Comparison,
     plan: &Plan,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     root.fill(&WHITE).map_err(err)?;
     let tc = plan.scenario.controller.tc;
     let title = format!(

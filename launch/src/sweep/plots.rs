@@ -52,7 +52,10 @@ fn label(c: &CellReport) -> String {
     }
 }
 
-fn boxes<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &SweepReport) -> Result<(), String> {
+fn boxes<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    r: &SweepReport,
+) -> Result<(), PlotError> {
     root.fill(&WHITE).map_err(err)?;
     let root = root
         .titled(
@@ -83,7 +86,7 @@ fn box_panel<DB: DrawingBackend>(
     caption: &str,
     r: &SweepReport,
     data: &[Vec<f64>],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let all = data.iter().flatten().copied();
     let (lo, hi) = all.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
         (a.min(x), b.max(x))
@@ -145,7 +148,7 @@ fn heatmap<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     r: &SweepReport,
     laws: &[String],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     root.fill(&WHITE).map_err(err)?;
     let root = root
         .titled(
@@ -255,7 +258,7 @@ fn colour_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     lo: f64,
     hi: f64,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let top = if hi > lo { hi } else { lo + 1e-12 };
     let mut chart = ChartBuilder::on(area)
         .caption("IAE", (FAMILY, 13))
