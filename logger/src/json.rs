@@ -20,6 +20,12 @@ use wire::{
 #[error("{0}")]
 pub struct DecodeError(pub String);
 
+impl From<wire::FieldError> for DecodeError {
+    fn from(e: wire::FieldError) -> Self {
+        Self(e.to_string())
+    }
+}
+
 /// A message type as it appears in the log.
 pub trait LogMessage: Bound {
     /// MCAP topic: the message's log channel in the wire's binding table.
@@ -94,7 +100,7 @@ pub trait LogMessage: Bound {
     /// The message back from its JSON text (a logged message's data).
     fn parse(text: &[u8]) -> Result<Self, DecodeError> {
         let m = crate::json_object::JsonObject::parse(text)?;
-        let header = || -> Result<Header, String> {
+        let header = || -> Result<Header, wire::FieldError> {
             Ok(Header {
                 seq: m.u("seq")?,
                 t_ns: m.u("t_ns")?,
@@ -103,7 +109,7 @@ pub trait LogMessage: Bound {
         };
         header()
             .and_then(|h| Self::decode(h, &m))
-            .map_err(DecodeError)
+            .map_err(DecodeError::from)
     }
 
     /// The message back from a log's data in `encoding` (JSON in log

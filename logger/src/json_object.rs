@@ -12,7 +12,7 @@ use std::fmt;
 
 use serde::Deserializer as _;
 use serde::de::{self, DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
-use wire::{FieldSource, Joints, MAX_DOF, joints};
+use wire::{FieldError, FieldSource, Joints, MAX_DOF, joints};
 
 use crate::json::DecodeError;
 
@@ -53,13 +53,13 @@ impl<'a> JsonObject<'a> {
             .map_err(not_json)
     }
 
-    fn get(&self, k: &str) -> Result<&Raw, String> {
+    fn get(&self, k: &str) -> Result<&Raw, FieldError> {
         self.0
             .iter()
             .rev()
             .find(|(key, _)| key == k)
             .map(|(_, v)| v)
-            .ok_or_else(|| format!("field '{k}' is missing"))
+            .ok_or_else(|| FieldError::Missing(k.into()))
     }
 }
 
@@ -67,44 +67,44 @@ impl FieldSource for JsonObject<'_> {
     fn has(&self, k: &str) -> bool {
         self.0.iter().any(|(key, _)| key == k)
     }
-    fn u(&self, k: &str) -> Result<u64, String> {
+    fn u(&self, k: &str) -> Result<u64, FieldError> {
         match self.get(k)? {
             Raw::U(x) => Ok(*x),
-            _ => Err(format!("field '{k}' is not an unsigned integer")),
+            _ => Err(FieldError::not_a(k, "an unsigned integer")),
         }
     }
-    fn u32(&self, k: &str) -> Result<u32, String> {
-        u32::try_from(self.u(k)?).map_err(|_| format!("field '{k}' is out of range"))
+    fn u32(&self, k: &str) -> Result<u32, FieldError> {
+        u32::try_from(self.u(k)?).map_err(|_| FieldError::OutOfRange(k.into()))
     }
-    fn i(&self, k: &str) -> Result<i64, String> {
+    fn i(&self, k: &str) -> Result<i64, FieldError> {
         match self.get(k)? {
             Raw::U(x) => i64::try_from(*x).ok(),
             Raw::I(x) => Some(*x),
             _ => None,
         }
-        .ok_or_else(|| format!("field '{k}' is not an integer"))
+        .ok_or_else(|| FieldError::not_a(k, "an integer"))
     }
-    fn f(&self, k: &str) -> Result<f64, String> {
+    fn f(&self, k: &str) -> Result<f64, FieldError> {
         match self.get(k)? {
             Raw::U(x) => Ok(*x as f64),
             Raw::I(x) => Ok(*x as f64),
             Raw::F(x) => Ok(*x),
             Raw::Null => Ok(f64::NAN),
-            _ => Err(format!("field '{k}' is not a number")),
+            _ => Err(FieldError::not_a(k, "a number")),
         }
     }
-    fn j(&self, k: &str) -> Result<Joints, String> {
+    fn j(&self, k: &str) -> Result<Joints, FieldError> {
         let Raw::Array(xs, all_numbers) = self.get(k)? else {
-            return Err(format!("field '{k}' is not an array"));
+            return Err(FieldError::not_a(k, "an array"));
         };
         if xs.len() > MAX_DOF {
-            return Err(format!(
-                "field '{k}' has {} entries (at most {MAX_DOF})",
-                xs.len()
-            ));
+            return Err(FieldError::TooLong {
+                field: k.into(),
+                len: xs.len(),
+            });
         }
         if !all_numbers {
-            return Err(format!("field '{k}' holds a non-number"));
+            return Err(FieldError::not_a(k, "an array of numbers"));
         }
         Ok(joints(xs))
     }

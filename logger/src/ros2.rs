@@ -17,7 +17,7 @@
 //! commands, `tf2_msgs/msg/TFMessage` for the arm's frames and
 //! `visualization_msgs/msg/MarkerArray` for its stick figure.
 
-use wire::{FieldRef, FieldSource, Header, Joints, MAX_DOF, joints};
+use wire::{FieldError, FieldRef, FieldSource, Header, Joints, MAX_DOF, joints};
 
 use crate::LogMessage;
 use crate::cdr::{CdrReader, CdrWriter};
@@ -182,41 +182,41 @@ enum Val {
 struct CdrFields(Vec<(&'static str, Val)>);
 
 impl CdrFields {
-    fn get(&self, k: &str) -> Result<&Val, String> {
+    fn get(&self, k: &str) -> Result<&Val, FieldError> {
         self.0
             .iter()
             .find(|(n, _)| *n == k)
             .map(|(_, v)| v)
-            .ok_or_else(|| format!("field '{k}' is missing"))
+            .ok_or_else(|| FieldError::Missing(k.into()))
     }
 }
 
 impl FieldSource for CdrFields {
-    fn u(&self, k: &str) -> Result<u64, String> {
+    fn u(&self, k: &str) -> Result<u64, FieldError> {
         match self.get(k)? {
             Val::U(x) => Ok(*x),
-            _ => Err(format!("field '{k}' is not an unsigned integer")),
+            _ => Err(FieldError::not_a(k, "an unsigned integer")),
         }
     }
-    fn u32(&self, k: &str) -> Result<u32, String> {
-        u32::try_from(self.u(k)?).map_err(|_| format!("field '{k}' is out of range"))
+    fn u32(&self, k: &str) -> Result<u32, FieldError> {
+        u32::try_from(self.u(k)?).map_err(|_| FieldError::OutOfRange(k.into()))
     }
-    fn i(&self, k: &str) -> Result<i64, String> {
+    fn i(&self, k: &str) -> Result<i64, FieldError> {
         match self.get(k)? {
             Val::I(x) => Ok(*x),
-            _ => Err(format!("field '{k}' is not an integer")),
+            _ => Err(FieldError::not_a(k, "an integer")),
         }
     }
-    fn f(&self, k: &str) -> Result<f64, String> {
+    fn f(&self, k: &str) -> Result<f64, FieldError> {
         match self.get(k)? {
             Val::F(x) => Ok(*x),
-            _ => Err(format!("field '{k}' is not a number")),
+            _ => Err(FieldError::not_a(k, "a number")),
         }
     }
-    fn j(&self, k: &str) -> Result<Joints, String> {
+    fn j(&self, k: &str) -> Result<Joints, FieldError> {
         match self.get(k)? {
             Val::J(x) => Ok(**x),
-            _ => Err(format!("field '{k}' is not an array")),
+            _ => Err(FieldError::not_a(k, "an array")),
         }
     }
     fn has(&self, k: &str) -> bool {
@@ -271,7 +271,7 @@ pub fn decode<M: LogMessage>(data: &[u8]) -> Result<M, DecodeError> {
             type_name::<M>()
         )));
     }
-    M::decode(header, &CdrFields(fields)).map_err(DecodeError)
+    M::decode(header, &CdrFields(fields)).map_err(DecodeError::from)
 }
 
 /// `sensor_msgs/msg/JointState`.

@@ -24,19 +24,56 @@ pub enum FieldRef<'a> {
     V(&'a [f64]),
 }
 
+/// Why a field could not be taken from a [`FieldSource`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FieldError {
+    /// The source lacks the field.
+    #[error("field '{0}' is missing")]
+    Missing(String),
+    /// The field holds another kind of value.
+    #[error("field '{field}' is not {want}")]
+    NotA {
+        /// The field.
+        field: String,
+        /// What it must be ("an unsigned integer", "an array", …).
+        want: &'static str,
+    },
+    /// The value does not fit the field's type.
+    #[error("field '{0}' is out of range")]
+    OutOfRange(String),
+    /// A per-joint array longer than [`crate::MAX_DOF`].
+    #[error("field '{field}' has {len} entries (at most {})", crate::MAX_DOF)]
+    TooLong {
+        /// The field.
+        field: String,
+        /// Its entries.
+        len: usize,
+    },
+}
+
+impl FieldError {
+    /// `field` is not `want`.
+    pub fn not_a(field: &str, want: &'static str) -> Self {
+        Self::NotA {
+            field: field.to_string(),
+            want,
+        }
+    }
+}
+
 /// Where [`MessageFields::decode`] takes each field from (a parsed JSON
 /// object, say); an error says which field is missing or wrong.
 pub trait FieldSource {
     /// An unsigned integer.
-    fn u(&self, name: &str) -> Result<u64, String>;
+    fn u(&self, name: &str) -> Result<u64, FieldError>;
     /// A u32.
-    fn u32(&self, name: &str) -> Result<u32, String>;
+    fn u32(&self, name: &str) -> Result<u32, FieldError>;
     /// A signed integer.
-    fn i(&self, name: &str) -> Result<i64, String>;
+    fn i(&self, name: &str) -> Result<i64, FieldError>;
     /// A real.
-    fn f(&self, name: &str) -> Result<f64, String>;
+    fn f(&self, name: &str) -> Result<f64, FieldError>;
     /// A per-joint array.
-    fn j(&self, name: &str) -> Result<Joints, String>;
+    fn j(&self, name: &str) -> Result<Joints, FieldError>;
     /// Whether the source has the field at all: a field added in a later
     /// version of its message takes its documented default when an older
     /// log lacks it.
@@ -53,7 +90,7 @@ pub trait MessageFields: Sized + Copy + Default {
     /// hot encoder (the log's CDR) is inlined field by field.
     fn each_field<F: FnMut(&'static str, FieldRef<'_>)>(&self, f: F);
     /// The message from `header` and each field of `source`.
-    fn decode(header: Header, source: &dyn FieldSource) -> Result<Self, String>;
+    fn decode(header: Header, source: &dyn FieldSource) -> Result<Self, FieldError>;
 }
 
 /// Defines a wire message (`#[repr(C)]`, `Copy`, zero-copy) and its field
@@ -113,7 +150,7 @@ macro_rules! data_message {
             fn decode(
                 header: $crate::Header,
                 source: &dyn $crate::FieldSource,
-            ) -> Result<Self, String> {
+            ) -> Result<Self, $crate::FieldError> {
                 let mut m = Self { header, ..Self::default() };
                 $( $crate::field_decode!($kind, m, $field, source $(, $default)?); )*
                 Ok(m)
@@ -195,24 +232,29 @@ mod tests {
     struct Echo(Vec<(&'static str, Vec<f64>)>);
 
     impl FieldSource for Echo {
-        fn u(&self, name: &str) -> Result<u64, String> {
+        fn u(&self, name: &str) -> Result<u64, FieldError> {
             Ok(self.f(name)? as u64)
         }
-        fn u32(&self, name: &str) -> Result<u32, String> {
+        fn u32(&self, name: &str) -> Result<u32, FieldError> {
             Ok(self.f(name)? as u32)
         }
-        fn i(&self, name: &str) -> Result<i64, String> {
+        fn i(&self, name: &str) -> Result<i64, FieldError> {
             Ok(self.f(name)? as i64)
         }
-        fn f(&self, name: &str) -> Result<f64, String> {
+        fn f(&self, name: &str) -> Result<f64, FieldError> {
             self.0
                 .iter()
                 .find(|(n, _)| *n == name)
                 .map(|(_, v)| v[0])
-                .ok_or(format!("no {name}"))
+                .ok_or(FieldError::Missing(name.into()))
         }
-        fn j(&self, name: &str) -> Result<Joints, String> {
-            let v = &self.0.iter().find(|(n, _)| *n == name).ok_or("none")?.1;
+        fn j(&self, name: &str) -> Result<Joints, FieldError> {
+            let v = &self
+                .0
+                .iter()
+                .find(|(n, _)| *n == name)
+                .ok_or(FieldError::Missing(name.into()))?
+                .1;
             Ok(crate::joints(v))
         }
         fn has(&self, name: &str) -> bool {

@@ -44,7 +44,7 @@ mod topic;
 pub use binding::{Bound, struct_of};
 pub use effects::Effects;
 pub use faults::Fault;
-pub use fields::{FieldRef, FieldSource, MessageFields};
+pub use fields::{FieldError, FieldRef, FieldSource, MessageFields};
 pub use files::{
     MAX_TEXT_FILE_BYTES, MAX_URDF_BYTES, open_regular_file, read_regular_file, read_text_file,
 };
