@@ -43,44 +43,64 @@ pub enum Geometry {
     },
 }
 
-/// A link's collision elements: the primitives, and what was not turned
-/// into a shape, with why (a mesh, a size that is not a positive number).
-/// Never an error: collisions matter only to a contact scenario, which says
-/// what was skipped; every other run ignores them.
+/// A link's collision elements, sorted: the primitives; the meshes (not
+/// contact shapes, named by file); and the primitives that cannot be
+/// shapes, each with why (a size or origin that is not a finite number up
+/// to 1000 m). Never an error here: collisions matter only to a contact
+/// scenario, which refuses the bad ones and notes the meshes; every other
+/// run ignores them.
 pub(super) fn collisions(
     l: &urdf_rs::Link,
     origin: impl Fn(&urdf_rs::Pose) -> Option<Origin>,
-) -> (Vec<CollisionShape>, Vec<String>) {
-    let mut shapes = Vec::new();
-    let mut skipped = Vec::new();
+) -> Collisions {
+    let mut out = Collisions::default();
     for (i, c) in l.collision.iter().enumerate() {
         let what = format!("link '{}' collision {}", l.name, i + 1);
-        match (geometry(&c.geometry), origin(&c.origin)) {
-            (Ok(geometry), Some(origin)) => shapes.push(CollisionShape { origin, geometry }),
-            (Err(why), _) => skipped.push(format!("{what}: {why}")),
-            (Ok(_), None) => skipped.push(format!("{what}: its origin is not finite")),
+        if let urdf_rs::Geometry::Mesh { filename, .. } = &c.geometry {
+            out.meshes.push(format!("{what}: mesh '{filename}'"));
+            continue;
+        }
+        let at =
+            origin(&c.origin).filter(|o| o.xyz.iter().chain(&o.rpy).all(|v| v.abs() <= MAX_SIZE));
+        match (geometry(&c.geometry), at) {
+            (Ok(geometry), Some(origin)) => out.shapes.push(CollisionShape { origin, geometry }),
+            (Err(why), _) => out.bad.push(format!("{what}: {why}")),
+            (Ok(_), None) => out.bad.push(format!(
+                "{what}: its <origin> is not finite numbers up to {MAX_SIZE}"
+            )),
         }
     }
-    (shapes, skipped)
+    out
 }
+
+/// A link's collision elements, sorted (see [`collisions`]).
+#[derive(Debug, Default)]
+pub(super) struct Collisions {
+    pub(super) shapes: Vec<CollisionShape>,
+    pub(super) meshes: Vec<String>,
+    pub(super) bad: Vec<String>,
+}
+
+/// The largest size or offset of a collision primitive, m.
+const MAX_SIZE: f64 = 1e3;
 
 fn geometry(g: &urdf_rs::Geometry) -> Result<Geometry, String> {
     let size = |what: &str, v: f64, zero_ok: bool| {
-        if v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0)) {
+        if v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0)) && v <= MAX_SIZE {
             Ok(v)
         } else {
-            Err(format!("{what} {v} is not a positive size"))
+            Err(format!("<{what}> {v} is not a size in (0, {MAX_SIZE}] m"))
         }
     };
     Ok(match g {
         urdf_rs::Geometry::Mesh { filename, .. } => {
-            return Err(format!("mesh '{filename}' (meshes are not contact shapes)"));
+            return Err(format!("mesh '{filename}'"));
         }
         urdf_rs::Geometry::Box { size: s } => Geometry::Box {
             size: [
-                size("box x", s.0[0], false)?,
-                size("box y", s.0[1], false)?,
-                size("box z", s.0[2], false)?,
+                size("box size x", s.0[0], false)?,
+                size("box size y", s.0[1], false)?,
+                size("box size z", s.0[2], false)?,
             ],
         },
         urdf_rs::Geometry::Cylinder { radius, length } => Geometry::Cylinder {

@@ -103,8 +103,10 @@ pub struct LinkInfo {
     pub inertia: [f64; 6],
     /// Its `<collision>` primitives (and those of links folded into it).
     pub collisions: Vec<CollisionShape>,
-    /// Collision elements not made into shapes, each with why (meshes).
+    /// Mesh collision elements (not contact shapes), named.
     pub skipped_collisions: Vec<String>,
+    /// Collision primitives that cannot be shapes, each with why.
+    pub bad_collisions: Vec<String>,
 }
 
 /// A URDF `<mimic joint multiplier offset>`: q = multiplier · q_leader + offset.

@@ -39,15 +39,15 @@ pub(super) fn link_info(l: &urdf_rs::Link) -> Result<LinkInfo, ModelError> {
     for v in inertia {
         finite(format!("{field} inertia"), v)?;
     }
-    let (collisions, skipped_collisions) =
-        super::collision::collisions(l, |o| origin(&field, o).ok());
+    let c = super::collision::collisions(l, |o| origin(&field, o).ok());
     Ok(LinkInfo {
         name: l.name.clone(),
         mass,
         inertial_origin: origin(&format!("{field} inertial"), &l.inertial.origin)?,
         inertia,
-        collisions,
-        skipped_collisions,
+        collisions: c.shapes,
+        skipped_collisions: c.meshes,
+        bad_collisions: c.bad,
     })
 }
 

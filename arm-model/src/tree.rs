@@ -54,6 +54,7 @@ pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, M
             inertia: [0.0; 6],
             collisions: Vec::new(),
             skipped_collisions: Vec::new(),
+            bad_collisions: Vec::new(),
         });
         notes.push(format!(
             "joint '{}' hangs from link '{WORLD}', which the URDF does not define: taken as the fixed world (the root)",
@@ -438,6 +439,9 @@ fn merge_fixed(mut links: Vec<LinkInfo>, mut joints: Vec<JointInfo>) -> Folded {
         links[parent]
             .skipped_collisions
             .extend(child_link.skipped_collisions.iter().cloned());
+        links[parent]
+            .bad_collisions
+            .extend(child_link.bad_collisions.iter().cloned());
         for k in &mut joints {
             if k.parent == child {
                 k.parent = parent;

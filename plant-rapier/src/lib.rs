@@ -51,7 +51,7 @@ pub use config::{
 pub use effects::Effects;
 pub use engine::EngineName;
 pub use machine::PlantMachine;
-pub use plant::{ContactReading, Plant};
+pub use plant::{ContactReading, Plant, check_contact};
 pub use rig::Rig;
 
 /// Why an arm cannot be built or stepped. Each variant names what is wrong.

@@ -298,3 +298,96 @@ fn an_object_rests_until_grasped_and_falls_when_released() {
         assert!((a + 9.81).abs() < 0.05, "period {k}: z'' = {a}");
     }
 }
+
+/// Three links in a row, a 10 cm ball at the middle of the first and at
+/// the end of the third.
+const FOLDING: &str = r#"<robot name="folding">
+  <link name="base"/>
+  <link name="a">
+    <inertial><mass value="1"/><origin xyz="0.2 0 0"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <collision><origin xyz="0.2 0 0"/><geometry><sphere radius="0.1"/></geometry></collision>
+  </link>
+  <link name="b">
+    <inertial><mass value="1"/><origin xyz="0.2 0 0"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <link name="c">
+    <inertial><mass value="1"/><origin xyz="0.2 0 0"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <collision><origin xyz="0.2 0 0"/><geometry><sphere radius="0.1"/></geometry></collision>
+  </link>
+  <joint name="j1" type="continuous"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint>
+  <joint name="j2" type="continuous"><parent link="a"/><child link="b"/>
+    <origin xyz="0.4 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="j3" type="continuous"><parent link="b"/><child link="c"/>
+    <origin xyz="0.4 0 0"/><axis xyz="0 0 1"/></joint>
+</robot>"#;
+
+/// Folded back (q2 = q3 = 2.2 rad), the third link's ball lies on the
+/// first's: with `self_contact` the two meet, without they pass.
+#[test]
+fn self_contact_makes_links_that_are_not_neighbours_meet() {
+    let model = ArmModel::from_urdf_str(FOLDING).unwrap();
+    let run = |self_contact: bool| {
+        let config = PlantConfig {
+            engine: EngineName::Rapier,
+            gravity: [0.0; 3],
+            contact: ContactConfig {
+                self_contact,
+                ..ContactConfig::default()
+            },
+            ..PlantConfig::default()
+        };
+        let mut r = Rig::new(&model, &config, 0, PERIOD_NS).unwrap();
+        r.set_state(&[0.0, 2.2, 2.2], &[0.0, 0.0, 0.0]).unwrap();
+        let mut touched = 0;
+        for _ in 0..50 {
+            r.step(Some(&[0.0, 0.0, 0.0])).unwrap();
+            touched += u32::from(r.effects().has(Effects::CONTACT));
+        }
+        touched
+    };
+    assert!(run(true) > 0, "self contact on: the folded links never met");
+    assert_eq!(run(false), 0);
+}
+
+/// What a contact scenario must be before it runs: no obstacle through the
+/// arm where it starts, no broken primitive, objects held by moving links.
+#[test]
+fn a_contact_scenario_is_checked_before_it_runs() {
+    let model = ArmModel::from_urdf_str(PENDULUM).unwrap();
+    let mut contact = ContactConfig {
+        obstacle: vec![wall()],
+        ..ContactConfig::default()
+    };
+    plant_rapier::check_contact(&model, &contact, &[0.0]).unwrap();
+    // At q = π/2 the ball is inside the wall.
+    let e = plant_rapier::check_contact(&model, &contact, &[1.5708])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("plant.contact.obstacle[0]") && e.contains("overlaps link 'arm'"),
+        "{e}"
+    );
+    let broken = PENDULUM.replace("sphere radius=\"0.05\"", "sphere radius=\"-0.05\"");
+    let e =
+        plant_rapier::check_contact(&ArmModel::from_urdf_str(&broken).unwrap(), &contact, &[0.0])
+            .unwrap_err()
+            .to_string();
+    assert!(
+        e.contains("link 'arm' collision 1: <sphere radius> -0.05"),
+        "{e}"
+    );
+    contact.object = vec![ContactObject {
+        link: "base".into(),
+        ..object(0.0, None)
+    }];
+    let e = plant_rapier::check_contact(&model, &contact, &[0.0])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("plant.contact.object[0].link") && e.contains("not the fixed base"),
+        "{e}"
+    );
+}

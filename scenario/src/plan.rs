@@ -410,6 +410,9 @@ pub fn plan(
     scenario
         .plant
         .check_for(dof, &model.link_names())
+        .and_then(|()| {
+            plant_rapier::check_contact(model, &scenario.plant.contact, &scenario.initial.q)
+        })
         .map_err(|cause| ScenarioError::Plant {
             file: source.clone(),
             cause,

@@ -146,9 +146,7 @@ impl ContactConfig {
         for (i, o) in self.obstacle.iter().enumerate() {
             o.geometry(i)?;
             let key = |k: &str| format!("plant.contact.obstacle[{i}].{k}");
-            if let Some(v) = o.xyz.iter().chain(&o.rpy).find(|v| !v.is_finite()) {
-                return Err(invalid(&key("xyz/rpy"), v, "finite numbers"));
-            }
+            place(&o.xyz, &o.rpy, &key)?;
         }
         Ok(())
     }
@@ -209,9 +207,7 @@ impl ContactObject {
         if !(self.mass.is_finite() && self.mass > 0.0 && self.mass <= 1e4) {
             return Err(invalid(&key("mass"), self.mass, "a mass in (0, 10000] kg"));
         }
-        if let Some(v) = self.xyz.iter().chain(&self.rpy).find(|v| !v.is_finite()) {
-            return Err(invalid(&key("xyz/rpy"), v, "finite numbers"));
-        }
+        place(&self.xyz, &self.rpy, &key)?;
         if !(self.grasp_at_s.is_finite() && self.grasp_at_s >= 0.0 && self.grasp_at_s <= 1e6) {
             return Err(invalid(
                 &key("grasp_at_s"),
@@ -233,6 +229,25 @@ impl ContactObject {
         }
         Ok(())
     }
+}
+
+/// A pose in the workspace: within 1000 m and turns of 1000 rad; `key`
+/// makes a field's key.
+fn place(xyz: &[f64; 3], rpy: &[f64; 3], key: &dyn Fn(&str) -> String) -> Result<(), PlantError> {
+    for (name, v) in [("xyz", xyz), ("rpy", rpy)] {
+        if let Some((i, x)) = v
+            .iter()
+            .enumerate()
+            .find(|(_, x)| x.is_nan() || x.abs() > 1e3)
+        {
+            return Err(invalid(
+                &key(&format!("{name}[{i}]")),
+                format!("{x:e}"),
+                "a finite number up to 1000 in size",
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A shape from its name and sizes; `key` names the sizes for errors.

@@ -54,7 +54,7 @@ pub(super) fn insert(
     bodies_of_arm: &[RigidBodyHandle],
     config: &ContactConfig,
 ) -> Result<Contacts, PlantError> {
-    refuse_without_shapes(model)?;
+    super::contact_check::check_contact_shapes(model, config)?;
     let arm_filter = if config.self_contact {
         ARM | OBSTACLES
     } else {
@@ -112,30 +112,6 @@ pub(super) fn insert(
     })
 }
 
-/// A robot none of whose links has a primitive could never touch anything.
-fn refuse_without_shapes(model: &ArmModel) -> Result<(), PlantError> {
-    if model.links.iter().all(|l| l.collisions.is_empty()) {
-        let skipped: Vec<&str> = model
-            .links
-            .iter()
-            .flat_map(|l| l.skipped_collisions.iter().map(String::as_str))
-            .take(3)
-            .collect();
-        return Err(PlantError::InvalidConfig {
-            key: "plant.contact".into(),
-            value: "set".into(),
-            need: match skipped.is_empty() {
-                true => "links with <collision> primitives (box, cylinder, sphere, capsule): this robot has none".into(),
-                false => format!(
-                    "links with <collision> primitives (box, cylinder, sphere, capsule): this robot has none usable ({}, …)",
-                    skipped.join("; ")
-                ),
-            },
-        });
-    }
-    Ok(())
-}
-
 /// Puts the collider `b` on `body` in the collision groups `(member, filter)`.
 fn attach(
     world: &mut PhysicsWorld,
@@ -157,7 +133,7 @@ fn attach(
 }
 
 /// A URDF primitive as a Rapier shape; cylinders and capsules along z.
-fn shape(g: &Geometry) -> ColliderBuilder {
+pub(super) fn shape(g: &Geometry) -> ColliderBuilder {
     match *g {
         Geometry::Box { size } => {
             ColliderBuilder::cuboid(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0)

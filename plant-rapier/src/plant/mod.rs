@@ -8,6 +8,7 @@ use arm_model::ArmModel;
 mod articulated;
 mod build;
 mod contact;
+mod contact_check;
 mod motor;
 mod rapier;
 
@@ -16,6 +17,7 @@ use motor::Motors;
 use rapier::RapierArm;
 
 pub use contact::ContactReading;
+pub use contact_check::check_contact;
 
 /// The engine that integrates the rigid-body dynamics.
 enum Engine {

@@ -119,6 +119,13 @@ impl RapierArm {
                 &config.contact,
             )?),
         };
+        if config.contact.self_contact
+            && let Some((mb, _)) = world.multibody_joints.get_mut(multibody)
+        {
+            // Links that are not neighbours meet (Rapier never lets
+            // neighbours collide).
+            mb.set_self_contacts_enabled(true);
+        }
         let n = dofs.len();
         Ok(Self {
             world,
