@@ -363,7 +363,7 @@ fn a_contact_scenario_is_checked_before_it_runs() {
     };
     plant_rapier::check_contact(&model, &contact, &[0.0]).unwrap();
     // At q = π/2 the ball is inside the wall.
-    let e = plant_rapier::check_contact(&model, &contact, &[1.5708])
+    let e = plant_rapier::check_contact(&model, &contact, &[std::f64::consts::FRAC_PI_2])
         .unwrap_err()
         .to_string();
     assert!(

@@ -192,16 +192,11 @@ impl Contacts {
     /// Object `i` joins its link where it now is: its collider (and so its
     /// mass and inertia) rides on the link's body; its own body rests.
     pub(super) fn grasp(&self, i: usize, world: &mut PhysicsWorld) -> Result<(), PlantError> {
-        let h = self.held(i)?;
+        let (h, at, link) = self.where_held(i, world)?;
+        let relative = link.position().inverse() * at;
         let PhysicsWorld {
             colliders, bodies, ..
         } = world;
-        let (Some(c), Some(link)) = (colliders.get(h.collider), bodies.get(h.link)) else {
-            return Err(PlantError::Engine(format!(
-                "object {i} or its link vanished"
-            )));
-        };
-        let relative = link.position().inverse() * *c.position();
         colliders.set_parent(h.collider, Some(h.link), bodies);
         if let Some(c) = colliders.get_mut(h.collider) {
             c.set_position_wrt_parent(relative);
@@ -215,17 +210,11 @@ impl Contacts {
     /// Object `i` leaves its link as a free body, moving as the link's
     /// material at its place did.
     pub(super) fn release(&self, i: usize, world: &mut PhysicsWorld) -> Result<(), PlantError> {
-        let h = self.held(i)?;
+        let (h, at, link) = self.where_held(i, world)?;
+        let (v, w) = (link.velocity_at_point(at.translation), link.angvel());
         let PhysicsWorld {
             colliders, bodies, ..
         } = world;
-        let (Some(c), Some(link)) = (colliders.get(h.collider), bodies.get(h.link)) else {
-            return Err(PlantError::Engine(format!(
-                "object {i} or its link vanished"
-            )));
-        };
-        let at = *c.position();
-        let (v, w) = (link.velocity_at_point(at.translation), link.angvel());
         if let Some(b) = bodies.get_mut(h.body) {
             b.set_enabled(true);
             b.set_position(at, true);
@@ -245,10 +234,18 @@ impl Contacts {
         Some(colliders.get(h.collider)?.position().translation)
     }
 
-    fn held(&self, i: usize) -> Result<&Held, PlantError> {
-        self.objects
-            .get(i)
-            .ok_or_else(|| PlantError::Engine(format!("no object {i}")))
+    /// Object `i`, where its collider is in the world, and its link's body
+    /// (a copy: the caller changes the world next).
+    fn where_held(
+        &self,
+        i: usize,
+        world: &PhysicsWorld,
+    ) -> Result<(&Held, Pose, RigidBody), PlantError> {
+        let vanished = || PlantError::Engine(format!("object {i} or its link vanished"));
+        let h = self.objects.get(i).ok_or_else(vanished)?;
+        let c = world.colliders.get(h.collider).ok_or_else(vanished)?;
+        let link = world.bodies.get(h.link).ok_or_else(vanished)?;
+        Ok((h, *c.position(), link.clone()))
     }
 
     /// Ends a period of length `dt`: the reading for it.
