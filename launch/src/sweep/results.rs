@@ -214,3 +214,31 @@ fn io(path: &Path, cause: std::io::Error) -> SweepError {
         cause,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// #39 row 16: the final check (made after the last line, where no
+    /// run's timing can place a removal) finds a folder removed or
+    /// replaced after the writer opened its file, and passes one left
+    /// alone.
+    #[test]
+    fn a_folder_removed_or_replaced_after_the_last_line_is_found() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("sweep");
+        for replace in [false, true] {
+            std::fs::create_dir_all(&dir).unwrap();
+            let w = ResultWriter::open(&dir, "w0").unwrap();
+            w.check_still_there().unwrap();
+            std::fs::remove_dir_all(&dir).unwrap();
+            if replace {
+                std::fs::create_dir_all(&dir).unwrap();
+                std::fs::write(dir.join("results-w0.jsonl"), "").unwrap();
+            }
+            let e = w.check_still_there().unwrap_err().to_string();
+            assert!(e.contains("removed or replaced while the sweep ran"), "{e}");
+        }
+    }
+}
