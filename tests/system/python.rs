@@ -151,19 +151,44 @@ fn every_message_of_a_run_decodes_with_the_official_python_reader() {
         assert_eq!(rows[topic].as_u64(), Some(*n), "{topic}: {py}");
     }
     // Every channel but an external controller's own diagnostics (the
-    // testbed's controller declares none).
+    // testbed's controller declares none) and contact's (no obstacles).
+    let silent = ["/controller/own_diagnostics", "/contact", "/arm/contact"];
     assert_eq!(
         per_topic.len(),
-        logger::channels().len() - 1,
+        logger::channels().len() - silent.len(),
         "{per_topic:?}"
     );
-    assert!(!per_topic.contains_key("/controller/own_diagnostics"));
+    assert!(silent.iter().all(|t| !per_topic.contains_key(*t)));
     assert_eq!(py["log_format"], logger::LOG_FORMAT);
     assert_eq!(py["types"]["/joint_state"], "testbed_msgs/msg/JointState");
     assert_eq!(py["types"]["/joint_states"], "sensor_msgs/msg/JointState");
     assert_eq!(py["types"]["/tf"], "tf2_msgs/msg/TFMessage");
     assert_eq!(py["q_shape"], serde_json::json!([1001, 2]), "{py}");
     assert_eq!(py["last_t"], 1.0);
+    // A contact run's /contact and /arm/contact decode too.
+    let r = lockstep(
+        dir.path(),
+        &["--scenario", "paper_obstacle", "--duration", "2.5"],
+        "c.csv",
+    );
+    let out = Command::new(python())
+        .args([
+            "python/examples/read_log.py",
+            r["log"].as_str().unwrap(),
+            "--json",
+        ])
+        .current_dir(repo_root())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let py: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(py["rows"]["/contact"], 2501, "{py}");
+    assert!(py["rows"]["/arm/contact"].as_u64().unwrap() > 0, "{py}");
+    assert_eq!(py["types"]["/contact"], "testbed_msgs/msg/ContactState");
 }
 
 /// A 10 s real-time run at 1 kHz with the Python PD completes and reports
