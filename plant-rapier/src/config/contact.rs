@@ -7,7 +7,7 @@
 use arm_model::{Geometry, Origin};
 use serde::{Deserialize, Serialize};
 
-use super::invalid;
+use super::{invalid, short};
 use crate::PlantError;
 
 /// Contact between the arm's `<collision>` primitives and the obstacles.
@@ -242,7 +242,7 @@ fn place(xyz: &[f64; 3], rpy: &[f64; 3], key: &dyn Fn(&str) -> String) -> Result
         {
             return Err(invalid(
                 &key(&format!("{name}[{i}]")),
-                format!("{x:e}"),
+                short(*x),
                 "a finite number up to 1000 in size",
             ));
         }
