@@ -1,6 +1,5 @@
 //! `testbed`: run the paper's controller on a simulated arm.
 
-mod bench_table;
 mod cli;
 
 use std::process::ExitCode;

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::NodeName;
-use launch::mode::Mode;
+use launcher::mode::Mode;
 
 #[derive(Debug, Args)]
 pub(crate) struct ScenarioArgs {
@@ -52,7 +52,7 @@ pub(crate) struct RunArgs {
     #[command(flatten)]
     pub(crate) common: ScenarioArgs,
     /// Timing mode: realtime or lockstep.
-    #[arg(long, value_parser = launch::mode::parse, default_value = "realtime")]
+    #[arg(long, value_parser = launcher::mode::parse, default_value = "realtime")]
     pub(crate) mode: Mode,
     /// Control rate in Hz instead of the scenario's rate_hz.
     #[arg(long, value_name = "HZ")]
@@ -116,7 +116,7 @@ fn parse_external_law(s: &str) -> Result<(String, String), String> {
     let (name, cmd) = s
         .split_once('=')
         .ok_or_else(|| format!("{s:?} is not NAME=CMD (e.g. pid=\"python3 my.py\")"))?;
-    if !launch::run::external::is_law_name(name) {
+    if !launcher::run::external::is_law_name(name) {
         return Err(format!(
             "{name:?} is not a row name (1 to 40 of a-z, 0-9, '-', '_')"
         ));

@@ -4,11 +4,11 @@ use std::fmt::Write;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use launch::bench_controller::ControllerBench;
+use experiments::bench::controller::ControllerBench;
 
 use super::args::BenchArgs;
-use crate::bench_table;
 use analysis::report::percentiles;
+use experiments::bench::table;
 
 pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
     if !(args.realtime_s.is_finite() && args.realtime_s > 0.0) {
@@ -25,7 +25,7 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
         .as_deref()
         .map(super::args::command_words)
         .transpose()?;
-    let opts = launch::bench::BenchOptions {
+    let opts = experiments::bench::BenchOptions {
         realtime_s: args.realtime_s,
         repeats: args.repeats,
         runs_dir: args.runs_dir,
@@ -41,7 +41,7 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
     }
     if args.peer {
         let python = super::args::command_words(&args.peer_python)?;
-        let report = launch::bench_peer::run(&opts, &python, progress)?;
+        let report = experiments::bench::peer::run(&opts, &python, progress)?;
         if args.json {
             super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&report)?))?;
         } else {
@@ -50,7 +50,7 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     if let Some(command) = command {
-        let report = launch::bench_controller::run(&opts, &command, progress)?;
+        let report = experiments::bench::controller::run(&opts, &command, progress)?;
         if args.json {
             super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&report)?))?;
         } else {
@@ -58,17 +58,17 @@ pub(crate) fn bench(args: BenchArgs) -> Result<ExitCode> {
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let report = launch::bench::run(&opts, progress)?;
+    let report = experiments::bench::run(&opts, progress)?;
     if args.json {
         super::write_stdout(&format!("{}\n", serde_json::to_string_pretty(&report)?))?;
     } else {
-        super::write_stdout(&bench_table::bench_table(&report))?;
+        super::write_stdout(&table::bench_table(&report))?;
     }
     Ok(ExitCode::SUCCESS)
 }
 
 /// The lockstep stack against the Python + MuJoCo loop, pair by pair.
-fn peer_table(b: &launch::bench_peer::PeerBench) -> String {
+fn peer_table(b: &experiments::bench::peer::PeerBench) -> String {
     let mut s = format!(
         "{} scenario, {:.1} s simulated; Python + MuJoCo (RK4, {} substeps) against `testbed run --mode lockstep` (logger on)\n",
         b.scenario, b.sim_s, b.peer_substeps
@@ -85,7 +85,7 @@ fn peer_table(b: &launch::bench_peer::PeerBench) -> String {
         s,
         "median ratio: {:.1}× (lockstep {:.0}× real time)",
         b.speedup,
-        b.sim_s / launch::bench::median(b.lockstep_wall_s.clone())
+        b.sim_s / experiments::bench::median(b.lockstep_wall_s.clone())
     );
     let _ = writeln!(
         s,

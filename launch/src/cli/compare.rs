@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use std::io::IsTerminal;
 
 use anyhow::{Context, Result, bail};
-use launch::compare::{self, CompareOptions, Comparison, METRICS};
+use experiments::compare::{self, CompareOptions, Comparison, METRICS};
 
 use super::args::{CompareArgs, ScenarioArgs};
 
@@ -61,7 +61,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
             );
         }
         let command = super::args::command_words(cmd)?;
-        launch::run::spawn::check_program(&command)
+        launcher::run::spawn::check_program(&command)
             .with_context(|| format!("--controller-cmd {label}={cmd}"))?;
         external.push(compare::ExternalSpec {
             label: label.clone(),
@@ -100,7 +100,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(dir) = &args.plots {
-        let n = launch::compare_plots::write_all(dir, &result, &plan)
+        let n = experiments::compare::plots::write_all(dir, &result, &plan)
             .with_context(|| format!("writing figures to {}", dir.display()))?;
         eprintln!("testbed: wrote {n} figures to {}", dir.display());
     }
@@ -138,10 +138,10 @@ fn tradeoff(args: &CompareArgs, plan: &scenario::Plan, opts: &CompareOptions) ->
     if args.csv.is_some() {
         bail!("--csv with --gain-scales: the trade-off has no per-run CSV; use --json");
     }
-    let t = launch::compare_tradeoff::tradeoff(plan, opts, &args.gain_scales)
+    let t = experiments::compare::tradeoff::tradeoff(plan, opts, &args.gain_scales)
         .with_context(|| format!("trade-off on {}", plan.source))?;
     if let Some(dir) = &args.plots {
-        let n = launch::compare_plots::write_tradeoff(dir, &t, &plan.scenario.name)
+        let n = experiments::compare::plots::write_tradeoff(dir, &t, &plan.scenario.name)
             .with_context(|| format!("writing figures to {}", dir.display()))?;
         eprintln!("testbed: wrote {n} figures to {}", dir.display());
     }

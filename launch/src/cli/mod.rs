@@ -17,7 +17,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 
-use launch::node::{self, NodeArgs};
+use launcher::node::{self, NodeArgs};
 use scenario::Overrides;
 use wire::NodeKind;
 
@@ -85,7 +85,7 @@ enum Command {
         prefix: String,
         /// Where to run (as lockstep's controller).
         #[command(flatten)]
-        placement: launch::node::placement::Placement,
+        placement: launcher::node::placement::Placement,
     },
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
     ///
@@ -183,7 +183,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Replay(args) => replay::replay(args),
         Command::Bench(args) => bench::bench(args),
         Command::BenchPong { prefix, placement } => {
-            launch::bench_pingpong::pong(&prefix, &placement)?;
+            experiments::bench::pingpong::pong(&prefix, &placement)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Compare(args) => compare::compare(args),
@@ -287,7 +287,7 @@ pub(crate) fn print_report(report: &Report, json: bool) -> Result<()> {
 /// (more only queue; twenty thousand once kept a run from ending for over
 /// a minute), said on stderr when the request is cut.
 pub(crate) fn worker_threads(requested: Option<usize>) -> Option<usize> {
-    let cpus = launch::node::placement::cpu_count();
+    let cpus = launcher::node::placement::cpu_count();
     let cap = 4 * cpus;
     match requested {
         Some(n) if n > cap => {

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use analysis::timing::Verdict;
 use anyhow::{Context, Result};
-use launch::run::{self, RunError, RunOptions};
+use launcher::run::{self, RunError, RunOptions};
 
 use super::args::RunArgs;
 use super::{EXIT_DEGRADED, EXIT_INTERRUPTED, EXIT_INVALID, load, print_report};

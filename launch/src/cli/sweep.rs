@@ -7,7 +7,7 @@ use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
-use launch::sweep::{self, RunOptions, file, report, slurm};
+use experiments::sweep::{self, RunOptions, file, report, slurm};
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum SweepCommand {

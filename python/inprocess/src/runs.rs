@@ -11,7 +11,7 @@ use pyo3::types::PyDict;
 use analysis::record::StepRecord;
 use analysis::report::Report;
 use analysis::summary::SummaryBuilder;
-use launch::compare::{CompareOptions, DEFAULT_LAWS};
+use experiments::compare::{CompareOptions, DEFAULT_LAWS};
 
 use crate::convert::{ScenarioArgs, err, json_to_py};
 
@@ -112,9 +112,9 @@ pub fn sim<'py>(
                 plan.scenario.controller.tc,
             )
             .with_gravity(&plan.robot.model);
-            let mut costs = launch::sim::StepCosts::default();
+            let mut costs = launcher::sim::StepCosts::default();
             let start = Instant::now();
-            launch::sim::run_measured(&plan, Some(&mut costs), |r| {
+            launcher::sim::run_measured(&plan, Some(&mut costs), |r| {
                 // Ctrl-C reaches Python only between steps: look every 4096.
                 if columns.t.len() % 4096 == 4095
                     && let Err(e) = Python::attach(|py| py.check_signals())
@@ -173,14 +173,14 @@ pub fn compare<'py>(
     if seeds == 0 || threads == Some(0) {
         return Err(err("compare needs at least one seed and one thread"));
     }
-    if seeds > launch::compare::MAX_SEEDS {
+    if seeds > experiments::compare::MAX_SEEDS {
         return Err(err(format!(
             "seeds={seeds}: at most {} seeds per law (use a sweep for more)",
-            launch::compare::MAX_SEEDS
+            experiments::compare::MAX_SEEDS
         )));
     }
     // More threads than four per CPU only queue (the CLI's cap too).
-    let cap = 4 * launch::node::placement::cpu_count();
+    let cap = 4 * launcher::node::placement::cpu_count();
     let threads = threads.map(|t| t.min(cap));
     let opts = CompareOptions {
         laws,
@@ -193,7 +193,7 @@ pub fn compare<'py>(
         progress: false,
     };
     let result = py
-        .detach(|| launch::compare::compare(&plan, &opts).map_err(|e| e.to_string()))
+        .detach(|| experiments::compare::compare(&plan, &opts).map_err(|e| e.to_string()))
         .map_err(err)?;
     json_to_py(py, &result)
 }

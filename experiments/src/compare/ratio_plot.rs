@@ -9,7 +9,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use scenario::Plan;
 
-use crate::compare::{Comparison, LawRow, LawSeries};
+use crate::compare::types::{Comparison, LawRow, LawSeries};
 use analysis::plots::{COLORS, FAMILY, PlotError, RED, err};
 
 /// Writes `compare_error_ratio.png` and `.svg` into `dir`.

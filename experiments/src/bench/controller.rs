@@ -6,8 +6,9 @@
 
 use serde::Serialize;
 
-use crate::bench::{
-    BenchError, BenchOptions, Machine, RealtimeFigures, TimerFloor, load, machine, realtime_part,
+use crate::bench::parts::{load, realtime_part};
+use crate::bench::types::{
+    BenchError, BenchOptions, Machine, RealtimeFigures, TimerFloor, machine,
 };
 use analysis::timing::Percentiles;
 

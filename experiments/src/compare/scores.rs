@@ -11,9 +11,8 @@
 use analysis::law_info::LawInfo;
 use analysis::stats::{median_interval, quantile, signed_rank};
 use analysis::summary::Summary;
-use serde::Serialize;
 
-use crate::compare::{IntervalRanks, LawRow, LawRun, Paired};
+use crate::compare::types::{Envelope, IntervalRanks, LawRow, LawRun, Paired, Stats};
 
 /// The metrics of the paired tests: error, peak error, effort beyond the
 /// gravity hold, energy.
@@ -23,29 +22,6 @@ pub const PAIRED_METRICS: [&str; 4] = [
     "effort_beyond_gravity",
     "energy_after_tc",
 ];
-
-/// One value per metric of [`METRICS`], in order (JSON: an object; an
-/// infinite value, i.e. a missing one counted as the worst, is null).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Stats(pub Vec<(&'static str, f64)>);
-
-impl Stats {
-    /// The value of metric `name`.
-    pub fn get(&self, name: &str) -> Option<f64> {
-        self.0.iter().find(|(k, _)| *k == name).map(|(_, v)| *v)
-    }
-}
-
-impl Serialize for Stats {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let mut map = s.serialize_map(Some(self.0.len()))?;
-        for (k, v) in &self.0 {
-            map.serialize_entry(k, &v.is_finite().then_some(*v))?;
-        }
-        map.end()
-    }
-}
 
 /// A metric of the table: its name, unit and which way is worse.
 pub struct Metric {
@@ -158,40 +134,6 @@ pub fn failed_because(failure: Option<&str>, s: &Summary) -> Option<String> {
     (!why.is_empty()).then(|| why.join("; "))
 }
 
-/// Whether a run kept |e_i| < k_c,i for every joint and every t ≥ T_c.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Envelope {
-    /// Inside at every step from T_c on.
-    Kept,
-    /// At or outside it at some step from T_c on (a non-finite error counts
-    /// as outside).
-    Left,
-    /// The run ended before T_c: nothing to judge.
-    NotJudged,
-}
-
-impl Envelope {
-    /// The run's envelope fact, from its summary.
-    pub fn of(s: &Summary) -> Self {
-        let judged = s.joints.iter().any(|j| j.min_margin_after_tc.is_some());
-        match (judged, s.constraint_satisfied_after_tc) {
-            (false, _) => Self::NotJudged,
-            (true, true) => Self::Kept,
-            (true, false) => Self::Left,
-        }
-    }
-
-    /// As the table and the CSV write it.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::Kept => "kept",
-            Self::Left => "left",
-            Self::NotJudged => "not-judged",
-        }
-    }
-}
-
 /// A run scored: its failure (if any) and its envelope fact, from its
 /// summary.
 pub fn scored(
@@ -199,7 +141,7 @@ pub fn scored(
     failure: Option<String>,
     summary: Summary,
     compute_us: analysis::timing::Percentiles,
-    series: Option<crate::compare::LawSeries>,
+    series: Option<crate::compare::types::LawSeries>,
 ) -> LawRun {
     LawRun {
         seed,

@@ -16,12 +16,11 @@ use std::process::{Child, Stdio};
 use std::time::{Duration, Instant};
 
 use bus::{Bus, RunPrefix};
-use serde::Serialize;
 use wire::{Command, Delivery, JointState, STATE_FINAL, Topic};
 
-use crate::bench::BenchError;
-use crate::mode::Mode;
-use crate::node::placement::{self, Placement};
+use crate::bench::types::{BenchError, PingPong};
+use launcher::mode::Mode;
+use launcher::node::placement::{self, Placement};
 use wire::NodeKind;
 
 /// The hidden subcommand the other process runs.
@@ -29,15 +28,6 @@ pub const PONG_COMMAND: &str = "bench-pong";
 
 /// How long either side waits for the other before giving up.
 const PATIENCE: Duration = Duration::from_secs(10);
-
-/// What the ping-pong measured.
-#[derive(Debug, Clone, Serialize)]
-pub struct PingPong {
-    /// Round trips timed (after one to connect).
-    pub rounds: u64,
-    /// Wall time per round trip, µs (the median run's).
-    pub round_trip_us: f64,
-}
 
 fn err(what: impl std::fmt::Display) -> BenchError {
     BenchError::PingPong(what.to_string())
@@ -150,7 +140,7 @@ pub fn measure(rounds: u64, repeats: usize, pinned: bool) -> Result<PingPong, Be
     }
     Ok(PingPong {
         rounds,
-        round_trip_us: crate::bench::median(us),
+        round_trip_us: crate::bench::types::median(us),
     })
 }
 

@@ -7,28 +7,10 @@ use analysis::law_info::LawInfo;
 use analysis::summary::SummaryBuilder;
 use analysis::timing::Percentiles;
 use scenario::Plan;
-use serde::Serialize;
 
-use crate::compare::{CompareError, CompareOptions, LawRow, plan_for, row, scored};
-
-/// A user's controller in the table: its row's label and its command.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ExternalSpec {
-    /// The row's name.
-    pub label: String,
-    /// The program and its arguments.
-    pub command: Vec<String>,
-}
-
-/// What a row of a user's controller says about it.
-#[derive(Debug, Clone, Serialize)]
-pub struct ExternalRow {
-    /// The command.
-    pub command: String,
-    /// The law it declared (`CMD --describe`) with its parameters, if it
-    /// declared one.
-    pub declared: Option<analysis::report::ExternalLaw>,
-}
+use crate::compare::runs::plan_for;
+use crate::compare::scores::{row, scored};
+use crate::compare::types::{CompareError, CompareOptions, ExternalRow, ExternalSpec, LawRow};
 
 /// A user's controller over every seed: each seed's plan (the scenario's
 /// law and gains, that seed's draws) run in lockstep with the command as
@@ -45,7 +27,7 @@ pub(crate) fn external_row(
     for s in 0..opts.seeds {
         let p = plan_for(plan, law, s, opts.tuning)?;
         let seed = p.scenario.seed;
-        let run = crate::run::run(crate::run::RunOptions {
+        let run = launcher::run::run(launcher::run::RunOptions {
             plan: p,
             mode: wire::Mode::Lockstep,
             csv: None,

@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 use scenario::Plan;
 
-use crate::compare::{Comparison, LawRow};
+use crate::compare::types::{Comparison, LawRow, LawSeries, Stats};
 use analysis::plots::{COLORS, FAMILY, FONT, Line, Panel, PlotError, RED, category, err, save};
 
 /// Writes `compare_errors`, `compare_error_ratio` and `compare_bars` (PNG
@@ -17,14 +17,14 @@ pub fn write_all(dir: &Path, c: &Comparison, plan: &Plan) -> Result<usize, PlotE
     std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
     let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
     errors(dir, c, plan)?;
-    crate::compare_ratio_plot::write(dir, c, plan)?;
+    crate::compare::ratio_plot::write(dir, c, plan)?;
     bars(dir, c)?;
     Ok(3)
 }
 
 /// The first seed's e = q − q_d of every law, one panel per joint.
 fn errors(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), PlotError> {
-    let curves: Vec<(&LawRow, &crate::compare::LawSeries)> = c
+    let curves: Vec<(&LawRow, &LawSeries)> = c
         .laws
         .iter()
         .filter_map(|row| Some((row, row.runs.first()?.series.as_ref()?)))
@@ -121,7 +121,7 @@ fn draw_bars<DB: DrawingBackend>(
         ),
     ];
     for (area, (caption, key)) in areas.iter().zip(panels) {
-        let get = |s: &crate::compare::Stats| s.get(key).unwrap_or(f64::NAN);
+        let get = |s: &Stats| s.get(key).unwrap_or(f64::NAN);
         let bars: Vec<Bar> = c
             .laws
             .iter()
@@ -227,7 +227,7 @@ fn bar_panel<DB: DrawingBackend>(
 /// and counted in the legend.
 pub fn write_tradeoff(
     dir: &Path,
-    t: &crate::compare_tradeoff::Tradeoff,
+    t: &crate::compare::tradeoff::Tradeoff,
     scenario: &str,
 ) -> Result<usize, PlotError> {
     std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
@@ -251,10 +251,10 @@ pub fn write_tradeoff(
 
 fn draw_tradeoff<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    t: &crate::compare_tradeoff::Tradeoff,
+    t: &crate::compare::tradeoff::Tradeoff,
     scenario: &str,
 ) -> Result<(), PlotError> {
-    use crate::compare_tradeoff::TradeoffPoint as P;
+    use crate::compare::tradeoff::TradeoffPoint as P;
     root.fill(&WHITE).map_err(err)?;
     let scales: Vec<String> = t.scales.iter().map(|s| format!("{s}")).collect();
     let title = format!(
@@ -280,18 +280,18 @@ fn draw_tradeoff<DB: DrawingBackend>(
 
 /// A point's cost and whether it is on the front for that cost.
 type CostOf = (
-    fn(&crate::compare_tradeoff::TradeoffPoint) -> Option<f64>,
-    fn(&crate::compare_tradeoff::TradeoffPoint) -> bool,
+    fn(&crate::compare::tradeoff::TradeoffPoint) -> Option<f64>,
+    fn(&crate::compare::tradeoff::TradeoffPoint) -> bool,
 );
 
 /// IAE against one cost, log-log, one polyline per law in scale order.
 fn tradeoff_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    t: &crate::compare_tradeoff::Tradeoff,
+    t: &crate::compare::tradeoff::Tradeoff,
     (cost, on_front): CostOf,
     x_desc: &str,
 ) -> Result<(), PlotError> {
-    let xy = |p: &crate::compare_tradeoff::TradeoffPoint| {
+    let xy = |p: &crate::compare::tradeoff::TradeoffPoint| {
         cost(p).zip(p.iae).filter(|(e, i)| *e > 0.0 && *i > 0.0)
     };
     let ok: Vec<(f64, f64)> = t.points.iter().filter_map(xy).collect();

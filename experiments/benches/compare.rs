@@ -2,13 +2,13 @@
 //! paper scenario with 20 seeds, and a sweep of 16 runs: each on every core and on one, so that the ratio shows the
 //! cores are used.
 //!
-//! `cargo bench -p launch --bench compare` (each sample is a whole
+//! `cargo bench -p experiments --bench compare` (each sample is a whole
 //! comparison of 8 laws × 20 s, about 4 s on two cores, or a whole sweep).
 
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use launch::compare::{CompareOptions, DEFAULT_LAWS, compare};
+use experiments::compare::{CompareOptions, DEFAULT_LAWS, compare};
 
 fn paper_compare(c: &mut Criterion) {
     let plan = scenario::load(None, &scenario::Overrides::default()).unwrap();
@@ -70,14 +70,14 @@ fn sweep_throughput(c: &mut Criterion) {
          [[axis]]\nkey = \"controller.k2\"\nvalues = [10.0, 15.0]\n",
     )
     .unwrap();
-    let sweep = launch::sweep::file::load(&file).unwrap();
+    let sweep = experiments::sweep::file::load(&file).unwrap();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let stop = std::sync::atomic::AtomicBool::new(false);
     let mut group = c.benchmark_group("sweep_16_runs");
     group.sample_size(10);
     let mut k = 0;
     for threads in [cores, 1] {
-        let opts = launch::sweep::RunOptions {
+        let opts = experiments::sweep::RunOptions {
             threads: Some(threads),
             share: None,
             progress: false,
@@ -86,7 +86,7 @@ fn sweep_throughput(c: &mut Criterion) {
             b.iter(|| {
                 k += 1;
                 let dir = root.path().join(format!("r{k}"));
-                launch::sweep::run(&sweep, &dir, &opts, &stop).unwrap()
+                experiments::sweep::run(&sweep, &dir, &opts, &stop).unwrap()
             })
         });
     }

@@ -11,9 +11,10 @@ use std::process::Command;
 use scenario::Plan;
 use serde::{Deserialize, Serialize};
 
-use crate::bench::{BenchError, BenchOptions, Machine, load, machine, median, stack};
-use crate::mode::Mode;
-use crate::node::configs;
+use crate::bench::parts::{load, stack};
+use crate::bench::types::{BenchError, BenchOptions, Machine, machine, median};
+use launcher::mode::Mode;
+use launcher::node::configs;
 
 /// MuJoCo substeps per control period (RK4): the loop a user would write.
 pub const PEER_SUBSTEPS: u32 = 4;

@@ -127,7 +127,7 @@ pub fn run(
     let writer = Mutex::new(None::<ResultWriter>);
     let first_error = Mutex::new(None::<SweepError>);
     let (ran, not_ok) = (Mutex::new(0usize), Mutex::new(0usize));
-    let bar = progress_bar(opts.progress, todo.len());
+    let bar = crate::progress::bar(opts.progress, todo.len());
     let pool = pool(opts.threads)?;
     pool.install(|| {
         todo.par_iter().for_each(|spec| {
@@ -212,20 +212,6 @@ fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool, SweepError> {
         .num_threads(n)
         .build()
         .map_err(|e| SweepError::Options(format!("cannot start {n} worker threads: {e}")))
-}
-
-/// A bar of `len` runs on standard error, if `show` (a terminal).
-pub(crate) fn progress_bar(show: bool, len: usize) -> Option<indicatif::ProgressBar> {
-    if !show || len == 0 {
-        return None;
-    }
-    let bar = indicatif::ProgressBar::new(len as u64);
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
-        "{spinner} [{bar:40}] {pos}/{len} runs, {elapsed_precise} elapsed, ETA {eta}",
-    ) {
-        bar.set_style(style);
-    }
-    Some(bar)
 }
 
 /// One run, as a result line; None if `stop` cut it short.

@@ -5,7 +5,7 @@ use std::fmt::Write;
 use analysis::report::percentiles;
 
 /// A readable bench report.
-pub fn bench_table(b: &launch::bench::BenchReport) -> String {
+pub fn bench_table(b: &crate::bench::types::BenchReport) -> String {
     let mut out = String::new();
     let m = &b.machine;
     let _ = writeln!(

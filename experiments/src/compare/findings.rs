@@ -1,6 +1,6 @@
 //! What a comparison says about the paper's claims, with the numbers, by
 //! stated rules (so that a reader can check each verdict). The facts they
-//! rest on are the same for every law ([`crate::compare_scores`]): a run
+//! rest on are the same for every law ([`crate::compare::scores`]): a run
 //! *failed* when it could not be scored (stopped, non-finite, faults); it
 //! *kept* the envelope when |e| < k_c at every t ≥ T_c, *left* it
 //! otherwise, and is *not judged* when it ended before T_c.
@@ -32,50 +32,13 @@
 //! A claim whose law is not in the comparison is "not tested".
 
 use controller::LawName;
-use serde::Serialize;
 
-use crate::compare::{Comparison, Envelope, LawRow, Paired};
+use crate::compare::types::{Comparison, Envelope, Finding, LawRow, Paired, Verdict};
 
 /// A relative difference smaller than this is "no difference".
 pub const MATTERS: f64 = 0.01;
 /// The paired test's level (on Holm-corrected p-values).
 pub const ALPHA: f64 = 0.05;
-
-/// A claim's verdict.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Verdict {
-    /// The rule of the claim is met.
-    Holds,
-    /// It is not.
-    DoesNotHold,
-    /// The comparison lacks a law or a situation the claim needs.
-    NotTested,
-    /// Every run ended before T_c: the constraint was never in force.
-    NotJudged,
-}
-
-impl std::fmt::Display for Verdict {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Self::Holds => "holds",
-            Self::DoesNotHold => "does not hold",
-            Self::NotTested => "not tested",
-            Self::NotJudged => "not judged",
-        })
-    }
-}
-
-/// One claim on one scenario.
-#[derive(Debug, Clone, Serialize)]
-pub struct Finding {
-    /// The claim, briefly.
-    pub claim: String,
-    /// The verdict by the module's rules.
-    pub verdict: Verdict,
-    /// The numbers it rests on.
-    pub evidence: String,
-}
 
 /// Every claim's finding on `c`.
 pub fn findings(c: &Comparison) -> Vec<Finding> {
