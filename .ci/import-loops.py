@@ -24,6 +24,16 @@ for src in sorted(crates()):
     for dp, dn, fn in os.walk(src):
         for f in fn:
             if f.endswith(".rs"): files[mod_of(src, os.path.join(dp, f))] = os.path.join(dp, f)
+    # Names a module re-exports from one of its children (`pub use
+    # child::{A, B}`): a path through the re-export leads to the child.
+    reexports = {}
+    for m, p in files.items():
+        text = re.sub(r"//[^\n]*", "", open(p).read())
+        for child, names in re.findall(r"pub(?:\([a-z]+\))? use (?:self::)?([a-z_][a-z0-9_]*)::(\{[^}]*\}|[A-Za-z_][A-Za-z0-9_]*)", text):
+            if m + (child,) not in files:
+                continue
+            for name in re.findall(r"[A-Za-z_][A-Za-z0-9_]*(?=\s*(?:,|\}|$))", names):
+                reexports[m + (name,)] = m + (child,)
     edges = {m: set() for m in files}
     for m, p in files.items():
         text = open(p).read()
@@ -32,7 +42,7 @@ for src in sorted(crates()):
         # strip comments
         text = re.sub(r"//[^\n]*", "", text)
         refs = set()
-        for r in re.findall(r"crate((?:::[a-z_][a-z0-9_]*)+)", text):
+        for r in re.findall(r"crate((?:::[A-Za-z_][A-Za-z0-9_]*)+)", text):
             refs.add(tuple(r.split("::")[1:]))
         for r in re.findall(r"\bsuper((?:::[a-z_][a-z0-9_]*)*)", text):
             base = m[:-1] if not p.endswith("mod.rs") else m[:-1]
@@ -41,15 +51,18 @@ for src in sorted(crates()):
         for g in re.findall(r"crate::\{([^}]*)\}", text):
             for item in g.split(","):
                 item = item.strip()
-                if item: refs.add(tuple(re.findall(r"[a-z_][a-z0-9_]*", item.split("{")[0])))
+                if item: refs.add(tuple(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", item.split("{")[0])))
         for c in (files if strict else []):
             if len(c) == len(m) + 1 and c[:-1] == m and re.search(r"(?<![:\w])(self::)?" + c[-1] + r"::", text):
                 refs.add(c)
         for r in refs:
             # longest prefix that is a file module
             for k in range(len(r), 0, -1):
-                if r[:k] in files and r[:k] != m:
-                    edges[m].add(r[:k]); break
+                target = r[:k] if r[:k] in files else reexports.get(r[:k])
+                if target is not None:
+                    if target != m:
+                        edges[m].add(target)
+                    break
     # find cycles of length 2 (and report SCCs)
     index = {}; low = {}; st = []; on = set(); sccs = []; c = [0]
     sys.setrecursionlimit(10000)

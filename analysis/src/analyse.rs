@@ -20,7 +20,8 @@ use crate::summary::{Summary, SummaryBuilder};
 use crate::timing::{RunFacts, TimingStats, TimingSummary, judge};
 use crate::verify::Verifier;
 use logger::{
-    DecodeError, Encoding, LogContents, LogError, LogMessage, MessageError, read_log, read_log_head,
+    Decode, DecodeError, Encoding, LogContents, LogError, LogMessage, MessageError, read_log,
+    read_log_head,
 };
 use wire::Mode;
 

@@ -8,7 +8,7 @@
 use serde::Serialize;
 use wire::{Command, JointState, NONE_U64, is_stale};
 
-use crate::timing::{Percentiles, Quantiles};
+use crate::percentiles::{Percentiles, Quantiles};
 
 /// What the log says about one state.
 #[derive(Debug, Clone, Copy, Default)]

@@ -16,6 +16,7 @@ pub mod csv_out;
 pub mod data_path;
 pub mod law_info;
 pub mod own;
+pub mod percentiles;
 pub mod plots;
 pub mod record;
 pub mod report;

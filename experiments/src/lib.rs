@@ -1,6 +1,6 @@
 //! Experiments built on the stack: [`compare`] runs laws on one scenario
 //! and judges them, [`sweep`] runs a grid of scenarios (here or on Slurm),
-//! [`bench`] measures the testbed itself.
+//! [`bench`](mod@bench) measures the testbed itself.
 //!
 //! Where it sits: above [`launcher`] (each experiment's runs go through
 //! [`launcher::sim`] or [`launcher::run`]) and below the `testbed` CLI

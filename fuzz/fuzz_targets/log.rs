@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use logger::LogMessage;
+use logger::{Decode, LogMessage};
 use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
 
 fuzz_target!(|data: &[u8]| {

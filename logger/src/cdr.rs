@@ -13,7 +13,7 @@
 //! straight into a reused buffer is a copy per field, and the whole codec
 //! is these two small types.
 
-use crate::json::DecodeError;
+use crate::decode_error::DecodeError;
 
 /// The encapsulation header of little-endian plain CDR (`CDR_LE`).
 pub const CDR_LE: [u8; 4] = [0x00, 0x01, 0x00, 0x00];

@@ -10,21 +10,12 @@
 //! numbers are written as `null` (JSON has no NaN) and read back as NaN.
 
 use serde_json::{Map, Value, json};
+
+use crate::decode_error::DecodeError;
 use wire::{
     Bound, Command, ContactState, ControllerDiagnostics, FieldRef, FieldSource, Header, JointState,
     OwnDiagnostics, ReferenceSample, Timing,
 };
-
-/// A logged message that does not decode: what is missing or wrong.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct DecodeError(pub String);
-
-impl From<wire::FieldError> for DecodeError {
-    fn from(e: wire::FieldError) -> Self {
-        Self(e.to_string())
-    }
-}
 
 /// A message type as it appears in the log.
 pub trait LogMessage: Bound {
@@ -110,15 +101,6 @@ pub trait LogMessage: Bound {
         header()
             .and_then(|h| Self::decode(h, &m))
             .map_err(DecodeError::from)
-    }
-
-    /// The message back from a log's data in `encoding` (JSON in log
-    /// formats 1 and 2, CDR from format 3).
-    fn decode_as(encoding: crate::Encoding, data: &[u8]) -> Result<Self, DecodeError> {
-        match encoding {
-            crate::Encoding::Json => Self::parse(data),
-            crate::Encoding::Cdr => crate::ros2::decode(data),
-        }
     }
 
     /// The JSON schema (draft 2020-12, `jsonschema` encoding in MCAP).

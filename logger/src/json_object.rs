@@ -14,7 +14,7 @@ use serde::Deserializer as _;
 use serde::de::{self, DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use wire::{FieldError, FieldSource, Joints, MAX_DOF, joints};
 
-use crate::json::DecodeError;
+use crate::decode_error::DecodeError;
 
 /// One value of a field, as far as a message's fields care.
 #[derive(Debug, Clone, PartialEq)]

@@ -28,6 +28,8 @@
 pub mod cdr;
 mod channels;
 mod compression;
+mod decode;
+mod decode_error;
 mod json;
 mod json_object;
 mod layout;
@@ -48,7 +50,9 @@ pub use channels::{
     SCHEMA_ENCODING, channels,
 };
 pub use compression::LogCompression;
-pub use json::{DecodeError, LogMessage};
+pub use decode::Decode;
+pub use decode_error::DecodeError;
+pub use json::LogMessage;
 pub use json_object::JsonObject;
 pub use layout::foxglove_layout;
 pub use reader::{

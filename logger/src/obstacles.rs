@@ -6,8 +6,7 @@ use arm_model::{Geometry, Origin, iso};
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-use crate::ros2::{self, Marker};
-use crate::scene::{WORLD_FRAME, parts};
+use crate::ros2::{self, Marker, WORLD_FRAME, parts};
 
 /// Topic of the contact point marker.
 pub const CONTACT_MARKER_TOPIC: &str = "/arm/contact";

@@ -68,7 +68,7 @@ pub enum MessageError {
 }
 
 /// How a channel's messages are encoded: JSON (log formats 1 and 2) or CDR
-/// (format 3). [`crate::LogMessage::decode_as`] decodes either.
+/// (format 3). [`crate::Decode::decode_as`] decodes either.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Encoding {
     /// JSON text (`json`).
@@ -89,7 +89,7 @@ impl Encoding {
 }
 
 /// Called for every message of a log, in file order, with its topic, its
-/// channel's encoding and its data ([`crate::LogMessage::decode_as`]
+/// channel's encoding and its data ([`crate::Decode::decode_as`]
 /// decodes it).
 pub type OnMessage<'a> = &'a mut dyn FnMut(&str, Encoding, &[u8]) -> Result<(), MessageError>;
 
@@ -405,7 +405,7 @@ mod tests {
     /// the reader hands it (the fuzzer's `log` target does this at length).
     #[test]
     fn damaged_cdr_logs_read_without_a_crash() {
-        use crate::LogMessage;
+        use crate::Decode;
         let dir = std::env::temp_dir().join(format!("testbed-cdr-dmg-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("run.mcap");
@@ -484,7 +484,7 @@ mod tests {
         let mut take = |_: &str, enc: Encoding, data: &[u8]| {
             assert_eq!(enc, Encoding::Cdr);
             seqs.push(
-                <wire::JointState as crate::LogMessage>::decode_as(enc, data)?
+                <wire::JointState as crate::Decode>::decode_as(enc, data)?
                     .header
                     .seq,
             );

@@ -21,7 +21,7 @@ use wire::{FieldError, FieldRef, FieldSource, Header, Joints, MAX_DOF, joints};
 
 use crate::LogMessage;
 use crate::cdr::{CdrReader, CdrWriter};
-use crate::json::DecodeError;
+use crate::decode_error::DecodeError;
 
 /// The testbed's message package.
 pub const PACKAGE: &str = "testbed_msgs";
@@ -334,6 +334,15 @@ pub fn tf_schema() -> String {
 
 /// A rigid transform: translation x, y, z and rotation x, y, z, w.
 pub type Pose = ([f64; 3], [f64; 4]);
+
+/// The fixed frame: the URDF's root link sits at its origin.
+pub const WORLD_FRAME: &str = "world";
+
+/// A rigid transform as translation and quaternion (x, y, z, w).
+pub(crate) fn parts(p: &nalgebra::Isometry3<f64>) -> Pose {
+    let (t, r) = (p.translation.vector, p.rotation);
+    ([t.x, t.y, t.z], [r.i, r.j, r.k, r.w])
+}
 
 /// A `tf2_msgs/msg/TFMessage`: each `(parent, child, pose)`, stamped `t_ns`.
 pub fn tf_message<'a>(

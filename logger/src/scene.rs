@@ -12,15 +12,13 @@ use arm_model::{ArmModel, iso};
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
 use crate::obstacles::DrawnObstacle;
-use crate::ros2::{self, Marker, Pose};
+pub use crate::ros2::WORLD_FRAME;
+use crate::ros2::{self, Marker, Pose, parts};
 
 /// Topic of the link frames (ROS 2's).
 pub const TRANSFORMS_TOPIC: &str = "/tf";
 /// Topic of the arm's geometry.
 pub const SCENE_TOPIC: &str = "/arm/scene";
-/// The fixed frame: the URDF's root link sits at its origin.
-pub const WORLD_FRAME: &str = "world";
-
 /// A cylinder of the stick figure, in its link's frame.
 #[derive(Debug, Clone)]
 struct Bone {
@@ -179,12 +177,6 @@ fn cylinder_pose(to: Vector3<f64>) -> Isometry3<f64> {
         UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
     });
     Isometry3::from_parts((to / 2.0).into(), rotation)
-}
-
-/// A rigid transform as translation and quaternion (x, y, z, w).
-pub(crate) fn parts(p: &Isometry3<f64>) -> Pose {
-    let (t, r) = (p.translation.vector, p.rotation);
-    ([t.x, t.y, t.z], [r.i, r.j, r.k, r.w])
 }
 
 /// Alternating link colours, so that neighbours stand apart.

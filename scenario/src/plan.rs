@@ -116,21 +116,6 @@ pub struct Overrides {
     pub set: Vec<(String, toml::Value)>,
 }
 
-/// Reads `key.path=value` (the value in TOML; a bare word is a string).
-pub fn parse_set(arg: &str) -> Result<(String, toml::Value), String> {
-    let Some((key, raw)) = arg.split_once('=') else {
-        return Err(format!("{arg:?} is not KEY=VALUE (e.g. controller.k1=20)"));
-    };
-    let key = key.trim().to_string();
-    crate::sweep_file::checks::check_key_shape(&key)?;
-    let raw = raw.trim();
-    let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
-        .ok()
-        .and_then(|mut t| t.remove("v"))
-        .unwrap_or_else(|| toml::Value::String(raw.to_string()));
-    Ok((key, value))
-}
-
 /// `text` with every `set` applied; `source` says so, for messages.
 fn apply_set(
     text: &str,
@@ -144,7 +129,7 @@ fn apply_set(
     let mut root: toml::Table = toml::from_str(text).map_err(|e| err(e.to_string()))?;
     let mut said = Vec::new();
     for (key, value) in set {
-        crate::sweep_file::set_key(&mut root, key, value.clone())
+        crate::keys::set_key(&mut root, key, value.clone())
             .map_err(|e| err(format!("--set {key}: {e}")))?;
         said.push(format!("--set {key}={value}"));
     }
@@ -456,7 +441,7 @@ mod tests {
             rate_hz: None,
             robot: None,
             law: law.map(|l| l.parse().unwrap()),
-            set: set.iter().map(|s| parse_set(s).unwrap()).collect(),
+            set: set.iter().map(|s| crate::parse_set(s).unwrap()).collect(),
         }
     }
 

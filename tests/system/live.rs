@@ -228,7 +228,7 @@ fn a_lockstep_run_streams_live_what_its_log_keeps() {
         // 50 Hz of a 1 kHz run: every 20th sample, the same ones each run.
         assert_eq!(t % 20_000_000, 0, "{topic} at {t}");
         if topic == "/joint_state" {
-            use logger::LogMessage;
+            use logger::Decode;
             let s = wire::JointState::decode_as(logger::Encoding::Cdr, v).unwrap();
             assert_eq!(s.header.t_ns, *t);
         }

@@ -30,7 +30,7 @@ fn lockstep_run(dir: &Path, duration: &str) -> (serde_json::Value, PathBuf) {
 /// message per step on each step topic.
 #[test]
 fn log_is_complete_ros2_mcap_whose_messages_decode() {
-    use logger::LogMessage;
+    use logger::{Decode, LogMessage};
     use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
     let dir = tempfile::tempdir().unwrap();
     let (run, log) = lockstep_run(dir.path(), "0.5");
@@ -133,7 +133,7 @@ fn log_is_complete_ros2_mcap_whose_messages_decode() {
 /// the default zstd log of the same (deterministic) run.
 #[test]
 fn logs_of_every_compression_hold_the_same_messages() {
-    use logger::LogMessage;
+    use logger::Decode;
     let enc = logger::Encoding::Cdr;
     let dir = tempfile::tempdir().unwrap();
     let messages = |compression: &str| {

@@ -187,7 +187,7 @@ fn a_contact_scenario_runs_the_same_in_sim_and_lockstep() {
     );
     // The log's /contact: one sample per state, the force where the state
     // says contact, the point on the table's top (z = -0.5 m) under the arm.
-    use logger::LogMessage;
+    use logger::{Decode, LogMessage};
     let (mut samples, mut touching, mut markers) = (0u64, 0u64, 0u64);
     let mut on_message = |topic: &str, enc: logger::Encoding, data: &[u8]| {
         markers += u64::from(topic == logger::obstacles::CONTACT_MARKER_TOPIC);
@@ -289,7 +289,7 @@ fn the_log_records_the_seed_and_the_effects() {
         .map(|m| m.unwrap())
         .find(|m| m.channel.topic == "/joint_state")
         .unwrap();
-    let s = <wire::JointState as logger::LogMessage>::decode_as(logger::Encoding::Cdr, &state.data)
+    let s = <wire::JointState as logger::Decode>::decode_as(logger::Encoding::Cdr, &state.data)
         .unwrap();
     assert_eq!(s.effects, 0b11_0001);
     assert_ne!(s.q, s.q_measured);

@@ -97,7 +97,7 @@ pub struct LawRun {
     pub seed: u64,
     /// Why the run stopped early, if it did (the summary covers the steps before).
     pub failure: Option<String>,
-    /// Why the run failed, if it did ([`failed_because`]: it could not be
+    /// Why the run failed, if it did ([`failed_because`](crate::compare::scores::failed_because): it could not be
     /// scored): a failed run's metrics count as the worst, whatever their
     /// values.
     pub failed: Option<String>,
@@ -146,7 +146,7 @@ pub struct LawRow {
     pub left_envelope: u64,
     /// Seeds whose run ended before T_c.
     pub not_judged: u64,
-    /// Seeds whose run failed ([`failed_because`]).
+    /// Seeds whose run failed ([`failed_because`](crate::compare::scores::failed_because)).
     pub failed: u64,
 }
 
@@ -221,7 +221,7 @@ impl From<(MedianInterval, usize)> for IntervalRanks {
     }
 }
 
-/// One value per metric of [`METRICS`], in order (JSON: an object; an
+/// One value per metric of [`METRICS`](crate::compare::scores::METRICS), in order (JSON: an object; an
 /// infinite value, i.e. a missing one counted as the worst, is null).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stats(pub Vec<(&'static str, f64)>);

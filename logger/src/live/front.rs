@@ -24,6 +24,8 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use super::shared::Shared;
+
 /// The subprotocol name the server knows.
 const SDK_V1: &str = "foxglove.sdk.v1";
 /// The name of the same protocol in the ws-protocol specification.
@@ -38,36 +40,6 @@ pub(super) struct Front {
     addr: SocketAddr,
     shared: Arc<Shared>,
     accept: Option<JoinHandle<()>>,
-}
-
-/// What the accept thread, the connections and the guard share with the
-/// logger.
-pub(super) struct Shared {
-    pub(super) stop: AtomicBool,
-    max_clients: usize,
-    refused: AtomicU64,
-    accepted: AtomicU64,
-    /// Connections to the server's port that the relay did not make, cut.
-    pub(super) bypassed: AtomicU64,
-    /// Open client connections by number, kept to cut them at the end.
-    open: Mutex<HashMap<u64, TcpStream>>,
-    /// Local ports of the relay's own connections to the server.
-    relayed: Mutex<HashSet<u16>>,
-}
-
-impl Shared {
-    fn open(&self) -> std::sync::MutexGuard<'_, HashMap<u64, TcpStream>> {
-        self.open.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
-    fn relayed(&self) -> std::sync::MutexGuard<'_, HashSet<u16>> {
-        self.relayed.lock().unwrap_or_else(|e| e.into_inner())
-    }
-
-    /// The relay's connections to the server, by local port.
-    pub(super) fn relayed_ports(&self) -> HashSet<u16> {
-        self.relayed().clone()
-    }
 }
 
 impl Front {

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 
-use super::front::Shared;
+use super::shared::Shared;
 
 /// How often the guard looks.
 const LOOK_EVERY: Duration = Duration::from_millis(250);

@@ -18,6 +18,8 @@ mod front;
 mod guard;
 #[cfg(feature = "live")]
 mod server;
+#[cfg(feature = "live")]
+mod shared;
 
 /// The port Foxglove's own examples use, and its app's default.
 pub const DEFAULT_PORT: u16 = 8765;

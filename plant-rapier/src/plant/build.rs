@@ -3,9 +3,35 @@
 
 use rapier3d_f64::prelude::*;
 
-use super::rapier::{Coupled, Dof, pose};
+use super::shapes::pose;
 use crate::{PlantConfig, PlantError};
 use arm_model::{ArmModel, JointKind};
+
+/// Where one actuated joint lives inside the Rapier multibody.
+#[derive(Debug, Clone)]
+pub(super) struct Dof {
+    pub(super) link_id: usize,
+    pub(super) assembly_id: usize,
+    /// Index into the joint's 6-vector of coordinates (LinX = 0, AngX = 3).
+    pub(super) coord: usize,
+    pub(super) prismatic: bool,
+    pub(super) parent: RigidBodyHandle,
+    pub(super) child: RigidBodyHandle,
+    /// Joint axis in the parent body's frame.
+    pub(super) axis_in_parent: Vector,
+}
+
+/// A joint that follows a controlled one by `<mimic>`: where it lives and
+/// how it is coupled, to keep `set_state` consistent with the coupling.
+#[derive(Debug, Clone)]
+pub(super) struct Coupled {
+    pub(super) link_id: usize,
+    pub(super) assembly_id: usize,
+    pub(super) coord: usize,
+    pub(super) leader: usize,
+    pub(super) multiplier: f64,
+    pub(super) offset: f64,
+}
 
 /// Where controlled joint `ji` lives in the multibody.
 pub(super) fn dof_of(

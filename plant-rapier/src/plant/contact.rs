@@ -3,10 +3,10 @@
 //! bodies, and what the contact solver did over a period read back from
 //! Rapier's narrow phase.
 
-use arm_model::{ArmModel, Geometry};
+use arm_model::ArmModel;
 use rapier3d_f64::prelude::*;
 
-use super::rapier::pose;
+use super::shapes::{pose, shape};
 use crate::{ContactConfig, PlantError};
 
 /// Arm colliders are in group 1, obstacles in group 2, free objects in 3:
@@ -130,25 +130,6 @@ fn attach(
         colliders, bodies, ..
     } = world;
     colliders.insert_with_parent(collider, body, bodies)
-}
-
-/// A URDF primitive as a Rapier shape; cylinders and capsules along z.
-pub(super) fn shape(g: &Geometry) -> ColliderBuilder {
-    match *g {
-        Geometry::Box { size } => {
-            ColliderBuilder::cuboid(size[0] / 2.0, size[1] / 2.0, size[2] / 2.0)
-        }
-        Geometry::Sphere { radius } => ColliderBuilder::ball(radius),
-        Geometry::Capsule { radius, length } => ColliderBuilder::capsule_z(length / 2.0, radius),
-        Geometry::Cylinder { radius, length } => {
-            // Rapier's cylinder lies along y: a quarter turn about x puts it on z.
-            let turn = Pose::from_parts(
-                Vector::ZERO,
-                Rotation::from_axis_angle(Vector::X, std::f64::consts::FRAC_PI_2),
-            );
-            ColliderBuilder::compound(vec![(turn, SharedShape::cylinder(length / 2.0, radius))])
-        }
-    }
 }
 
 impl Contacts {

@@ -9,8 +9,7 @@ use arm_model::dynamics::Dynamics;
 use rapier3d_f64::parry::query;
 use rapier3d_f64::prelude::*;
 
-use super::contact::shape;
-use super::rapier::pose;
+use super::shapes::{pose, shape};
 use crate::{ContactConfig, PlantError};
 
 /// What the engine itself checks when it builds the colliders (the rest

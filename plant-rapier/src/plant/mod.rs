@@ -11,6 +11,7 @@ mod contact;
 mod contact_check;
 mod motor;
 mod rapier;
+mod shapes;
 
 use articulated::{Articulated, Drive, Setup, Springs, Stage};
 use motor::Motors;

@@ -3,40 +3,15 @@
 //! checked against, and the engine to reach for when Rapier's own joint
 //! constraints are what is being studied.
 
-use rapier3d_f64::glamx::EulerRot;
 use rapier3d_f64::prelude::*;
 
 use super::articulated::{Drive, Stage};
-use super::build::{couple_mimics, dof_of, insert_bodies, insert_joints, joint_dynamics, settle};
+use super::build::{
+    Coupled, Dof, couple_mimics, dof_of, insert_bodies, insert_joints, joint_dynamics, settle,
+};
 use super::contact::{self, ContactReading, Contacts};
 use crate::{PlantConfig, PlantError};
-use arm_model::{ArmModel, Origin};
-
-/// Where one actuated joint lives inside the Rapier multibody.
-#[derive(Debug, Clone)]
-pub(super) struct Dof {
-    pub(super) link_id: usize,
-    pub(super) assembly_id: usize,
-    /// Index into the joint's 6-vector of coordinates (LinX = 0, AngX = 3).
-    pub(super) coord: usize,
-    pub(super) prismatic: bool,
-    pub(super) parent: RigidBodyHandle,
-    pub(super) child: RigidBodyHandle,
-    /// Joint axis in the parent body's frame.
-    pub(super) axis_in_parent: Vector,
-}
-
-/// A joint that follows a controlled one by `<mimic>`: where it lives and
-/// how it is coupled, to keep `set_state` consistent with the coupling.
-#[derive(Debug, Clone)]
-pub(super) struct Coupled {
-    pub(super) link_id: usize,
-    pub(super) assembly_id: usize,
-    pub(super) coord: usize,
-    pub(super) leader: usize,
-    pub(super) multiplier: f64,
-    pub(super) offset: f64,
-}
+use arm_model::ArmModel;
 
 /// An arm simulated by Rapier in double precision.
 pub(crate) struct RapierArm {
@@ -55,13 +30,6 @@ pub(crate) struct RapierArm {
     contacts: Option<Contacts>,
     /// What contact did over the last period.
     contact: Option<ContactReading>,
-}
-
-pub(super) fn pose(o: &Origin) -> Pose {
-    Pose::from_parts(
-        Vector::new(o.xyz[0], o.xyz[1], o.xyz[2]),
-        Rotation::from_euler(EulerRot::ZYX, o.rpy[2], o.rpy[1], o.rpy[0]),
-    )
 }
 
 impl RapierArm {

@@ -3,23 +3,9 @@
 //! [`MAX_RUNS`] runs, and every `[set]` and axis value valid for the
 //! scenario (#31: each of these once aborted, overflowed or mislabelled).
 
-use super::{MAX_KEY_PARTS, MAX_RUNS, SweepFile, SweepFileError, set_key};
+use super::{MAX_RUNS, SweepFile, SweepFileError};
+use crate::keys::{check_key_shape, set_key};
 use crate::{Plan, Scenario};
-
-/// A dotted scenario key of at most [`MAX_KEY_PARTS`] non-empty parts.
-pub(crate) fn check_key_shape(key: &str) -> Result<(), String> {
-    let parts = key.split('.').take(MAX_KEY_PARTS + 1).collect::<Vec<_>>();
-    if parts.len() > MAX_KEY_PARTS {
-        let shown: String = key.chars().take(40).collect();
-        return Err(format!(
-            "'{shown}…' has more than {MAX_KEY_PARTS} dotted parts; scenario keys have at most 3"
-        ));
-    }
-    if parts.iter().any(|p| p.is_empty()) {
-        return Err(format!("'{key}' is not a dotted scenario key"));
-    }
-    Ok(())
-}
 
 /// Refuses what would make runs that are not what their labels say, or
 /// identical runs counted as distinct: a law fixed beside `laws`, a seed
@@ -118,7 +104,7 @@ pub(super) fn check_key(
         Ok(toml::Value::Table(t)) => t,
         _ => return Err(bad("cannot write the base scenario".into())),
     };
-    set_key(&mut tree, key, value).map_err(bad)?;
+    set_key(&mut tree, key, value).map_err(|e| bad(e.to_string()))?;
     let text = toml::to_string(&tree).map_err(|e| bad(e.to_string()))?;
     match toml::from_str::<Scenario>(&text) {
         Ok(_) => Ok(()),

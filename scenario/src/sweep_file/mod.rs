@@ -12,7 +12,9 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 pub(crate) mod checks;
-use checks::{check_distinct, check_key, check_key_shape, count_runs};
+pub use crate::keys::MAX_KEY_PARTS;
+use crate::keys::set_key;
+use checks::{check_distinct, check_key, count_runs};
 
 /// Files a sweep reads (sweep files, manifests, results) larger than this
 /// are refused rather than read.
@@ -54,10 +56,6 @@ pub enum SweepFileError {
 /// they end (measured: docs/results.md), where 10⁶ took 10 GB and 7
 /// minutes before the first began. A larger study is several sweeps.
 pub const MAX_RUNS: usize = 100_000;
-
-/// Parts a dotted scenario key may have: the deepest scenario key has 3
-/// (`plant.payload.mass`); a longer one is refused before it is built.
-pub const MAX_KEY_PARTS: usize = 8;
 
 /// A sweep file as written.
 #[derive(Debug, Clone, Deserialize)]
@@ -223,32 +221,6 @@ impl Axis {
         }
         Ok(out)
     }
-}
-
-/// Sets the dotted `key` in a scenario's TOML tree, creating tables.
-pub(crate) fn set_key(root: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
-    check_key_shape(key)?;
-    let parts: Vec<&str> = key.split('.').collect();
-    let mut table = root;
-    for (i, part) in parts.iter().enumerate() {
-        if i + 1 == parts.len() {
-            table.insert((*part).to_string(), value);
-            return Ok(());
-        }
-        let entry = table
-            .entry((*part).to_string())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        table = match entry {
-            toml::Value::Table(t) => t,
-            _ => {
-                return Err(format!(
-                    "'{}' is a value, not a table",
-                    parts[..=i].join(".")
-                ));
-            }
-        };
-    }
-    Ok(())
 }
 
 /// Reads and expands the sweep file at `path`: every run's plan is built
@@ -440,7 +412,7 @@ fn resolve(
         reason: format!("{key}: {reason}"),
     };
     for (key, value) in sets.chain(cell.iter().cloned()) {
-        set_key(&mut tree, &key, value).map_err(|r| what(&key, r))?;
+        set_key(&mut tree, &key, value).map_err(|r| what(&key, r.to_string()))?;
     }
     let label = format!("{file} ({law}, seed {})", scenario.seed);
     let toml_text = toml::to_string(&tree).map_err(|e| what("scenario", e.to_string()))?;

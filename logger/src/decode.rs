@@ -1,0 +1,20 @@
+//! A logged message back from its data, whatever the log's format: JSON
+//! (formats 1 and 2, [`crate::json`]) or CDR (format 3, [`crate::ros2`]).
+
+use crate::decode_error::DecodeError;
+use crate::json::LogMessage;
+use crate::reader::Encoding;
+
+/// Every logged message decodes from either encoding.
+pub trait Decode: LogMessage {
+    /// The message back from a log's data in `encoding` (JSON in log
+    /// formats 1 and 2, CDR from format 3).
+    fn decode_as(encoding: Encoding, data: &[u8]) -> Result<Self, DecodeError> {
+        match encoding {
+            Encoding::Json => Self::parse(data),
+            Encoding::Cdr => crate::ros2::decode(data),
+        }
+    }
+}
+
+impl<M: LogMessage> Decode for M {}
