@@ -29,7 +29,7 @@ use std::time::Duration;
 use bus::{NodeLink, ReferenceWindow, RunPrefix, monotonic_ns, read_config};
 use controller::node::ControllerNodeConfig;
 use wire::{
-    Command, ControllerDiagnostics, JointState, Mode, NodeKind, OwnDiagnostics, STATE_FINAL, Topic,
+    Command, ControllerDiagnostics, JointState, Mode, NodeKind, OwnDiagnostics, STATE_FINAL,
 };
 
 /// The declared defaults of the law's own parameters.
@@ -82,21 +82,16 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     };
     let (kp, kd) = (own("kp", KP), own("kd", KD));
     let mut link = NodeLink::connect(NodeKind::Controller, &prefix, None, mode)?;
-    let states = link.bus.subscriber::<JointState>(Topic::JointState)?;
+    let states = link.bus.subscriber::<JointState>()?;
     let mut references = ReferenceWindow::new(&link, mode, config.reference_period())?;
-    let commands = link
-        .bus
-        .publisher::<Command>(Topic::Command, mode.delivery())?;
+    let commands = link.bus.publisher::<Command>(mode.delivery())?;
     let diagnostics = link
         .bus
-        .publisher::<ControllerDiagnostics>(Topic::Diagnostics, mode.delivery())?;
+        .publisher::<ControllerDiagnostics>(mode.delivery())?;
     // Its own diagnostic, only when the launcher laid it out (a run by
     // hand with --external declared nothing, and the log expects nothing).
     let own = if config.own_diagnostics == "error_norm:scalar" {
-        Some(
-            link.bus
-                .publisher::<OwnDiagnostics>(Topic::OwnDiagnostics, mode.delivery())?,
-        )
+        Some(link.bus.publisher::<OwnDiagnostics>(mode.delivery())?)
     } else {
         None
     };

@@ -7,9 +7,7 @@ use std::io::Write;
 use std::path::Path;
 
 use scenario::{Plan, RobotSource, Scenario};
-use wire::{
-    Command, ControllerDiagnostics, JointState, OwnDiagnostics, OwnLayout, ReferenceSample, Timing,
-};
+use wire::{Logged, OwnLayout, Timing};
 
 use crate::own::{OwnDiagnosticSummary, OwnStats};
 
@@ -19,10 +17,7 @@ use crate::data_path::DataPath;
 use crate::summary::{Summary, SummaryBuilder};
 use crate::timing::{RunFacts, TimingStats, TimingSummary, judge};
 use crate::verify::Verifier;
-use logger::{
-    Decode, DecodeError, Encoding, LogContents, LogError, LogMessage, MessageError, read_log,
-    read_log_head,
-};
+use logger::{DecodeError, Encoding, LogContents, LogError, MessageError, read_log, read_log_head};
 use wire::Mode;
 
 /// Why a log could not be analysed.
@@ -238,9 +233,10 @@ struct Analyser<'a, 'o> {
 
 impl Analyser<'_, '_> {
     fn on_message(&mut self, topic: &str, enc: Encoding, v: &[u8]) -> Result<(), MessageError> {
-        match topic {
-            t if t == JointState::LOG_TOPIC => {
-                let s = JointState::decode_as(enc, v)?;
+        // Every logged message has its arm: the match is over the wire's
+        // one list of them.
+        match logger::decode_logged(topic, enc, v)? {
+            Some(Logged::JointState(s)) => {
                 check_dof(s.dof, self.n)?;
                 self.wall = (
                     self.wall.0.min(s.header.wall_ns),
@@ -252,24 +248,21 @@ impl Analyser<'_, '_> {
                 self.data_path.add_state(&s);
                 self.assembler.push_state(s);
             }
-            t if t == ControllerDiagnostics::LOG_TOPIC => {
-                let d = ControllerDiagnostics::decode_as(enc, v)?;
+            Some(Logged::ControllerDiagnostics(d)) => {
                 check_dof(d.dof, self.n)?;
                 if let Some(ver) = self.verifier.as_mut() {
                     ver.push_diag(d);
                 }
                 self.assembler.push_diag(d);
             }
-            t if t == Command::LOG_TOPIC => {
-                let c = Command::decode_as(enc, v)?;
+            Some(Logged::Command(c)) => {
                 self.data_path.add_command(&c);
                 if let Some(ver) = self.verifier.as_mut() {
                     ver.push_command(c);
                 }
             }
-            t if t == Timing::LOG_TOPIC => self.on_timing(&Timing::decode_as(enc, v)?),
-            t if t == OwnDiagnostics::LOG_TOPIC => {
-                let o = OwnDiagnostics::decode_as(enc, v)?;
+            Some(Logged::Timing(t)) => self.on_timing(&t),
+            Some(Logged::OwnDiagnostics(o)) => {
                 if o.count as usize != self.own_len {
                     return Err(DecodeError(format!(
                         "{} values where the run's controller_diagnostics declares {}",
@@ -279,13 +272,13 @@ impl Analyser<'_, '_> {
                 }
                 self.assembler.push_own(o);
             }
-            t if t == ReferenceSample::LOG_TOPIC => {
-                ReferenceSample::decode_as(enc, v)?;
-            }
+            // Decoded (a damaged one fails the log) but not analysed: the
+            // reference is in the diagnostics, contact in the effect bits.
+            Some(Logged::ReferenceSample(_) | Logged::ContactState(_)) => {}
             // The arm's frames and figure, the standard views: not
             // analysed, but a log whose message is not JSON (formats 1 and
             // 2) or CDR (format 3) is damaged there.
-            _ => logger::check_message(enc, v)?,
+            None => logger::check_message(enc, v)?,
         }
         let (summary, series, csv) = (&mut self.summary, &mut self.series, &mut self.csv);
         let own = &mut self.own;

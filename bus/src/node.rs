@@ -11,7 +11,7 @@ use crate::{
 };
 use wire::{
     CONTROL_START, CONTROL_STOP, Control, Delivery, HEARTBEAT, Header, Mode, NODE_DONE,
-    NODE_FAILED, NODE_READY, NODE_RUNNING, NodeKind, NodeStatus, Topic,
+    NODE_FAILED, NODE_READY, NODE_RUNNING, NodeKind, NodeStatus,
 };
 
 /// Why a node stopped.
@@ -60,8 +60,8 @@ impl NodeLink {
         mode: Mode,
     ) -> Result<Self, WireError> {
         let bus = Bus::new(prefix, kind.name())?;
-        let status = bus.publisher(Topic::Status, Delivery::DropWhenFull)?;
-        let control = bus.subscriber(Topic::Control)?;
+        let status = bus.publisher(Delivery::DropWhenFull)?;
+        let control = bus.subscriber()?;
         Ok(Self {
             bus,
             kind,

@@ -14,7 +14,7 @@ use std::collections::VecDeque;
 use std::time::Duration;
 
 use crate::{NodeError, NodeLink, TopicSubscriber};
-use wire::{Mode, ReferenceSample, Topic, is_stale};
+use wire::{Mode, ReferenceSample, is_stale};
 
 /// The reference topic and the samples received but not yet passed.
 pub struct ReferenceWindow {
@@ -30,7 +30,7 @@ impl ReferenceWindow {
     /// reference samples come every `period_ns`.
     pub fn new(link: &NodeLink, mode: Mode, period_ns: u64) -> Result<Self, NodeError> {
         Ok(Self {
-            sub: link.bus.subscriber(Topic::Reference)?,
+            sub: link.bus.subscriber()?,
             recent: VecDeque::with_capacity(2048),
             wait_for_final: mode == Mode::Lockstep,
             period_ns: period_ns.max(1),

@@ -18,7 +18,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use crate::connections::{CONNECTION_FAILED, degraded};
 use iceoryx2::prelude::*;
 use wire::{
-    Delivery, Header, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, MessageFields,
+    Bound, Delivery, Header, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, MessageFields,
     SUBSCRIBER_BUFFER, Topic,
 };
 
@@ -271,12 +271,13 @@ impl Bus {
             .map_err(|e| ipc("open event", topic.name())(format!("{e:?}")))
     }
 
-    /// A publisher on `topic`.
-    pub fn publisher<T: Debug + ZeroCopySend + MessageFields + 'static>(
+    /// A publisher of `T` on its topic ([`wire::Bound::TOPIC`]): the
+    /// message type alone says where it goes.
+    pub fn publisher<T: Debug + ZeroCopySend + Bound + 'static>(
         &self,
-        topic: Topic,
         delivery: Delivery,
     ) -> Result<TopicPublisher<T>, WireError> {
+        let topic = T::TOPIC;
         let service = self.service::<T>(topic)?;
         let builder = service
             .publisher_builder()
@@ -316,22 +317,20 @@ impl Bus {
         })
     }
 
-    /// A subscriber on `topic` that can block until a sample arrives
+    /// A subscriber of `T` on its topic that can block until a sample arrives
     /// ([`TopicSubscriber::wait_event`]); only topics with waiters have
     /// wake-ups ([`Topic::has_waiters`]).
-    pub fn subscriber<T: Debug + ZeroCopySend + MessageFields + 'static>(
+    pub fn subscriber<T: Debug + ZeroCopySend + Bound + 'static>(
         &self,
-        topic: Topic,
     ) -> Result<TopicSubscriber<T>, WireError> {
-        self.subscriber_with(topic, topic.has_waiters())
+        self.subscriber_with(T::TOPIC, T::TOPIC.has_waiters())
     }
 
     /// A subscriber read by polling: no listener, so publishers do not wake it.
-    pub fn polling_subscriber<T: Debug + ZeroCopySend + MessageFields + 'static>(
+    pub fn polling_subscriber<T: Debug + ZeroCopySend + Bound + 'static>(
         &self,
-        topic: Topic,
     ) -> Result<TopicSubscriber<T>, WireError> {
-        self.subscriber_with(topic, false)
+        self.subscriber_with(T::TOPIC, false)
     }
 
     fn subscriber_with<T: Debug + ZeroCopySend + MessageFields + 'static>(
@@ -466,10 +465,8 @@ mod tests {
     fn a_resent_sample_is_received_once() {
         let prefix = RunPrefix::unique();
         let bus = Bus::new(&prefix, "resend-test").unwrap();
-        let publisher = bus
-            .publisher::<Timing>(Topic::Timing, Delivery::Lossless)
-            .unwrap();
-        let subscriber = bus.polling_subscriber::<Timing>(Topic::Timing).unwrap();
+        let publisher = bus.publisher::<Timing>(Delivery::Lossless).unwrap();
+        let subscriber = bus.polling_subscriber::<Timing>().unwrap();
         let sample = |seq| Timing {
             header: Header {
                 seq,

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use bus::{NodeError, NodeLink, ReferenceWindow, monotonic_ns};
 use serde::{Deserialize, Serialize};
-use wire::{Command, ControllerDiagnostics, JointState, Mode, STATE_FINAL, Topic};
+use wire::{Command, ControllerDiagnostics, JointState, Mode, STATE_FINAL};
 
 use arm_model::{ArmModel, Locks};
 
@@ -111,13 +111,11 @@ pub fn run(
     mode: Mode,
 ) -> Result<(), ControllerNodeError> {
     let mut m = config.machine()?;
-    let states = link.bus.subscriber::<JointState>(Topic::JointState)?;
-    let commands = link
-        .bus
-        .publisher::<Command>(Topic::Command, mode.delivery())?;
+    let states = link.bus.subscriber::<JointState>()?;
+    let commands = link.bus.publisher::<Command>(mode.delivery())?;
     let diagnostics = link
         .bus
-        .publisher::<ControllerDiagnostics>(Topic::Diagnostics, mode.delivery())?;
+        .publisher::<ControllerDiagnostics>(mode.delivery())?;
     let mut reference = ReferenceWindow::new(link, mode, config.reference_period())?;
     link.ready_and_wait_for_start()?;
 

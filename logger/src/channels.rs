@@ -3,11 +3,6 @@
 //! topics with the same schemas (and one Foxglove layout serves both).
 //! Every channel carries CDR messages with a `ros2msg` schema ([`crate::ros2`]).
 
-use wire::{
-    Command, ContactState, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample,
-    Timing,
-};
-
 use crate::LogMessage;
 use crate::obstacles::CONTACT_MARKER_TOPIC;
 use crate::ros2;
@@ -56,16 +51,16 @@ impl ChannelSpec {
     }
 }
 
-/// Every channel of a run, in the order the log opens them.
+/// Every channel of a run, in the order the log opens them: the wire's
+/// logged messages ([`wire::logged_messages!`]), then the standard views.
 pub fn channels() -> Vec<ChannelSpec> {
-    vec![
-        ChannelSpec::of::<JointState>(),
-        ChannelSpec::of::<ReferenceSample>(),
-        ChannelSpec::of::<Command>(),
-        ChannelSpec::of::<ControllerDiagnostics>(),
-        ChannelSpec::of::<Timing>(),
-        ChannelSpec::of::<OwnDiagnostics>(),
-        ChannelSpec::of::<ContactState>(),
+    macro_rules! logged {
+        ($($ty:ident => $topic:ident, $channel:literal, $schema:literal;)*) => {
+            vec![$(ChannelSpec::of::<wire::$ty>(),)*]
+        };
+    }
+    let mut all = wire::logged_messages!(logged);
+    all.extend([
         ChannelSpec::standard(
             JOINT_STATES_TOPIC,
             ros2::JOINT_STATE,
@@ -83,5 +78,6 @@ pub fn channels() -> Vec<ChannelSpec> {
             ros2::MARKER_ARRAY,
             ros2::marker_array_schema(),
         ),
-    ]
+    ]);
+    all
 }

@@ -4,6 +4,7 @@
 use crate::decode_error::DecodeError;
 use crate::json::LogMessage;
 use crate::reader::Encoding;
+use wire::Logged;
 
 /// Every logged message decodes from either encoding.
 pub trait Decode: LogMessage {
@@ -18,3 +19,22 @@ pub trait Decode: LogMessage {
 }
 
 impl<M: LogMessage> Decode for M {}
+
+/// A logged message from its channel's `topic`, its encoding and its data;
+/// None for a channel that is not one of the wire's logged messages (the
+/// standard views: `/tf`, `/joint_states`, the markers).
+pub fn decode_logged(
+    topic: &str,
+    encoding: Encoding,
+    data: &[u8],
+) -> Result<Option<Logged>, DecodeError> {
+    macro_rules! arms {
+        ($($ty:ident => $topic:ident, $channel:literal, $schema:literal;)*) => {
+            match topic {
+                $($channel => wire::$ty::decode_as(encoding, data).map(Logged::from),)*
+                _ => return Ok(None),
+            }
+        };
+    }
+    wire::logged_messages!(arms).map(Some)
+}

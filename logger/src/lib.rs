@@ -50,7 +50,7 @@ pub use channels::{
     SCHEMA_ENCODING, channels,
 };
 pub use compression::LogCompression;
-pub use decode::Decode;
+pub use decode::{Decode, decode_logged};
 pub use decode_error::DecodeError;
 pub use json::LogMessage;
 pub use json_object::JsonObject;

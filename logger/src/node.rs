@@ -10,10 +10,7 @@ use std::time::Duration;
 
 use bus::{NodeError, NodeLink, TopicSubscriber};
 use serde::{Deserialize, Serialize};
-use wire::{
-    Command, ContactState, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample,
-    Timing,
-};
+use wire::Logged;
 
 use crate::live::{LiveConfig, LiveError};
 use crate::outputs::Outputs;
@@ -89,22 +86,24 @@ struct Sub<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> {
     count: TopicCount,
 }
 
-impl<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> Sub<M> {
-    /// Subscribes to the message's topic (the wire's binding table).
-    fn new(link: &NodeLink) -> Result<Self, LoggerNodeError> {
-        Ok(Self {
-            sub: link.bus.polling_subscriber(<M as wire::Bound>::TOPIC)?,
-            count: TopicCount::default(),
-        })
-    }
+/// A subscription to one logged message, whatever its type.
+trait Drain {
+    /// Takes every sample waiting into `out`.
+    fn drain(&mut self, out: &mut Outputs) -> Result<(), LoggerNodeError>;
+    /// Its counts, for the log's stats.
+    fn stats(&self, out: &mut BTreeMap<String, String>);
+    /// Its topic.
+    fn topic(&self) -> wire::Topic;
+}
 
-    fn drain(
-        &mut self,
-        mut take: impl FnMut(&M) -> Result<(), LogError>,
-    ) -> Result<(), LoggerNodeError> {
+impl<M> Drain for Sub<M>
+where
+    M: LogMessage + Into<Logged> + std::fmt::Debug + wire::ZeroCopySend + 'static,
+{
+    fn drain(&mut self, out: &mut Outputs) -> Result<(), LoggerNodeError> {
         while let Some(m) = self.sub.receive()? {
             self.count.add(m.header().seq);
-            take(&m)?;
+            out.take_logged(&m.into())?;
         }
         let _ = self.sub.drain_events();
         Ok(())
@@ -115,43 +114,45 @@ impl<M: LogMessage + std::fmt::Debug + wire::ZeroCopySend + 'static> Sub<M> {
         out.insert(format!("{name}.received"), self.count.received.to_string());
         out.insert(format!("{name}.dropped"), self.count.dropped.to_string());
     }
+
+    fn topic(&self) -> wire::Topic {
+        M::TOPIC
+    }
 }
 
-struct Subs {
-    state: Sub<JointState>,
-    reference: Sub<ReferenceSample>,
-    command: Sub<Command>,
-    diag: Sub<ControllerDiagnostics>,
-    own: Sub<OwnDiagnostics>,
-    timing: Sub<Timing>,
-    contact: Sub<ContactState>,
-}
+/// A subscription to each of the wire's logged messages
+/// ([`wire::logged_messages!`]).
+struct Subs(Vec<Box<dyn Drain>>);
 
 impl Subs {
-    fn drain(&mut self, out: &mut Outputs) -> Result<(), LoggerNodeError> {
+    fn new(link: &NodeLink) -> Result<Self, LoggerNodeError> {
+        macro_rules! subscribe {
+            ($($ty:ident => $topic:ident, $channel:literal, $schema:literal;)*) => {
+                vec![$(Box::new(Sub::<wire::$ty> {
+                    sub: link.bus.polling_subscriber()?,
+                    count: TopicCount::default(),
+                }) as Box<dyn Drain>,)*]
+            };
+        }
+        let mut subs = wire::logged_messages!(subscribe);
         // Timing first. Drained last, it lost 19 samples right after its
         // buffer's 2048th, in 2 of 8 lockstep runs on a loaded machine, even
         // though its publisher is lossless (retry until delivered). The
         // logger counted them as dropped. Drained first, no run of 32 lost
         // any. The cause inside iceoryx2 is not found yet.
-        self.timing.drain(|m| out.take(m))?;
-        self.contact.drain(|m| out.take_contact(m))?;
-        self.state.drain(|m| out.take_state(m))?;
-        self.reference.drain(|m| out.take(m))?;
-        self.command.drain(|m| out.take_command(m))?;
-        self.diag.drain(|m| out.take(m))?;
-        self.own.drain(|m| out.take(m))
+        subs.sort_by_key(|s| s.topic() != wire::Topic::Timing);
+        Ok(Self(subs))
+    }
+
+    fn drain(&mut self, out: &mut Outputs) -> Result<(), LoggerNodeError> {
+        self.0.iter_mut().try_for_each(|s| s.drain(out))
     }
 
     fn stats(&self) -> BTreeMap<String, String> {
         let mut out = BTreeMap::new();
-        self.state.stats(&mut out);
-        self.reference.stats(&mut out);
-        self.command.stats(&mut out);
-        self.diag.stats(&mut out);
-        self.own.stats(&mut out);
-        self.timing.stats(&mut out);
-        self.contact.stats(&mut out);
+        for s in &self.0 {
+            s.stats(&mut out);
+        }
         out
     }
 }
@@ -171,15 +172,7 @@ fn run_end(link: &NodeLink, result: &Result<(), LoggerNodeError>) -> String {
 
 /// Runs the logger node to the end of the run.
 pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerNodeError> {
-    let mut subs = Subs {
-        state: Sub::new(link)?,
-        reference: Sub::new(link)?,
-        command: Sub::new(link)?,
-        diag: Sub::new(link)?,
-        own: Sub::new(link)?,
-        timing: Sub::new(link)?,
-        contact: Sub::new(link)?,
-    };
+    let mut subs = Subs::new(link)?;
     let model = arm_model::ArmModel::from_urdf_str_locked(&config.urdf, &config.lock)?;
     // The live view first: a taken port fails the run before anything is
     // written.

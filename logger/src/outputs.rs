@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 
 use arm_model::ArmModel;
-use wire::{Command, ContactState, JointState};
+use wire::{Command, ContactState, JointState, Logged};
 
 use crate::obstacles::{CONTACT_MARKER_TOPIC, DrawnObstacle, contact_marker};
 
@@ -86,8 +86,21 @@ impl Outputs {
         })
     }
 
+    /// One logged message, and the views it is drawn in.
+    pub(crate) fn take_logged(&mut self, m: &Logged) -> Result<(), LogError> {
+        match m {
+            Logged::JointState(s) => self.take_state(s),
+            Logged::Command(c) => self.take_command(c),
+            Logged::ContactState(c) => self.take_contact(c),
+            Logged::ReferenceSample(m) => self.take(m),
+            Logged::ControllerDiagnostics(m) => self.take(m),
+            Logged::Timing(m) => self.take(m),
+            Logged::OwnDiagnostics(m) => self.take(m),
+        }
+    }
+
     /// One sample of any topic.
-    pub(crate) fn take<M: LogMessage>(&mut self, msg: &M) -> Result<(), LogError> {
+    fn take<M: LogMessage>(&mut self, msg: &M) -> Result<(), LogError> {
         let data = self.log.write(msg)?;
         if let Some(live) = self.live.as_mut() {
             live.offer(M::LOG_TOPIC, msg.header().t_ns, data);

@@ -8,7 +8,7 @@ use std::time::Duration;
 use bus::clock;
 use bus::{NodeError, NodeLink, TopicPublisher, TopicSubscriber, monotonic_ns};
 use serde::{Deserialize, Serialize};
-use wire::{Command, ContactState, JointState, Mode, NODE_RUNNING, Timing, Topic};
+use wire::{Command, ContactState, JointState, Mode, NODE_RUNNING, Timing};
 
 use crate::{ArmModel, PlantConfig, PlantError, PlantMachine};
 
@@ -108,11 +108,11 @@ pub fn run(
     };
     let mut m = config.machine().map_err(plant_err)?;
     let ports = Ports {
-        state: link.bus.publisher(Topic::JointState, mode.delivery())?,
-        timing: link.bus.publisher(Topic::Timing, mode.delivery())?,
-        command: link.bus.subscriber(Topic::Command)?,
+        state: link.bus.publisher(mode.delivery())?,
+        timing: link.bus.publisher(mode.delivery())?,
+        command: link.bus.subscriber()?,
         contact: match m.has_contact() {
-            true => Some(link.bus.publisher(Topic::Contact, mode.delivery())?),
+            true => Some(link.bus.publisher(mode.delivery())?),
             false => None,
         },
     };

@@ -30,8 +30,6 @@ fn lockstep_run(dir: &Path, duration: &str) -> (serde_json::Value, PathBuf) {
 /// message per step on each step topic.
 #[test]
 fn log_is_complete_ros2_mcap_whose_messages_decode() {
-    use logger::{Decode, LogMessage};
-    use wire::{Command, ControllerDiagnostics, JointState, ReferenceSample, Timing};
     let dir = tempfile::tempdir().unwrap();
     let (run, log) = lockstep_run(dir.path(), "0.5");
     let buf = std::fs::read(&log).unwrap();
@@ -66,23 +64,14 @@ fn log_is_complete_ros2_mcap_whose_messages_decode() {
     for msg in mcap::MessageStream::new(&buf).unwrap() {
         let msg = msg.unwrap();
         let enc = logger::Encoding::Cdr;
-        let header = match msg.channel.topic.as_str() {
-            t if t == JointState::LOG_TOPIC => {
-                JointState::decode_as(enc, &msg.data).map(|m| m.header)
-            }
-            t if t == ReferenceSample::LOG_TOPIC => {
-                ReferenceSample::decode_as(enc, &msg.data).map(|m| m.header)
-            }
-            t if t == Command::LOG_TOPIC => Command::decode_as(enc, &msg.data).map(|m| m.header),
-            t if t == ControllerDiagnostics::LOG_TOPIC => {
-                ControllerDiagnostics::decode_as(enc, &msg.data).map(|m| m.header)
-            }
-            t if t == Timing::LOG_TOPIC => Timing::decode_as(enc, &msg.data).map(|m| m.header),
-            _ => {
+        let header = match logger::decode_logged(&msg.channel.topic, enc, &msg.data) {
+            Ok(Some(m)) => Ok(*m.header()),
+            Ok(None) => {
                 logger::check_message(enc, &msg.data).unwrap();
                 seen += 1;
                 continue;
             }
+            Err(e) => Err(e),
         };
         let header =
             header.unwrap_or_else(|e| panic!("{} {}: {e}", msg.channel.topic, msg.sequence));

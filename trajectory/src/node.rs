@@ -13,7 +13,7 @@ use std::time::Duration;
 use bus::clock;
 use bus::{NodeError, NodeLink, monotonic_ns};
 use serde::{Deserialize, Serialize};
-use wire::{JointState, Mode, ReferenceSample, Topic};
+use wire::{JointState, Mode, ReferenceSample};
 
 use crate::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError, TrajectoryMachine};
 
@@ -80,14 +80,9 @@ pub fn run(
     mode: Mode,
 ) -> Result<(), TrajectoryNodeError> {
     let mut m = config.machine()?;
-    let out = link
-        .bus
-        .publisher::<ReferenceSample>(Topic::Reference, mode.delivery())?;
+    let out = link.bus.publisher::<ReferenceSample>(mode.delivery())?;
     let states = match mode {
-        Mode::Lockstep => Some(
-            link.bus
-                .polling_subscriber::<JointState>(Topic::JointState)?,
-        ),
+        Mode::Lockstep => Some(link.bus.polling_subscriber::<JointState>()?),
         Mode::Realtime => None,
     };
     let epoch = link.ready_and_wait_for_start()?;

@@ -21,34 +21,102 @@ pub trait Bound: MessageFields {
     const STRUCT: &'static str;
 }
 
-macro_rules! bind {
-    ($($ty:ident => $topic:ident, $channel:expr, $schema:literal;)*) => {
+/// The logged messages, declared once: calls `$then!` with one row per
+/// message (`Type => TopicVariant, "/channel", "schema";`, the type a
+/// name in `wire`: a caller outside it writes `wire::$ty`), in the order
+/// the log opens their channels. The wire binds them here ([`Bound`],
+/// [`Logged`]); the logger subscribes to each and opens its channel, and
+/// the log's reader decodes each ([`Logged`] is matched exhaustively), all
+/// from this one list. A message added here is logged and read, or the
+/// code that must handle it does not compile.
+#[macro_export]
+macro_rules! logged_messages {
+    ($then:ident) => {
+        $then! {
+            JointState => JointState, "/joint_state", "testbed.JointState";
+            ReferenceSample => Reference, "/reference", "testbed.Reference";
+            Command => Command, "/command", "testbed.Command";
+            ControllerDiagnostics => Diagnostics, "/controller/diagnostics", "testbed.ControllerDiagnostics";
+            Timing => Timing, "/timing", "testbed.Timing";
+            OwnDiagnostics => OwnDiagnostics, "/controller/own_diagnostics", "testbed.OwnDiagnostics";
+            ContactState => Contact, "/contact", "testbed.ContactState";
+        }
+    };
+}
+
+macro_rules! bind_logged {
+    ($($ty:ident => $topic:ident, $channel:literal, $schema:literal;)*) => {
         $(impl Bound for $ty {
             const TOPIC: Topic = Topic::$topic;
-            const CHANNEL: Option<&'static str> = $channel;
+            const CHANNEL: Option<&'static str> = Some($channel);
             const SCHEMA: &'static str = $schema;
             const STRUCT: &'static str = stringify!($ty);
         })*
 
-        /// The structure name of the message a topic carries.
-        pub fn struct_of(topic: Topic) -> &'static str {
-            match topic {
-                $(Topic::$topic => stringify!($ty),)*
+        /// One logged message of any type ([`logged_messages!`]'s list).
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        #[allow(
+            clippy::large_enum_variant,
+            reason = "one message at a time, on the stack: boxing would allocate for every sample logged or read"
+        )]
+        pub enum Logged {
+            $(
+                #[doc = concat!("A `", stringify!($ty), "` (", $channel, ").")]
+                $ty($ty),
+            )*
+        }
+
+        $(impl From<$ty> for Logged {
+            fn from(m: $ty) -> Self {
+                Self::$ty(m)
+            }
+        })*
+
+        impl Logged {
+            /// Every logged message's channel, in the list's order.
+            pub const CHANNELS: &'static [&'static str] = &[$($channel),*];
+
+            /// The message's header.
+            pub fn header(&self) -> &crate::Header {
+                match self {
+                    $(Self::$ty(m) => &m.header,)*
+                }
             }
         }
     };
 }
 
-bind! {
-    JointState => JointState, Some("/joint_state"), "testbed.JointState";
-    ReferenceSample => Reference, Some("/reference"), "testbed.Reference";
-    Command => Command, Some("/command"), "testbed.Command";
-    ControllerDiagnostics => Diagnostics, Some("/controller/diagnostics"), "testbed.ControllerDiagnostics";
-    OwnDiagnostics => OwnDiagnostics, Some("/controller/own_diagnostics"), "testbed.OwnDiagnostics";
-    Timing => Timing, Some("/timing"), "testbed.Timing";
-    ContactState => Contact, Some("/contact"), "testbed.ContactState";
-    Control => Control, None, "testbed.Control";
-    NodeStatus => Status, None, "testbed.NodeStatus";
+logged_messages!(bind_logged);
+
+/// Messages that stay on the bus (the nodes' protocol), never logged.
+macro_rules! bind_unlogged {
+    ($($ty:ident => $topic:ident, $schema:literal;)*) => {
+        $(impl Bound for $ty {
+            const TOPIC: Topic = Topic::$topic;
+            const CHANNEL: Option<&'static str> = None;
+            const SCHEMA: &'static str = $schema;
+            const STRUCT: &'static str = stringify!($ty);
+        })*
+    };
+}
+
+bind_unlogged! {
+    Control => Control, "testbed.Control";
+    NodeStatus => Status, "testbed.NodeStatus";
+}
+
+/// The structure name of the message a topic carries.
+pub fn struct_of(topic: Topic) -> &'static str {
+    macro_rules! logged_arms {
+        ($($ty:ident => $topic:ident, $channel:literal, $schema:literal;)*) => {
+            match topic {
+                $(Topic::$topic => stringify!($ty),)*
+                Topic::Control => <Control as Bound>::STRUCT,
+                Topic::Status => <NodeStatus as Bound>::STRUCT,
+            }
+        };
+    }
+    logged_messages!(logged_arms)
 }
 
 #[cfg(test)]

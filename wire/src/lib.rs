@@ -41,7 +41,7 @@ mod protocol;
 mod reference_rule;
 mod topic;
 
-pub use binding::{Bound, struct_of};
+pub use binding::{Bound, Logged, struct_of};
 pub use effects::Effects;
 pub use faults::Fault;
 pub use fields::{FieldError, FieldRef, FieldSource, MessageFields};

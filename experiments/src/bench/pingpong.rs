@@ -16,7 +16,7 @@ use std::process::{Child, Stdio};
 use std::time::{Duration, Instant};
 
 use bus::{Bus, RunPrefix};
-use wire::{Command, Delivery, JointState, STATE_FINAL, Topic};
+use wire::{Command, Delivery, JointState, STATE_FINAL};
 
 use crate::bench::types::{BenchError, PingPong};
 use launcher::mode::Mode;
@@ -83,9 +83,9 @@ fn ping(rounds: u64, pinned: bool) -> Result<f64, BenchError> {
     let prefix = RunPrefix::unique();
     let bus = Bus::new(&prefix, "bench-ping").map_err(err)?;
     let states = bus
-        .publisher::<JointState>(Topic::JointState, Delivery::Lossless)
+        .publisher::<JointState>(Delivery::Lossless)
         .map_err(err)?;
-    let commands = bus.subscriber::<Command>(Topic::Command).map_err(err)?;
+    let commands = bus.subscriber::<Command>().map_err(err)?;
     let exe = std::env::current_exe().map_err(err)?;
     let mut pong = std::process::Command::new(exe)
         .args([PONG_COMMAND, "--prefix", prefix.as_str()])
@@ -150,8 +150,8 @@ pub fn pong(prefix: &str, placement: &Placement) -> anyhow::Result<()> {
     let _ = placement.apply();
     let prefix = RunPrefix::parse(prefix)?;
     let bus = Bus::new(&prefix, "bench-pong")?;
-    let states = bus.subscriber::<JointState>(Topic::JointState)?;
-    let commands = bus.publisher::<Command>(Topic::Command, Delivery::Lossless)?;
+    let states = bus.subscriber::<JointState>()?;
+    let commands = bus.publisher::<Command>(Delivery::Lossless)?;
     let mut last = Instant::now();
     loop {
         while let Some(s) = states.receive()? {

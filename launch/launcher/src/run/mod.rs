@@ -22,7 +22,6 @@ use logger::live::LiveConfig;
 use scenario::Plan;
 use wire::{
     CONTROL_START, CONTROL_STOP, Control, Delivery, Header, MAX_DOF, NodeKind, NodeStatus, RunEnd,
-    Topic,
 };
 
 use crate::mode::Mode;
@@ -161,8 +160,8 @@ fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
     // And the files of nodes killed while they were being created.
     prefix.remove_leftover_files(false);
     let bus = Bus::new(&prefix, "launcher")?;
-    let status = bus.subscriber::<NodeStatus>(Topic::Status)?;
-    let control = bus.publisher::<Control>(Topic::Control, Delivery::DropWhenFull)?;
+    let status = bus.subscriber::<NodeStatus>()?;
+    let control = bus.publisher::<Control>(Delivery::DropWhenFull)?;
     let cpus = crate::node::placement::cpu_count();
     let _off_loop = opts
         .realtime_setup
