@@ -17,7 +17,9 @@ use crate::data_path::DataPath;
 use crate::summary::{Summary, SummaryBuilder};
 use crate::timing::{RunFacts, TimingStats, TimingSummary, judge};
 use crate::verify::Verifier;
-use logger::{DecodeError, Encoding, LogContents, LogError, MessageError, read_log, read_log_head};
+use logger::{
+    DecodeError, LogContents, LogError, MessageError, RawMessage, read_log, read_log_head,
+};
 use wire::Mode;
 
 /// Why a log could not be analysed.
@@ -232,10 +234,10 @@ struct Analyser<'a, 'o> {
 }
 
 impl Analyser<'_, '_> {
-    fn on_message(&mut self, topic: &str, enc: Encoding, v: &[u8]) -> Result<(), MessageError> {
+    fn on_message(&mut self, m: &RawMessage<'_>) -> Result<(), MessageError> {
         // Every logged message has its arm: the match is over the wire's
         // one list of them.
-        match logger::decode_logged(topic, enc, v)? {
+        match logger::decode_logged(m)? {
             Some(Logged::JointState(s)) => {
                 check_dof(s.dof, self.n)?;
                 self.wall = (
@@ -278,7 +280,7 @@ impl Analyser<'_, '_> {
             // The arm's frames and figure, the standard views: not
             // analysed, but a log whose message is not JSON (formats 1 and
             // 2) or CDR (format 3) is damaged there.
-            None => logger::check_message(enc, v)?,
+            None => logger::check_message(m.encoding, m.data)?,
         }
         let (summary, series, csv) = (&mut self.summary, &mut self.series, &mut self.csv);
         let own = &mut self.own;
@@ -359,7 +361,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         own_len,
         own: OwnStats::new(own, n),
     };
-    let contents = match read_log(path, Some(&mut |t, e, v| a.on_message(t, e, v))) {
+    let contents = match read_log(path, Some(&mut |m| a.on_message(m))) {
         Err(LogError::Sink { cause, .. }) => return Err(out_err(cause)),
         other => other?,
     };

@@ -5,12 +5,13 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    // Every logged message of the wire's list, as the analysis decodes
-    // them; the standard views checked as replay checks them.
-    let mut decode = |topic: &str, e: logger::Encoding, v: &[u8]| {
-        let _ = match logger::decode_logged(topic, e, v) {
+    // Every logged message of the wire's list decoded by the schema its
+    // log stores, as the analysis does; the standard views checked as
+    // replay checks them.
+    let mut decode = |m: &logger::RawMessage<'_>| {
+        let _ = match logger::decode_logged(m) {
             Ok(Some(_)) => Ok(()),
-            Ok(None) => logger::check_message(e, v),
+            Ok(None) => logger::check_message(m.encoding, m.data),
             Err(e) => Err(e),
         };
         Ok(())

@@ -3,7 +3,7 @@
 
 use crate::decode_error::DecodeError;
 use crate::json::LogMessage;
-use crate::reader::Encoding;
+use crate::reader::{Encoding, RawMessage};
 use wire::Logged;
 
 /// Every logged message decodes from either encoding.
@@ -20,21 +20,29 @@ pub trait Decode: LogMessage {
 
 impl<M: LogMessage> Decode for M {}
 
-/// A logged message from its channel's `topic`, its encoding and its data;
-/// None for a channel that is not one of the wire's logged messages (the
-/// standard views: `/tf`, `/joint_states`, the markers).
-pub fn decode_logged(
-    topic: &str,
-    encoding: Encoding,
-    data: &[u8],
-) -> Result<Option<Logged>, DecodeError> {
+/// A logged message from the log's message: decoded by the schema its
+/// log stores (CDR) or by field name (JSON); None for a channel that is
+/// not one of the wire's logged messages (the standard views: `/tf`,
+/// `/joint_states`, the markers).
+pub fn decode_logged(m: &RawMessage<'_>) -> Result<Option<Logged>, DecodeError> {
     macro_rules! arms {
         ($($ty:ident => $topic:ident, $channel:literal, $schema:literal;)*) => {
-            match topic {
-                $($channel => wire::$ty::decode_as(encoding, data).map(Logged::from),)*
+            match m.topic {
+                $($channel => decode_one::<wire::$ty>(m).map(Logged::from),)*
                 _ => return Ok(None),
             }
         };
     }
     wire::logged_messages!(arms).map(Some)
+}
+
+fn decode_one<M: LogMessage>(m: &RawMessage<'_>) -> Result<M, DecodeError> {
+    match (m.encoding, m.schema) {
+        (Encoding::Json, _) => M::parse(m.data),
+        (Encoding::Cdr, Some(schema)) => crate::ros2::decode_by(schema, m.data),
+        (Encoding::Cdr, None) => Err(DecodeError(format!(
+            "channel {} has no testbed_msgs schema to read its CDR by",
+            m.topic
+        ))),
+    }
 }

@@ -35,6 +35,7 @@ mod json_object;
 mod layout;
 pub mod live;
 mod mcap_out;
+pub mod msg_schema;
 pub mod node;
 pub mod obstacles;
 mod outputs;
@@ -56,7 +57,8 @@ pub use json::LogMessage;
 pub use json_object::JsonObject;
 pub use layout::foxglove_layout;
 pub use reader::{
-    Encoding, LogContents, MessageError, OnMessage, read_log, read_log_bytes, read_log_head,
+    Encoding, LogContents, MessageError, OnMessage, RawMessage, read_log, read_log_bytes,
+    read_log_head,
 };
 pub use writer::{LOG_FORMAT, LogWriter, RunMetadata, ZSTD_LEVEL};
 

@@ -2,10 +2,12 @@
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use mcap::records::Record;
 
 use super::{DecodeError, LogError, RUN_METADATA, STATS_METADATA, URDF_ATTACHMENT};
+use crate::msg_schema::MsgSchema;
 
 /// What a log holds besides its messages.
 #[derive(Debug, Clone, Default)]
@@ -88,10 +90,35 @@ impl Encoding {
     }
 }
 
-/// Called for every message of a log, in file order, with its topic, its
-/// channel's encoding and its data ([`crate::Decode::decode_as`]
-/// decodes it).
-pub type OnMessage<'a> = &'a mut dyn FnMut(&str, Encoding, &[u8]) -> Result<(), MessageError>;
+/// One message of a log, as the reader hands it over: its channel's topic,
+/// encoding and stored schema, and its data ([`crate::decode_logged`]
+/// decodes a testbed message by that schema).
+#[derive(Debug, Clone, Copy)]
+pub struct RawMessage<'a> {
+    /// The channel's topic.
+    pub topic: &'a str,
+    /// The channel's message encoding.
+    pub encoding: Encoding,
+    /// The channel's schema, for a testbed message in CDR (None for JSON
+    /// and for the standard views).
+    pub schema: Option<&'a MsgSchema>,
+    /// The message's bytes.
+    pub data: &'a [u8],
+}
+
+/// Called for every message of a log, in file order.
+pub type OnMessage<'a> = &'a mut dyn FnMut(&RawMessage<'_>) -> Result<(), MessageError>;
+
+/// The package of testbed's own messages: their stored schemas are read.
+const OWN_SCHEMAS: &str = "testbed_msgs/";
+
+/// One channel of the log, as its record and its schema's said.
+struct ChannelInfo {
+    topic: String,
+    encoding: Result<Encoding, String>,
+    /// A testbed message's schema in CDR, read (or why it cannot be).
+    schema: Option<Result<Arc<MsgSchema>, String>>,
+}
 
 /// Reads `path` record by record, calling `on_message(topic, data)` (if
 /// given) for every message in file order. A truncated or unfinished file is
@@ -250,7 +277,9 @@ fn read(
 struct Walk {
     out: LogContents,
     p: String,
-    topics: HashMap<u16, (String, Result<Encoding, String>)>,
+    topics: HashMap<u16, ChannelInfo>,
+    /// The testbed messages' schemas by id, read.
+    schemas: HashMap<u16, Result<Arc<MsgSchema>, String>>,
     /// Where the framing stopped being sound, if it did.
     damaged: Option<String>,
 }
@@ -264,6 +293,7 @@ impl Walk {
             },
             p: path.display().to_string(),
             topics: HashMap::new(),
+            schemas: HashMap::new(),
             damaged: None,
         }
     }
@@ -291,15 +321,32 @@ impl Walk {
                 }
             };
             match record {
+                Record::Schema { header, data }
+                    if header.name.starts_with(OWN_SCHEMAS) && header.encoding == "ros2msg" =>
+                {
+                    let read = MsgSchema::parse(&header.name, &data)
+                        .map(Arc::new)
+                        .map_err(|e| e.to_string());
+                    self.schemas.insert(header.id, read);
+                }
                 Record::Channel(c) => {
-                    let enc = Encoding::of(&c.message_encoding).ok_or(c.message_encoding);
-                    self.topics.insert(c.id, (c.topic, enc));
+                    let encoding = Encoding::of(&c.message_encoding).ok_or(c.message_encoding);
+                    let schema = match encoding {
+                        Ok(Encoding::Cdr) => self.schemas.get(&c.schema_id).cloned(),
+                        _ => None,
+                    };
+                    let info = ChannelInfo {
+                        topic: c.topic,
+                        encoding,
+                        schema,
+                    };
+                    self.topics.insert(c.id, info);
                 }
                 Record::Message { .. } if head_only => return Ok(true),
                 Record::Message { header, data } => {
-                    let topic = self.topics.get(&header.channel_id);
-                    if let (Some((topic, enc)), Some(handler)) = (topic, on_message.as_mut())
-                        && let Some(why) = deliver(handler, topic, enc, &data, &self.p)?
+                    let channel = self.topics.get(&header.channel_id);
+                    if let (Some(channel), Some(handler)) = (channel, on_message.as_mut())
+                        && let Some(why) = deliver(handler, channel, &data, &self.p)?
                     {
                         out.cut_short = Some(why);
                         return Ok(true);
@@ -342,12 +389,12 @@ impl Walk {
 /// the log is to be read no further, an error when the handler failed.
 fn deliver(
     handler: &mut OnMessage<'_>,
-    topic: &str,
-    enc: &Result<Encoding, String>,
+    channel: &ChannelInfo,
     data: &[u8],
     path: &str,
 ) -> Result<Option<String>, LogError> {
-    let enc = match enc {
+    let topic = channel.topic.as_str();
+    let encoding = match &channel.encoding {
         Ok(enc) => *enc,
         Err(other) => {
             return Ok(Some(format!(
@@ -355,7 +402,22 @@ fn deliver(
             )));
         }
     };
-    match handler(topic, enc, data) {
+    let schema = match &channel.schema {
+        Some(Ok(schema)) => Some(schema.as_ref()),
+        Some(Err(why)) => {
+            return Ok(Some(format!(
+                "channel {topic}'s stored schema cannot be read: {why}"
+            )));
+        }
+        None => None,
+    };
+    let message = RawMessage {
+        topic,
+        encoding,
+        schema,
+        data,
+    };
+    match handler(&message) {
         Ok(()) => Ok(None),
         Err(MessageError::Malformed(e)) => Ok(Some(format!("a {topic} message is malformed: {e}"))),
         Err(MessageError::Sink(cause)) => Err(LogError::Sink {
@@ -380,10 +442,10 @@ mod tests {
         for e in std::fs::read_dir(&dir).unwrap().flatten() {
             let buf = std::fs::read(e.path()).unwrap();
             // Every message decoded as JSON, as a reader of the log does.
-            let mut count = |_: &str, enc: Encoding, data: &[u8]| {
-                match enc {
-                    Encoding::Json => drop(crate::json_object::JsonObject::parse(data)?),
-                    Encoding::Cdr => crate::check_message(enc, data)?,
+            let mut count = |m: &RawMessage<'_>| {
+                match m.encoding {
+                    Encoding::Json => drop(crate::json_object::JsonObject::parse(m.data)?),
+                    Encoding::Cdr => crate::check_message(m.encoding, m.data)?,
                 }
                 Ok(())
             };
@@ -405,7 +467,6 @@ mod tests {
     /// the reader hands it (the fuzzer's `log` target does this at length).
     #[test]
     fn damaged_cdr_logs_read_without_a_crash() {
-        use crate::Decode;
         let dir = std::env::temp_dir().join(format!("testbed-cdr-dmg-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("run.mcap");
@@ -443,10 +504,9 @@ mod tests {
                 let at = (next() % buf.len() as u64) as usize;
                 buf[at] = next() as u8;
             }
-            let mut decode = |topic: &str, enc: Encoding, data: &[u8]| {
-                match topic {
-                    "/joint_state" => drop(wire::JointState::decode_as(enc, data)?),
-                    _ => drop(wire::ControllerDiagnostics::decode_as(enc, data)?),
+            let mut decode = |m: &RawMessage<'_>| {
+                if crate::decode_logged(m)?.is_none() {
+                    crate::check_message(m.encoding, m.data)?;
                 }
                 Ok(())
             };
@@ -481,13 +541,12 @@ mod tests {
         assert!(head.cut_short.is_none());
 
         let mut seqs = Vec::new();
-        let mut take = |_: &str, enc: Encoding, data: &[u8]| {
-            assert_eq!(enc, Encoding::Cdr);
-            seqs.push(
-                <wire::JointState as crate::Decode>::decode_as(enc, data)?
-                    .header
-                    .seq,
-            );
+        let mut take = |m: &RawMessage<'_>| {
+            assert_eq!(m.encoding, Encoding::Cdr);
+            assert!(m.schema.is_some(), "a testbed message's schema is read");
+            if let Some(wire::Logged::JointState(s)) = crate::decode_logged(m)? {
+                seqs.push(s.header.seq);
+            }
             Ok(())
         };
         let all = read_log(&path, Some(&mut take)).unwrap();

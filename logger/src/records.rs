@@ -78,8 +78,9 @@ impl<'a> Iterator for Records<'a> {
     }
 }
 
-/// Footer, channel, message, attachment, metadata: what the reader uses.
-const USED: [u8; 5] = [0x02, 0x04, 0x05, 0x09, 0x0c];
+/// Footer, schema, channel, message, attachment, metadata: what the reader
+/// uses.
+const USED: [u8; 6] = [0x02, 0x03, 0x04, 0x05, 0x09, 0x0c];
 
 /// Walks a record's fields, checking each length against what is left.
 struct Fields<'b>(&'b [u8]);
@@ -117,6 +118,13 @@ impl Fields<'_> {
 fn fields_fit(opcode: u8, data: &[u8]) -> Result<(), String> {
     let mut f = Fields(data);
     match opcode {
+        // Schema: id, name, encoding, data.
+        0x03 => {
+            f.skip(2, "id")?;
+            f.prefixed(4, "name")?;
+            f.prefixed(4, "encoding")?;
+            f.prefixed(4, "data")
+        }
         // Channel: id, schema id, topic, message encoding, metadata map.
         0x04 => {
             f.skip(4, "ids")?;

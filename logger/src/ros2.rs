@@ -22,6 +22,7 @@ use wire::{FieldError, FieldRef, FieldSource, Header, Joints, MAX_DOF, joints};
 use crate::LogMessage;
 use crate::cdr::{CdrReader, CdrWriter};
 use crate::decode_error::DecodeError;
+use crate::msg_schema::{MsgSchema, SchemaError, SchemaKind};
 
 /// The testbed's message package.
 pub const PACKAGE: &str = "testbed_msgs";
@@ -136,6 +137,11 @@ pub fn schema_text<M: LogMessage>() -> String {
     with_deps(&msg_text::<M>(), &HEADER_DEPS)
 }
 
+/// The schema this build writes for `M`, read back as a field list.
+pub fn msg_schema<M: LogMessage>() -> Result<MsgSchema, SchemaError> {
+    MsgSchema::parse(&type_name::<M>(), schema_text::<M>().as_bytes())
+}
+
 fn wrap(text: &str, width: usize) -> Vec<String> {
     let mut lines = vec![String::new()];
     for word in text.split_whitespace() {
@@ -177,11 +183,11 @@ enum Val {
     J(Box<Joints>),
 }
 
-/// A message's fields read from its CDR, in the order its field list
-/// gives, for [`wire::MessageFields::decode`].
-struct CdrFields(Vec<(&'static str, Val)>);
+/// A message's fields read from its CDR, in the order its schema gives,
+/// for [`wire::MessageFields::decode`].
+struct CdrFields<'s>(Vec<(&'s str, Val)>);
 
-impl CdrFields {
+impl CdrFields<'_> {
     fn get(&self, k: &str) -> Result<&Val, FieldError> {
         self.0
             .iter()
@@ -191,7 +197,7 @@ impl CdrFields {
     }
 }
 
-impl FieldSource for CdrFields {
+impl FieldSource for CdrFields<'_> {
     fn u(&self, k: &str) -> Result<u64, FieldError> {
         match self.get(k)? {
             Val::U(x) => Ok(*x),
@@ -224,53 +230,65 @@ impl FieldSource for CdrFields {
     }
 }
 
-/// The message back from its CDR.
+/// The message back from its CDR, written with this build's own schema
+/// for `M` (a log is read by the schema it stores: [`decode_by`]).
 pub fn decode<M: LogMessage>(data: &[u8]) -> Result<M, DecodeError> {
+    let schema = msg_schema::<M>().map_err(|e| DecodeError(e.to_string()))?;
+    decode_by(&schema, data)
+}
+
+/// The message back from CDR written with `schema`: each field is read as
+/// the schema says and handed to `M` by name, so a field `M` has and the
+/// schema lacks takes its declared default for older logs (or is missing),
+/// and a field the schema has and `M` lacks is read past.
+pub fn decode_by<M: LogMessage>(schema: &MsgSchema, data: &[u8]) -> Result<M, DecodeError> {
     let mut r = CdrReader::new(data)?;
-    let t_ns = r.time("header.stamp")?;
-    r.string("header.frame_id")?;
-    let header = Header {
-        seq: r.u64("seq")?,
-        t_ns,
-        wall_ns: r.u64("wall_ns")?,
-    };
-    let mut fields = Vec::with_capacity(32);
-    let mut err = None;
+    let (mut stamp, mut seq, mut wall_ns) = (None, None, None);
+    let mut fields = Vec::with_capacity(schema.fields.len());
     let mut xs = Vec::with_capacity(MAX_DOF);
-    M::default().visit(&mut |name, f| {
-        if err.is_some() {
-            return;
-        }
-        let v = match f {
-            FieldRef::U32(_) => r.u32(name).map(|x| Val::U(x.into())),
-            FieldRef::U(_) => r.u64(name).map(Val::U),
-            FieldRef::I(_) => r.i64(name).map(Val::I),
-            FieldRef::F(_) => r.f64(name).map(Val::F),
-            FieldRef::J(_) | FieldRef::V(_) => r.f64s(name, &mut xs).and_then(|()| {
+    for f in &schema.fields {
+        let name = f.name.as_str();
+        let v = match f.kind {
+            SchemaKind::Header => {
+                stamp = Some(r.time(name)?);
+                r.string(name)?;
+                continue;
+            }
+            SchemaKind::U32 => Val::U(r.u32(name)?.into()),
+            SchemaKind::U64 => Val::U(r.u64(name)?),
+            SchemaKind::I64 => Val::I(r.i64(name)?),
+            SchemaKind::F64 => Val::F(r.f64(name)?),
+            SchemaKind::F64s => {
+                r.f64s(name, &mut xs)?;
                 if xs.len() > MAX_DOF {
-                    Err(DecodeError(format!(
+                    return Err(DecodeError(format!(
                         "field '{name}' has {} entries (at most {MAX_DOF})",
                         xs.len()
-                    )))
-                } else {
-                    Ok(Val::J(Box::new(joints(&xs))))
+                    )));
                 }
-            }),
+                Val::J(Box::new(joints(&xs)))
+            }
         };
-        match v {
-            Ok(v) => fields.push((name, v)),
-            Err(e) => err = Some(e),
+        match (name, v) {
+            ("seq", Val::U(x)) => seq = Some(x),
+            ("wall_ns", Val::U(x)) => wall_ns = Some(x),
+            (name, v) => fields.push((name, v)),
         }
-    });
-    if let Some(e) = err {
-        return Err(e);
     }
     if !r.at_end() {
         return Err(DecodeError(format!(
-            "the CDR message is longer than a {}",
-            type_name::<M>()
+            "the CDR message is longer than its schema {} says",
+            schema.name
         )));
     }
+    let need = |v: Option<u64>, what: &str| {
+        v.ok_or_else(|| DecodeError(format!("schema {} has no {what}", schema.name)))
+    };
+    let header = Header {
+        seq: need(seq, "uint64 seq")?,
+        t_ns: need(stamp, "std_msgs/Header header")?,
+        wall_ns: need(wall_ns, "uint64 wall_ns")?,
+    };
     M::decode(header, &CdrFields(fields)).map_err(DecodeError::from)
 }
 

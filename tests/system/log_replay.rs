@@ -64,7 +64,18 @@ fn log_is_complete_ros2_mcap_whose_messages_decode() {
     for msg in mcap::MessageStream::new(&buf).unwrap() {
         let msg = msg.unwrap();
         let enc = logger::Encoding::Cdr;
-        let header = match logger::decode_logged(&msg.channel.topic, enc, &msg.data) {
+        // Each message read by the schema its channel stores.
+        let stored = msg.channel.schema.as_ref().expect("a schema");
+        let schema = logger::msg_schema::MsgSchema::parse(&stored.name, &stored.data).ok();
+        let raw = logger::RawMessage {
+            topic: &msg.channel.topic,
+            encoding: enc,
+            schema: schema
+                .as_ref()
+                .filter(|_| stored.name.starts_with("testbed_msgs/")),
+            data: &msg.data,
+        };
+        let header = match logger::decode_logged(&raw) {
             Ok(Some(m)) => Ok(*m.header()),
             Ok(None) => {
                 logger::check_message(enc, &msg.data).unwrap();
@@ -391,13 +402,13 @@ fn a_log_read_from_its_file_equals_the_log_read_whole() {
         let path = dir.path().join(format!("cut{cut}.mcap"));
         std::fs::write(&path, &bytes[..cut]).unwrap();
         let (mut a, mut b) = (Vec::<String>::new(), Vec::<String>::new());
-        let mut on_a = |topic: &str, _: logger::Encoding, data: &[u8]| {
-            a.push(format!("{topic}:{}", data.len()));
+        let mut on_a = |m: &logger::RawMessage<'_>| {
+            a.push(format!("{}:{}", m.topic, m.data.len()));
             Ok(())
         };
         let streamed = logger::read_log(&path, Some(&mut on_a));
-        let mut on_b = |topic: &str, _: logger::Encoding, data: &[u8]| {
-            b.push(format!("{topic}:{}", data.len()));
+        let mut on_b = |m: &logger::RawMessage<'_>| {
+            b.push(format!("{}:{}", m.topic, m.data.len()));
             Ok(())
         };
         let whole = logger::read_log_bytes(&bytes[..cut], &path, Some(&mut on_b));

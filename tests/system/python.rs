@@ -138,8 +138,8 @@ fn every_message_of_a_run_decodes_with_the_official_python_reader() {
     let mut per_topic = std::collections::BTreeMap::<String, u64>::new();
     let contents = logger::read_log(
         Path::new(log),
-        Some(&mut |t: &str, _: logger::Encoding, _: &[u8]| {
-            *per_topic.entry(t.to_string()).or_default() += 1;
+        Some(&mut |m: &logger::RawMessage<'_>| {
+            *per_topic.entry(m.topic.to_string()).or_default() += 1;
             Ok(())
         }),
     )

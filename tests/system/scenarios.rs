@@ -187,12 +187,10 @@ fn a_contact_scenario_runs_the_same_in_sim_and_lockstep() {
     );
     // The log's /contact: one sample per state, the force where the state
     // says contact, the point on the table's top (z = -0.5 m) under the arm.
-    use logger::{Decode, LogMessage};
     let (mut samples, mut touching, mut markers) = (0u64, 0u64, 0u64);
-    let mut on_message = |topic: &str, enc: logger::Encoding, data: &[u8]| {
-        markers += u64::from(topic == logger::obstacles::CONTACT_MARKER_TOPIC);
-        if topic == wire::ContactState::LOG_TOPIC {
-            let c = wire::ContactState::decode_as(enc, data)?;
+    let mut on_message = |m: &logger::RawMessage<'_>| {
+        markers += u64::from(m.topic == logger::obstacles::CONTACT_MARKER_TOPIC);
+        if let Some(wire::Logged::ContactState(c)) = logger::decode_logged(m)? {
             samples += 1;
             if c.points > 0 {
                 touching += 1;
