@@ -5,7 +5,9 @@ Every table in docs/generated/ comes from a deterministic in-process run
 (`testbed sim`, `testbed compare`): the same code gives the same digits on
 any machine, so they are regenerated here, never copied by hand. Wall-clock
 figures (speed, compute time) move with the machine and are left out; the
-dated ones live in docs/results.md.
+dated ones live in docs/results.md. (One page there comes from code, not
+runs: controller-parameters.md, written from the parameters' declaration by
+`TESTBED_WRITE_DOCS=1 cargo test -p controller --lib params_reference`.)
 
     python3 docs/regenerate.py                 # rewrite docs/generated/*.md
     python3 docs/regenerate.py --check         # exit 1 if any is stale

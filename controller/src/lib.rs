@@ -42,6 +42,7 @@ mod mpc;
 mod nac;
 pub mod node;
 mod params;
+mod params_reference;
 mod ppc;
 mod rbf;
 mod shifting;
@@ -54,8 +55,10 @@ pub use law_table::{BarrierParts, FeedbackKind, LawDecl, LawKind, LawName};
 pub use machine::ControllerMachine;
 pub use nac::{Controller, ControllerInput, barrier_lyapunov};
 pub use params::{
-    BarrierMode, ControllerParams, Integrator, MAX_MPC_HORIZON, MAX_NEURONS, RbfLayout, Tuning,
+    BarrierMode, Check, ControllerParams, Integrator, MAX_MPC_HORIZON, MAX_NEURONS, ParamDoc,
+    RbfLayout, Tuning,
 };
+pub use params_reference::reference_markdown;
 pub use ppc::{Ppc, XI_LIMIT};
 pub use rbf::Rbf;
 pub use shifting::shifting;

@@ -65,14 +65,15 @@ fn is_default<T: Default + PartialEq>(x: &T) -> bool {
 /// [`ControllerParams::for_law`] carries are all made from this one list.
 macro_rules! parameters {
     ($(
-        $(#[$meta:meta])*
+        $(#[doc = $doc:literal])*
+        $(#[serde($($serde:tt)*)])*
         $field:ident : $ty:ty = $default:expr, $check:path;
     )*) => {
         /// Every parameter of the law. Unset keys take the paper's values.
         #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
         #[serde(default, deny_unknown_fields)]
         pub struct ControllerParams {
-            $( $(#[$meta])* pub $field: $ty, )*
+            $( $(#[doc = $doc])* $(#[serde($($serde)*)])* pub $field: $ty, )*
         }
 
         impl Default for ControllerParams {
@@ -95,9 +96,26 @@ macro_rules! parameters {
 
             /// Each key's own check; the error names it (`controller.<key>`).
             fn check_each(&self) -> Result<(), ControllerError> {
-                $( $check(concat!("controller.", stringify!($field)), &self.$field)?; )*
+                $( $check.run(concat!("controller.", stringify!($field)), &self.$field)?; )*
                 Ok(())
             }
+
+            /// The default of `key` as a scenario would write it (JSON).
+            pub fn default_of(key: &str) -> Option<serde_json::Value> {
+                let d = Self::default();
+                match key {
+                    $( stringify!($field) => serde_json::to_value(&d.$field).ok(), )*
+                    _ => None,
+                }
+            }
+
+            /// Every key as the parameter reference lists it
+            /// (docs/generated/controller-parameters.md).
+            pub const REFERENCE: &'static [ParamDoc] = &[$(ParamDoc {
+                key: stringify!($field),
+                doc: concat!($($doc, "\n"),*),
+                need: $check.need,
+            }),*];
 
             /// Copies from `other` every key `keep` accepts.
             fn carry(&mut self, other: &Self, keep: impl Fn(&str) -> bool) {
@@ -108,86 +126,88 @@ macro_rules! parameters {
 }
 
 parameters! {
-    /// The law (default: "nac", the paper's). Every other key must be one
-    /// the law takes ([`LawName::keys`]) or be left at its default.
-    law: LawName = LawName::Nac, any;
-    /// Prescribed time T_c at which the constraint is fully on (default: 2, s).
-    tc: f64 = 2.0, positive;
-    /// Position-error gain K1 = diag(K1_i): one number or one per joint
-    /// (default: 15, 1/s; SPEC §7 needs K1_i > 0).
-    k1: Gain = Gain::All(15.0), positive_gain;
-    /// Velocity-error gain K2 = diag(K2_i): one number or one per joint
-    /// (default: 15, N m s/rad; the analysis asks K2_i > 1/2, SPEC §7 allows
-    /// less on very light joints and the testbed reports them).
-    k2: Gain = Gain::All(15.0), positive_gain;
-    /// Barrier steepness β (default: 10).
-    beta: f64 = 10.0, positive;
-    /// Actor learning rate σ_a (default: 50).
-    sigma_a: f64 = 50.0, positive;
-    /// Critic learning rate σ_c (default: 50).
-    sigma_c: f64 = 50.0, positive;
-    /// Actor regularisation η_a (default: 0.01).
-    eta_a: f64 = 0.01, positive;
-    /// Critic regularisation η_c (default: 0.5).
-    eta_c: f64 = 0.5, positive;
-    /// RBF neurons N in each network (default: 10; at most [`MAX_NEURONS`]).
-    neurons: usize = 10, neuron_count;
-    /// Smallest RBF centre c_min (default: -5).
-    center_min: f64 = -5.0, finite;
-    /// Largest RBF centre c_max (default: 5).
-    center_max: f64 = 5.0, finite;
-    /// RBF width η (default: 1).
-    width: f64 = 1.0, positive;
-    /// Where the centres lie (default: "diagonal", the paper's).
-    rbf_layout: RbfLayout = RbfLayout::Diagonal, any;
-    /// Young's-inequality weight a in α (default: 1).
-    a: f64 = 1.0, positive;
-    /// Critic discount time constant ψ (default: 1, s).
-    psi: f64 = 1.0, positive;
-    /// Critic-to-actor gain k_a (default: 0.1).
-    k_a: f64 = 0.1, non_negative;
-    /// Q = q_weight · I on Z_c = [Z1; Z2] (default: 1).
-    q_weight: f64 = 1.0, non_negative;
-    /// R = r_weight · I on τ (default: 0.01).
-    r_weight: f64 = 0.01, non_negative;
-    /// Weight integrator (default: "exact").
-    integrator: Integrator = Integrator::Exact, any;
-    /// Barrier mode (default: "per-joint").
-    barrier: BarrierMode = BarrierMode::PerJoint, any;
-    /// Guard ε: D is clamped to at least ε k_c² (default: 1e-6).
-    breach_epsilon: f64 = 1e-6, open_unit;
+    /// The law: "nac", the paper's, or a baseline of docs/baselines.md.
+    /// Every other key must be one the law takes ([`LawName::keys`]) or be
+    /// left at its default.
+    law: LawName = LawName::Nac, ANY_NAME;
+    /// Prescribed time T_c at which the constraint is fully on, s.
+    tc: f64 = 2.0, POSITIVE;
+    /// Position-error gain K1 = diag(K1_i), 1/s: one number or one per
+    /// joint (SPEC §7 needs K1_i > 0).
+    k1: Gain = Gain::All(15.0), POSITIVE_GAIN;
+    /// Velocity-error gain K2 = diag(K2_i), N m s/rad: one number or one
+    /// per joint (the analysis asks K2_i > 1/2, SPEC §7 allows less on very
+    /// light joints and the testbed reports them).
+    k2: Gain = Gain::All(15.0), POSITIVE_GAIN;
+    /// Barrier steepness β.
+    beta: f64 = 10.0, POSITIVE;
+    /// Actor learning rate σ_a.
+    sigma_a: f64 = 50.0, POSITIVE;
+    /// Critic learning rate σ_c.
+    sigma_c: f64 = 50.0, POSITIVE;
+    /// Actor regularisation η_a.
+    eta_a: f64 = 0.01, POSITIVE;
+    /// Critic regularisation η_c.
+    eta_c: f64 = 0.5, POSITIVE;
+    /// RBF neurons N in each network (at most [`MAX_NEURONS`]).
+    neurons: usize = 10, NEURON_COUNT;
+    /// Smallest RBF centre c_min (≤ `center_max`).
+    center_min: f64 = -5.0, FINITE;
+    /// Largest RBF centre c_max.
+    center_max: f64 = 5.0, FINITE;
+    /// RBF width η.
+    width: f64 = 1.0, POSITIVE;
+    /// Where the centres lie: "diagonal" (the paper's) or "per-input".
+    rbf_layout: RbfLayout = RbfLayout::Diagonal, ANY_NAME;
+    /// Young's-inequality weight a in α.
+    a: f64 = 1.0, POSITIVE;
+    /// Critic discount time constant ψ, s.
+    psi: f64 = 1.0, POSITIVE;
+    /// Critic-to-actor gain k_a.
+    k_a: f64 = 0.1, NON_NEGATIVE;
+    /// Q = q_weight · I on Z_c = [Z1; Z2].
+    q_weight: f64 = 1.0, NON_NEGATIVE;
+    /// R = r_weight · I on τ.
+    r_weight: f64 = 0.01, NON_NEGATIVE;
+    /// Weight integrator: "exact" or "euler" (SPEC §9).
+    integrator: Integrator = Integrator::Exact, ANY_NAME;
+    /// Barrier mode: "per-joint" or "norm" (SPEC §5).
+    barrier: BarrierMode = BarrierMode::PerJoint, ANY_NAME;
+    /// Guard ε: D is clamped to at least ε k_c² (SPEC §10).
+    breach_epsilon: f64 = 1e-6, OPEN_UNIT;
     /// `pd-gravity`, `ctc`: every link's mass and inertia in the law's copy
-    /// of the model is scaled by this (default: 1, the URDF's).
-    model_scale: f64 = 1.0, positive;
-    /// `ppc`: the final velocity-funnel width ρ2,∞ (default: 4, rad/s: the
-    /// smallest power of two that keeps every shipped two-link scenario
-    /// inside both funnels; 2 breaches under the 3 ms actuation delay).
-    rho2_inf: f64 = 4.0, positive;
-    /// `smc`: the switching gain k_s, N m (default: 2: the size of an
-    /// unmodelled torque the law rejects inside its boundary layer, e.g.
-    /// the paper arm's payload and friction).
-    smc_gain: f64 = 2.0, non_negative;
-    /// `smc`: the boundary layer's width φ on s = ė + K1 e, rad/s (default:
-    /// 0.05: the switch is linear for |s| < φ, which keeps it from
-    /// chattering at a 1 ms period).
-    smc_boundary: f64 = 0.05, positive;
+    /// of the model is scaled by this (1: the URDF's).
+    model_scale: f64 = 1.0, POSITIVE;
+    /// `ppc`: the final velocity-funnel width ρ2,∞, rad/s (the default is
+    /// the smallest power of two that keeps every shipped two-link scenario
+    /// inside both funnels; half of it breaches under the 3 ms actuation
+    /// delay).
+    rho2_inf: f64 = 4.0, POSITIVE;
+    /// `smc`: the switching gain k_s, N m: the size of an unmodelled torque
+    /// the law rejects inside its boundary layer (the default covers the
+    /// paper arm's payload and friction).
+    smc_gain: f64 = 2.0, NON_NEGATIVE;
+    /// `smc`: the boundary layer's width φ on s = ė + K1 e, rad/s: the
+    /// switch is linear for |s| < φ, which keeps it from chattering at a
+    /// 1 ms period.
+    smc_boundary: f64 = 0.05, POSITIVE;
     /// `cbf-ctc`: the filter's rate λ, 1/s: h = k_c² − e² obeys
-    /// ḧ + 2λ ḣ + λ² h ≥ 0, a double pole at −λ (default: 20).
-    cbf_rate: f64 = 20.0, positive;
-    /// `mpc`: prediction steps N (default: 10; with `mpc_step` a 0.1 s
-    /// look-ahead for the envelope, 1.5 time constants of the default
-    /// gains' error dynamics; beyond it the terminal cost is the infinite
-    /// horizon's, so N sets only how far ahead the envelope is seen; at
-    /// most [`MAX_MPC_HORIZON`]).
-    mpc_horizon: usize = 10, horizon_steps;
-    /// `mpc`: the prediction step h, s (default: 0.01: ten control periods
+    /// ḧ + 2λ ḣ + λ² h ≥ 0, a double pole at −λ.
+    cbf_rate: f64 = 20.0, POSITIVE;
+    /// `mpc`: prediction steps N (at most [`MAX_MPC_HORIZON`]). The default,
+    /// with `mpc_step`'s, looks 0.1 s ahead for the envelope, 1.5 time
+    /// constants of the default gains' error dynamics; beyond it the
+    /// terminal cost is the infinite horizon's, so N sets only how far
+    /// ahead the envelope is seen.
+    mpc_horizon: usize = 10, HORIZON_STEPS;
+    /// `mpc`: the prediction step h, s (the default is ten control periods
     /// at 1 kHz; the QP is still solved every period).
-    mpc_step: f64 = 0.01, positive;
-    /// `ctc`, `cbf-ctc`, `mpc`, `ppc`: how K1, K2 become the law's gains (default:
-    /// "as-given"; "matched" matches `pd`'s error dynamics). Unwritten at
-    /// its default so that existing scenarios keep their identity.
+    mpc_step: f64 = 0.01, POSITIVE;
+    /// `ctc`, `cbf-ctc`, `mpc`, `ppc`: how K1, K2 become the law's gains:
+    /// "as-given", or "matched" to `pd`'s error dynamics. Unwritten at its
+    /// default so that existing scenarios keep their identity.
     #[serde(skip_serializing_if = "is_default")]
-    tuning: Tuning = Tuning::AsGiven, any;
+    tuning: Tuning = Tuning::AsGiven, ANY_NAME;
 }
 
 /// The most neurons a network may have: checked before anything is
@@ -208,57 +228,89 @@ fn invalid(key: &str, value: impl ToString, need: impl Into<String>) -> Controll
     }
 }
 
+/// One key of `[controller]` as the reference page lists it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ParamDoc {
+    /// The key.
+    pub key: &'static str,
+    /// Its documentation, one line per doc-comment line.
+    pub doc: &'static str,
+    /// What its value must be.
+    pub need: &'static str,
+}
+
+/// A parameter's check: what a value must be, said once for the error
+/// and for the reference page, and the test of it.
+pub struct Check<T: ?Sized> {
+    /// What a value must be.
+    pub need: &'static str,
+    ok: fn(&T) -> bool,
+}
+
+impl<T: std::fmt::Display + ?Sized> Check<T> {
+    fn run(&self, key: &str, v: &T) -> Result<(), ControllerError> {
+        match (self.ok)(v) {
+            true => Ok(()),
+            false => Err(invalid(key, v, self.need)),
+        }
+    }
+}
+
 // The checks a parameter's declaration names; each fails NaN.
 
-fn any<T>(_key: &str, _value: &T) -> Result<(), ControllerError> {
-    Ok(())
+/// Any value serde accepts: a name, checked as it is read.
+const ANY_NAME: AnyName = AnyName {
+    need: "a name (see what it is)",
+};
+const POSITIVE: Check<f64> = Check {
+    need: "a finite number > 0",
+    ok: |v| v.is_finite() && *v > 0.0,
+};
+const NON_NEGATIVE: Check<f64> = Check {
+    need: "a finite number ≥ 0",
+    ok: |v| v.is_finite() && *v >= 0.0,
+};
+const OPEN_UNIT: Check<f64> = Check {
+    need: "a number in (0, 1)",
+    ok: |v| *v > 0.0 && *v < 1.0,
+};
+const FINITE: Check<f64> = Check {
+    need: "a finite number",
+    ok: |v| v.is_finite(),
+};
+/// Gains say which joint's entry is wrong: [`Gain::check_positive`].
+const POSITIVE_GAIN: GainCheck = GainCheck {
+    need: "a finite number > 0, or one per controlled joint, each > 0",
+};
+const NEURON_COUNT: Check<usize> = Check {
+    need: "an integer from 1 to 1000 (MAX_NEURONS)",
+    ok: |v| (1..=MAX_NEURONS).contains(v),
+};
+const HORIZON_STEPS: Check<usize> = Check {
+    need: "an integer from 1 to 200 (MAX_MPC_HORIZON)",
+    ok: |v| (1..=MAX_MPC_HORIZON).contains(v),
+};
+
+/// The check of a gain, whose error names the joint.
+struct GainCheck {
+    need: &'static str,
 }
 
-fn positive(key: &str, v: &f64) -> Result<(), ControllerError> {
-    match v.is_finite() && *v > 0.0 {
-        true => Ok(()),
-        false => Err(invalid(key, v, "a finite number > 0")),
+impl GainCheck {
+    fn run(&self, key: &str, g: &Gain) -> Result<(), ControllerError> {
+        g.check_positive(key)
     }
 }
 
-fn non_negative(key: &str, v: &f64) -> Result<(), ControllerError> {
-    match v.is_finite() && *v >= 0.0 {
-        true => Ok(()),
-        false => Err(invalid(key, v, "a finite number ≥ 0")),
+/// The check of a name (a law, a layout, …): serde has made it one.
+struct AnyName {
+    need: &'static str,
+}
+
+impl AnyName {
+    fn run<T>(&self, _key: &str, _v: &T) -> Result<(), ControllerError> {
+        Ok(())
     }
-}
-
-fn open_unit(key: &str, v: &f64) -> Result<(), ControllerError> {
-    match *v > 0.0 && *v < 1.0 {
-        true => Ok(()),
-        false => Err(invalid(key, v, "a number in (0, 1)")),
-    }
-}
-
-fn finite(key: &str, v: &f64) -> Result<(), ControllerError> {
-    match v.is_finite() {
-        true => Ok(()),
-        false => Err(invalid(key, v, "a finite number")),
-    }
-}
-
-fn positive_gain(key: &str, g: &Gain) -> Result<(), ControllerError> {
-    g.check_positive(key)
-}
-
-fn in_range(key: &str, v: usize, max: usize) -> Result<(), ControllerError> {
-    match (1..=max).contains(&v) {
-        true => Ok(()),
-        false => Err(invalid(key, v, format!("from 1 to {max}"))),
-    }
-}
-
-fn neuron_count(key: &str, v: &usize) -> Result<(), ControllerError> {
-    in_range(key, *v, MAX_NEURONS)
-}
-
-fn horizon_steps(key: &str, v: &usize) -> Result<(), ControllerError> {
-    in_range(key, *v, MAX_MPC_HORIZON)
 }
 
 impl ControllerParams {
@@ -308,8 +360,9 @@ impl ControllerParams {
 mod tests {
     use super::*;
 
-    /// Every key a law takes is declared, and every declared key is in the
-    /// `[controller]` row of the scenario docs.
+    /// Every key a law takes is declared, and documented: the reference
+    /// page is made from the declarations (`params_reference.rs`, whose
+    /// test keeps the shipped page current).
     #[test]
     fn every_key_is_declared_once_and_documented() {
         for law in LawName::ALL {
@@ -317,16 +370,8 @@ mod tests {
                 assert!(ControllerParams::KEYS.contains(&key), "{law}: {key}");
             }
         }
-        let docs = include_str!("../../docs/scenarios-and-robots.md");
-        let row = docs
-            .lines()
-            .find(|l| l.starts_with("| `[controller]` |"))
-            .unwrap();
-        for key in ControllerParams::KEYS {
-            assert!(
-                row.contains(&format!("`{key}`")),
-                "{key} is not in the docs' [controller] row"
-            );
+        for p in ControllerParams::REFERENCE {
+            assert!(p.doc.trim().len() > 10, "{} has no documentation", p.key);
         }
         // One key per field, each once.
         let mut keys = ControllerParams::KEYS.to_vec();
