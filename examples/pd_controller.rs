@@ -64,7 +64,13 @@ fn args() -> Result<(RunPrefix, std::path::PathBuf, Mode), String> {
             .ok_or(format!("missing {flag}"))
     };
     let prefix = RunPrefix::parse(&value("--prefix")?).map_err(|e| e.to_string())?;
-    Ok((prefix, value("--config")?.into(), value("--mode")?.parse()?))
+    Ok((
+        prefix,
+        value("--config")?.into(),
+        value("--mode")?
+            .parse()
+            .map_err(|e: wire::UnknownMode| e.to_string())?,
+    ))
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {

@@ -210,7 +210,7 @@ fn plan_from(contents: &LogContents) -> Result<(Plan, Mode), AnalysisError> {
     };
     let mode: Mode = get("mode")?
         .parse()
-        .map_err(|e: String| meta_err(path, format!("testbed.run mode: {e}")))?;
+        .map_err(|e: wire::UnknownMode| meta_err(path, format!("testbed.run mode: {e}")))?;
     let plan = scenario::plan(scenario, label, toml.clone(), robot)
         .map_err(|e| meta_err(path, e.to_string()))?;
     Ok((plan, mode))

@@ -34,15 +34,25 @@ impl LogCompression {
     }
 
     /// Parses a name of [`LogCompression::NAMES`].
-    pub fn parse(s: &str) -> Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self, UnknownCompression> {
         match s {
             "zstd" => Ok(Self::Zstd),
             "lz4" => Ok(Self::Lz4),
             "none" => Ok(Self::None),
-            other => Err(format!(
-                "{other:?} is not a log compression (one of: {})",
-                Self::NAMES.join(", ")
-            )),
+            other => Err(UnknownCompression(other.into())),
         }
     }
 }
+
+/// A name that is not a [`LogCompression`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownCompression(pub String);
+
+impl std::fmt::Display for UnknownCompression {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let names = LogCompression::NAMES.join(", ");
+        write!(f, "{:?} is not a log compression (one of: {names})", self.0)
+    }
+}
+
+impl std::error::Error for UnknownCompression {}

@@ -50,7 +50,7 @@ pub use channels::{
     ChannelSpec, JOINT_COMMANDS_TOPIC, JOINT_STATES_TOPIC, MESSAGE_ENCODING, PROFILE,
     SCHEMA_ENCODING, channels,
 };
-pub use compression::LogCompression;
+pub use compression::{LogCompression, UnknownCompression};
 pub use decode::{Decode, decode_logged};
 pub use decode_error::DecodeError;
 pub use json::LogMessage;

@@ -310,7 +310,7 @@ impl Walk {
             let record = match record {
                 Ok(r) => r,
                 Err(e) => {
-                    out.cut_short = Some(if e.to_lowercase().contains("crc") {
+                    out.cut_short = Some(if e.is_checksum() {
                         format!(
                             "a chunk is damaged (its checksum does not match: {e}); it and what follows are left out"
                         )

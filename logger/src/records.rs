@@ -10,6 +10,53 @@
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
+/// Why the records stop: a record whose framing does not hold, or what
+/// the `mcap` reader found (a checksum among them).
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    /// A length field claims more than the record holds.
+    #[error("claims {claims} bytes for its {what} but {left} remain")]
+    Overrun {
+        /// Bytes claimed.
+        claims: u64,
+        /// Which field.
+        what: &'static str,
+        /// Bytes left in the record.
+        left: usize,
+    },
+    /// The record ends inside a length field.
+    #[error("ends inside its {0}")]
+    Short(&'static str),
+    /// A record the reader uses whose fields do not fit it.
+    #[error("a record (opcode {opcode:#04x}) {cause}")]
+    Record {
+        /// The record's opcode.
+        opcode: u8,
+        /// What does not fit.
+        cause: Box<RecordError>,
+    },
+    /// The `mcap` reader's own error.
+    #[error(transparent)]
+    Mcap(#[from] mcap::McapError),
+}
+
+impl RecordError {
+    /// A checksum does not match (a chunk's, the data section's, an
+    /// attachment's or the summary's).
+    pub fn is_checksum(&self) -> bool {
+        use mcap::McapError as E;
+        matches!(
+            self,
+            Self::Mcap(
+                E::BadChunkCrc { .. }
+                    | E::BadDataCrc { .. }
+                    | E::BadAttachmentCrc { .. }
+                    | E::BadSummaryCrc { .. }
+            )
+        )
+    }
+}
+
 /// No record of a testbed log is longer (the URDF attachment is at most
 /// 16 MB, chunks about 1 MB).
 pub const MAX_RECORD_BYTES: usize = 64 << 20;
@@ -50,7 +97,7 @@ impl<'a> Records<'a> {
 }
 
 impl<'a> Iterator for Records<'a> {
-    type Item = Result<Record<'a>, String>;
+    type Item = Result<Record<'a>, RecordError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         while let Some(event) = self.reader.next_event() {
@@ -66,12 +113,13 @@ impl<'a> Iterator for Records<'a> {
                         continue;
                     }
                     if let Err(why) = fields_fit(opcode, data) {
-                        return Some(Err(format!("a record (opcode {opcode:#04x}) {why}")));
+                        let cause = Box::new(why);
+                        return Some(Err(RecordError::Record { opcode, cause }));
                     }
                     let parsed = mcap::parse_record(opcode, data);
-                    return Some(parsed.map(Record::into_owned).map_err(|e| e.to_string()));
+                    return Some(parsed.map(Record::into_owned).map_err(RecordError::from));
                 }
-                Err(e) => return Some(Err(e.to_string())),
+                Err(e) => return Some(Err(e.into())),
             }
         }
         None
@@ -86,20 +134,21 @@ const USED: [u8; 6] = [0x02, 0x03, 0x04, 0x05, 0x09, 0x0c];
 struct Fields<'b>(&'b [u8]);
 
 impl Fields<'_> {
-    fn skip(&mut self, n: u64, what: &str) -> Result<(), String> {
+    fn skip(&mut self, n: u64, what: &'static str) -> Result<(), RecordError> {
         if n > self.0.len() as u64 {
-            return Err(format!(
-                "claims {n} bytes for its {what} but {} remain",
-                self.0.len()
-            ));
+            return Err(RecordError::Overrun {
+                claims: n,
+                what,
+                left: self.0.len(),
+            });
         }
         self.0 = &self.0[n as usize..];
         Ok(())
     }
 
-    fn int(&mut self, bytes: usize, what: &str) -> Result<u64, String> {
+    fn int(&mut self, bytes: usize, what: &'static str) -> Result<u64, RecordError> {
         if self.0.len() < bytes {
-            return Err(format!("ends inside its {what}"));
+            return Err(RecordError::Short(what));
         }
         let mut b = [0u8; 8];
         b[..bytes].copy_from_slice(&self.0[..bytes]);
@@ -108,14 +157,14 @@ impl Fields<'_> {
     }
 
     /// A u32-prefixed string or map, or a u64-prefixed byte array.
-    fn prefixed(&mut self, prefix: usize, what: &str) -> Result<(), String> {
+    fn prefixed(&mut self, prefix: usize, what: &'static str) -> Result<(), RecordError> {
         let n = self.int(prefix, what)?;
         self.skip(n, what)
     }
 }
 
 /// Whether every length field of a used record fits inside it.
-fn fields_fit(opcode: u8, data: &[u8]) -> Result<(), String> {
+fn fields_fit(opcode: u8, data: &[u8]) -> Result<(), RecordError> {
     let mut f = Fields(data);
     match opcode {
         // Schema: id, name, encoding, data.
@@ -151,12 +200,13 @@ fn fields_fit(opcode: u8, data: &[u8]) -> Result<(), String> {
 }
 
 /// A map of `len` bytes of u32-prefixed key and value strings.
-fn map_fits(body: &[u8], len: u64) -> Result<(), String> {
+fn map_fits(body: &[u8], len: u64) -> Result<(), RecordError> {
     if len > body.len() as u64 {
-        return Err(format!(
-            "claims {len} bytes for a map but {} remain",
-            body.len()
-        ));
+        return Err(RecordError::Overrun {
+            claims: len,
+            what: "map",
+            left: body.len(),
+        });
     }
     let mut f = Fields(body);
     while !f.0.is_empty() {

@@ -53,8 +53,8 @@ pub use layout::{
     FieldLayout, FieldType, TypeLayout, WireField, WireLayout, all_layouts, field_size,
 };
 pub use messages::*;
-pub use own::{OwnLayout, OwnShape, is_diagnostic_name};
-pub use protocol::{HEARTBEAT, Mode, SILENT_AFTER, ns_to_s};
+pub use own::{OwnLayout, OwnLayoutError, OwnShape, is_diagnostic_name};
+pub use protocol::{HEARTBEAT, Mode, SILENT_AFTER, UnknownMode, ns_to_s};
 pub use reference_rule::is_stale;
 pub use topic::{
     Delivery, LOSSLESS_TIMEOUT, MAX_NODES, MAX_SUBSCRIBERS, RUN_PREFIX_STEM, SUBSCRIBER_BUFFER,

@@ -8,6 +8,33 @@
 
 use crate::MAX_OWN_DIAGNOSTICS;
 
+/// Why a declaration of own diagnostics is refused.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum OwnLayoutError {
+    /// A shape other than the two there are.
+    #[error("shape {0:?}: \"scalar\" or \"joints\"")]
+    Shape(String),
+    /// A name that cannot name a CSV column or a field.
+    #[error("diagnostic {0:?}: 1 to 40 of a-z, 0-9 and '_', starting with a letter")]
+    Name(String),
+    /// A name declared twice.
+    #[error("diagnostic {0:?} is declared twice")]
+    Twice(String),
+    /// More values a step than the message holds.
+    #[error(
+        "the diagnostics declared take {len} values a step for {dof} joints; at most {MAX_OWN_DIAGNOSTICS} fit"
+    )]
+    TooMany {
+        /// Values a step.
+        len: usize,
+        /// Joints.
+        dof: usize,
+    },
+    /// An entry of the text that is not `name:shape`.
+    #[error("{0:?} is not name:shape")]
+    Entry(String),
+}
+
 /// How many values one diagnostic has.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum OwnShape {
@@ -27,11 +54,11 @@ impl OwnShape {
     }
 
     /// From its spelling.
-    pub fn parse(s: &str) -> Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self, OwnLayoutError> {
         match s {
             "scalar" => Ok(OwnShape::Scalar),
             "joints" => Ok(OwnShape::Joints),
-            other => Err(format!("shape {other:?}: \"scalar\" or \"joints\"")),
+            other => Err(OwnLayoutError::Shape(other.into())),
         }
     }
 
@@ -62,40 +89,35 @@ pub fn is_diagnostic_name(name: &str) -> bool {
 impl OwnLayout {
     /// A layout of `entries`, checked for `dof` joints: valid, distinct
     /// names, and at most [`MAX_OWN_DIAGNOSTICS`] values a step.
-    pub fn new(entries: Vec<(String, OwnShape)>, dof: usize) -> Result<Self, String> {
+    pub fn new(entries: Vec<(String, OwnShape)>, dof: usize) -> Result<Self, OwnLayoutError> {
         for (i, (name, _)) in entries.iter().enumerate() {
             if !is_diagnostic_name(name) {
-                return Err(format!(
-                    "diagnostic {name:?}: 1 to 40 of a-z, 0-9 and '_', starting with a letter"
-                ));
+                return Err(OwnLayoutError::Name(name.clone()));
             }
             if entries[..i].iter().any(|(n, _)| n == name) {
-                return Err(format!("diagnostic {name:?} is declared twice"));
+                return Err(OwnLayoutError::Twice(name.clone()));
             }
         }
         let layout = Self { entries };
         let len = layout.len(dof);
         if len > MAX_OWN_DIAGNOSTICS {
-            return Err(format!(
-                "the diagnostics declared take {len} values a step for {dof} joints; \
-                 at most {MAX_OWN_DIAGNOSTICS} fit"
-            ));
+            return Err(OwnLayoutError::TooMany { len, dof });
         }
         Ok(layout)
     }
 
     /// Reads [`OwnLayout::text`] back (`""`: none declared).
-    pub fn parse(text: &str, dof: usize) -> Result<Self, String> {
+    pub fn parse(text: &str, dof: usize) -> Result<Self, OwnLayoutError> {
         let entries = text
             .split(',')
             .filter(|e| !e.is_empty())
             .map(|e| {
                 let (name, shape) = e
                     .split_once(':')
-                    .ok_or_else(|| format!("{e:?} is not name:shape"))?;
+                    .ok_or_else(|| OwnLayoutError::Entry(e.into()))?;
                 Ok((name.to_string(), OwnShape::parse(shape)?))
             })
-            .collect::<Result<Vec<_>, String>>()?;
+            .collect::<Result<Vec<_>, OwnLayoutError>>()?;
         Self::new(entries, dof)
     }
 
@@ -171,7 +193,7 @@ mod tests {
             ("x:vector", "\"scalar\" or \"joints\""),
             ("x", "not name:shape"),
         ] {
-            let e = OwnLayout::parse(text, 20).unwrap_err();
+            let e = OwnLayout::parse(text, 20).unwrap_err().to_string();
             assert!(e.contains(says), "{text}: {e}");
         }
     }

@@ -45,14 +45,19 @@ impl Mode {
     }
 }
 
-impl std::str::FromStr for Mode {
-    type Err = String;
+/// A spelling that is not a [`Mode`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("'{0}' is not a mode: realtime or lockstep")]
+pub struct UnknownMode(pub String);
 
-    fn from_str(s: &str) -> Result<Self, String> {
+impl std::str::FromStr for Mode {
+    type Err = UnknownMode;
+
+    fn from_str(s: &str) -> Result<Self, UnknownMode> {
         match s {
             "realtime" => Ok(Mode::Realtime),
             "lockstep" => Ok(Mode::Lockstep),
-            other => Err(format!("'{other}' is not a mode: realtime or lockstep")),
+            other => Err(UnknownMode(other.into())),
         }
     }
 }
@@ -85,6 +90,7 @@ mod tests {
             "real-time"
                 .parse::<Mode>()
                 .unwrap_err()
+                .to_string()
                 .contains("realtime or lockstep")
         );
         assert_eq!(Mode::Lockstep.delivery(), Delivery::Lossless);

@@ -4,6 +4,6 @@
 pub use wire::Mode;
 
 /// `--mode realtime|lockstep` for clap (`value_parser = mode::parse`).
-pub fn parse(s: &str) -> Result<Mode, String> {
+pub fn parse(s: &str) -> Result<Mode, wire::UnknownMode> {
     s.parse()
 }
