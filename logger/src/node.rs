@@ -38,6 +38,10 @@ pub struct LoggerNodeConfig {
     /// A contact scenario's obstacles, for the 3D view.
     #[serde(default)]
     pub obstacles: Vec<crate::obstacles::DrawnObstacle>,
+    /// A contact scenario's free objects' shapes, in order, for the 3D
+    /// view (their poses come with the contact samples).
+    #[serde(default)]
+    pub objects: Vec<crate::obstacles::DrawnShape>,
 }
 
 /// Why the logger node stopped.
@@ -195,7 +199,7 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_nanos() as u64);
     let log = LogWriter::create_with(&config.out, &meta, &config.urdf, config.compression)?;
-    let mut out = Outputs::open(log, &model, &config.obstacles, live)?;
+    let mut out = Outputs::open(log, &model, (&config.obstacles, &config.objects), live)?;
 
     let started = link.ready_and_wait_for_start();
     let result: Result<(), LoggerNodeError> = match started {

@@ -1,6 +1,7 @@
 //! What the 3D view draws of a contact scenario: its obstacles, fixed in
-//! the world, with the arm's figure on `/arm/scene`, and the point where
-//! the arm touches one on `/arm/contact` while it does.
+//! the world, with the arm's figure on `/arm/scene`; and on `/arm/contact`
+//! the point where the arm touches something while it does, and each free
+//! object where the plant says it is.
 
 use arm_model::{Geometry, Origin, iso};
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
@@ -54,78 +55,106 @@ pub enum DrawnShape {
     },
 }
 
-impl DrawnObstacle {
-    /// The obstacle at `origin` shaped `g`.
-    pub fn new(origin: &Origin, g: &Geometry) -> Self {
-        let shape = match *g {
-            Geometry::Box { size } => DrawnShape::Box { size },
-            Geometry::Sphere { radius } => DrawnShape::Sphere { radius },
-            Geometry::Cylinder { radius, length } => DrawnShape::Cylinder { radius, length },
-            Geometry::Capsule { radius, length } => DrawnShape::Capsule { radius, length },
-        };
-        Self {
-            xyz: origin.xyz,
-            rpy: origin.rpy,
-            shape,
+impl DrawnShape {
+    /// The shape of a URDF primitive.
+    pub fn of(g: &Geometry) -> Self {
+        match *g {
+            Geometry::Box { size } => Self::Box { size },
+            Geometry::Sphere { radius } => Self::Sphere { radius },
+            Geometry::Cylinder { radius, length } => Self::Cylinder { radius, length },
+            Geometry::Capsule { radius, length } => Self::Capsule { radius, length },
         }
     }
 
-    /// Its marker in the world frame (a capsule drawn as the cylinder that
-    /// holds it), numbered `id`.
-    pub(crate) fn marker(&self, id: i32) -> Marker {
-        let (kind, scale) = match self.shape {
-            DrawnShape::Box { size } => (CUBE, size),
-            DrawnShape::Sphere { radius } => (SPHERE, [2.0 * radius; 3]),
-            DrawnShape::Cylinder { radius, length } => {
-                (CYLINDER, [2.0 * radius, 2.0 * radius, length])
-            }
-            DrawnShape::Capsule { radius, length } => (
+    /// Its marker at `pose` in the world frame (a capsule drawn as the
+    /// cylinder that holds it), numbered `id`.
+    fn marker(self, id: i32, pose: &Isometry3<f64>, color: [f32; 4], lifetime_ns: u64) -> Marker {
+        let (kind, scale) = match self {
+            Self::Box { size } => (CUBE, size),
+            Self::Sphere { radius } => (SPHERE, [2.0 * radius; 3]),
+            Self::Cylinder { radius, length } => (CYLINDER, [2.0 * radius, 2.0 * radius, length]),
+            Self::Capsule { radius, length } => (
                 CYLINDER,
                 [2.0 * radius, 2.0 * radius, length + 2.0 * radius],
             ),
-        };
-        let origin = Origin {
-            xyz: self.xyz,
-            rpy: self.rpy,
         };
         Marker {
             frame: WORLD_FRAME.into(),
             id,
             kind,
-            pose: parts(&iso(&origin)),
+            pose: parts(pose),
             scale,
-            color: [0.55, 0.55, 0.55, 0.8],
-            lifetime_ns: 0,
+            color,
+            lifetime_ns,
         }
     }
 }
 
+impl DrawnObstacle {
+    /// The obstacle at `origin` shaped `g`.
+    pub fn new(origin: &Origin, g: &Geometry) -> Self {
+        Self {
+            xyz: origin.xyz,
+            rpy: origin.rpy,
+            shape: DrawnShape::of(g),
+        }
+    }
+
+    /// Its marker in the world frame, numbered `id`.
+    pub(crate) fn marker(&self, id: i32) -> Marker {
+        let origin = Origin {
+            xyz: self.xyz,
+            rpy: self.rpy,
+        };
+        self.shape
+            .marker(id, &iso(&origin), [0.55, 0.55, 0.55, 0.8], 0)
+    }
+}
+
 /// The contact point as a red ball in the world frame, 1 cm across per
-/// 100 N of mean contact force (from 1 to 10 cm).
+/// 100 N of mean contact force (from 1 to 10 cm), and each free object
+/// (`objects`: their shapes, in order) at the pose `c` gives it, green.
 pub(crate) fn contact_marker(
     out: &mut Vec<u8>,
     t_ns: u64,
     c: &wire::ContactState,
+    objects: &[DrawnShape],
     lifetime_ns: u64,
 ) {
-    let d = (c.force / 1e4).clamp(0.01, 0.1);
-    let pose = Isometry3::from_parts(
-        Vector3::new(c.point_x, c.point_y, c.point_z).into(),
-        UnitQuaternion::identity(),
-    );
-    let markers = match c.points {
-        0 => Vec::new(),
-        _ => vec![Marker {
-            frame: WORLD_FRAME.into(),
-            id: 0,
-            kind: SPHERE,
-            pose: parts(&pose),
-            scale: [d; 3],
-            color: [0.9, 0.1, 0.1, 1.0],
+    let mut markers = Vec::new();
+    if c.points > 0 {
+        let d = (c.force / 1e4).clamp(0.01, 0.1);
+        let at = Isometry3::from_parts(
+            Vector3::new(c.point_x, c.point_y, c.point_z).into(),
+            UnitQuaternion::identity(),
+        );
+        markers.push(DrawnShape::Sphere { radius: d / 2.0 }.marker(
+            0,
+            &at,
+            [0.9, 0.1, 0.1, 1.0],
             lifetime_ns,
-        }],
-    };
+        ));
+    }
+    let poses = c.objects[..(c.count as usize).min(wire::MAX_DOF)].chunks_exact(7);
+    for (i, (shape, p)) in objects.iter().zip(poses).enumerate() {
+        let Some(at) = object_pose(p) else { continue };
+        markers.push(shape.marker(1 + i as i32, &at, [0.2, 0.7, 0.3, 1.0], lifetime_ns));
+    }
     ros2::marker_array(out, t_ns, &markers);
+}
+
+/// An object's pose from its 7 numbers (None if not finite or not a
+/// rotation).
+fn object_pose(p: &[f64]) -> Option<Isometry3<f64>> {
+    if !p.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let q = nalgebra::Quaternion::new(p[6], p[3], p[4], p[5]);
+    let r = UnitQuaternion::try_new(q, 1e-9)?;
+    Some(Isometry3::from_parts(
+        Vector3::new(p[0], p[1], p[2]).into(),
+        r,
+    ))
 }
 
 /// `visualization_msgs/Marker.CUBE`.

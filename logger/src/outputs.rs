@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use arm_model::ArmModel;
 use wire::{Command, ContactState, JointState, Logged};
 
-use crate::obstacles::{CONTACT_MARKER_TOPIC, DrawnObstacle, contact_marker};
+use crate::obstacles::{CONTACT_MARKER_TOPIC, DrawnObstacle, DrawnShape, contact_marker};
 
 use crate::live::LiveView;
 use crate::scene::{ArmScene, SCENE_TOPIC, TRANSFORMS_TOPIC};
@@ -44,6 +44,8 @@ pub(crate) struct Outputs {
     next_state_view_ns: u64,
     next_command_view_ns: u64,
     next_contact_view_ns: u64,
+    /// The free objects' shapes, drawn where the contact samples say.
+    objects: Vec<DrawnShape>,
     /// A derived message's CDR, reused.
     buf: Vec<u8>,
 }
@@ -54,7 +56,7 @@ impl Outputs {
     pub(crate) fn open(
         mut log: LogWriter,
         model: &ArmModel,
-        obstacles: &[DrawnObstacle],
+        (obstacles, objects): (&[DrawnObstacle], &[DrawnShape]),
         live: Option<Box<dyn LiveView>>,
     ) -> Result<Self, LogError> {
         for spec in channels() {
@@ -82,6 +84,7 @@ impl Outputs {
             next_state_view_ns: 0,
             next_command_view_ns: 0,
             next_contact_view_ns: 0,
+            objects: objects.to_vec(),
             buf: Vec::with_capacity(4096),
         })
     }
@@ -109,16 +112,17 @@ impl Outputs {
     }
 
     /// What contact did: the sample, then, while the arm touches
-    /// something, the contact point on `/arm/contact` at most every 20 ms
-    /// of sim time (each marker lasting two of those, so it goes when the
-    /// contact does).
+    /// something or free objects are about, the contact point and the
+    /// objects on `/arm/contact` at most every 20 ms of sim time (each
+    /// marker lasting two of those, so it goes when the contact does).
     pub(crate) fn take_contact(&mut self, c: &ContactState) -> Result<(), LogError> {
         self.take(c)?;
         let (t, wall) = (c.header.t_ns, c.header.wall_ns);
-        if c.points > 0 && c.force.is_finite() && t >= self.next_contact_view_ns {
+        let shown = (c.points > 0 && c.force.is_finite()) || !self.objects.is_empty();
+        if shown && t >= self.next_contact_view_ns {
             self.next_contact_view_ns = t.saturating_add(VIEWS_EVERY_NS);
             self.buf.clear();
-            contact_marker(&mut self.buf, t, c, 2 * VIEWS_EVERY_NS);
+            contact_marker(&mut self.buf, t, c, &self.objects, 2 * VIEWS_EVERY_NS);
             self.emit(CONTACT_MARKER_TOPIC, t, wall)?;
         }
         Ok(())

@@ -134,11 +134,18 @@ impl PlantMachine {
                 wall_ns,
             },
             points: c.points,
-            reserved: 0,
+            count: (7 * c.n_objects) as u32,
             force: c.force,
             point_x: c.point[0],
             point_y: c.point[1],
             point_z: c.point[2],
+            objects: {
+                let mut v = [0.0; wire::MAX_DOF];
+                for (out, pose) in v.chunks_exact_mut(7).zip(&c.objects[..c.n_objects]) {
+                    out.copy_from_slice(pose);
+                }
+                v
+            },
         })
     }
 

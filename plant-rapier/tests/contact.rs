@@ -299,6 +299,58 @@ fn an_object_rests_until_grasped_and_falls_when_released() {
     }
 }
 
+/// The pendulum's tip strikes a free ball in its path (no gravity, so it
+/// floats until struck): the ball flies off along the tip's motion, the
+/// pendulum slows, and the reading reports the ball's pose as it moves.
+#[test]
+fn the_arm_pushes_a_free_object() {
+    let model = ArmModel::from_urdf_str(PENDULUM).unwrap();
+    let q_ball: f64 = 0.5;
+    let ball = ContactObject {
+        name: "ball".into(),
+        shape: ShapeName::Sphere,
+        size: vec![0.05],
+        mass: 0.2,
+        xyz: [q_ball.cos(), q_ball.sin(), 0.0],
+        rpy: [0.0; 3],
+        link: "arm".into(),
+        grasp_at_s: 100.0,
+        release_at_s: None,
+    };
+    let config = PlantConfig {
+        engine: EngineName::Rapier,
+        gravity: [0.0; 3],
+        substeps: Some(8),
+        contact: ContactConfig {
+            friction: 0.0,
+            object: vec![ball],
+            ..ContactConfig::default()
+        },
+        ..PlantConfig::default()
+    };
+    let mut r = Rig::new(&model, &config, 0, PERIOD_NS).unwrap();
+    r.set_state(&[0.0], &[2.0]).unwrap();
+    let (mut q, mut qd) = ([0.0], [0.0]);
+    let mut touched = 0;
+    for _ in 0..400 {
+        r.step(Some(&[0.0])).unwrap();
+        touched += u32::from(r.effects().has(Effects::CONTACT));
+        let reading = r.plant().contact().unwrap();
+        let p = r.plant().object_position(0).unwrap();
+        assert_eq!(reading.n_objects, 1);
+        for (a, b) in reading.objects[0][..3].iter().zip(p) {
+            assert!((a - b).abs() < 1e-12, "{:?} vs {p:?}", reading.objects[0]);
+        }
+    }
+    r.true_state_into(&mut q, &mut qd);
+    let p = r.plant().object_position(0).unwrap();
+    // Pushed: it left its place along the tip's motion (+y near q = 0.45).
+    let moved = [p[0] - q_ball.cos(), p[1] - q_ball.sin()];
+    assert!(touched > 0, "no contact");
+    assert!(moved[1] > 0.2, "the ball stayed: {p:?}");
+    assert!(qd[0] < 1.9, "the pendulum did not slow: {}", qd[0]);
+}
+
 /// Three links in a row, a 10 cm ball at the middle of the first and at
 /// the end of the third.
 const FOLDING: &str = r#"<robot name="folding">
@@ -390,4 +442,26 @@ fn a_contact_scenario_is_checked_before_it_runs() {
         e.contains("plant.contact.object[0].link") && e.contains("not the fixed base"),
         "{e}"
     );
+    // A free object through the tip at the start is refused; grasped from
+    // the first step, it is part of the link at once and allowed.
+    let mut at_tip = ContactObject {
+        link: "arm".into(),
+        xyz: [1.0, 0.0, 0.0],
+        ..object(0.5, None)
+    };
+    contact.object = vec![at_tip.clone()];
+    let e = plant_rapier::check_contact(&model, &contact, &[0.0])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("plant.contact.object[0]") && e.contains("overlaps link 'arm'"),
+        "{e}"
+    );
+    at_tip.grasp_at_s = 0.0;
+    contact.object = vec![at_tip];
+    plant_rapier::check_contact(&model, &contact, &[0.0]).unwrap();
+    // More objects than the log carries poses of.
+    contact.object = vec![object(100.0, None); wire::MAX_OBJECTS + 1];
+    let e = contact.validate().unwrap_err().to_string();
+    assert!(e.contains("at most 4"), "{e}");
 }

@@ -211,20 +211,21 @@ class ContactState(ctypes.Structure):
     _fields_ = [
         ("header", Header),
         ("points", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
+        ("count", ctypes.c_uint32),
         ("force", ctypes.c_double),
         ("point_x", ctypes.c_double),
         ("point_y", ctypes.c_double),
         ("point_z", ctypes.c_double),
+        ("objects", ctypes.c_double * MAX_DOF),
     ]
-    SIZE = 64
+    SIZE = 320
     ALIGN = 8
-    OFFSETS = {"header": 0, "points": 24, "reserved": 28, "force": 32, "point_x": 40, "point_y": 48, "point_z": 56}
-    JOINT_FIELDS = ()
+    OFFSETS = {"header": 0, "points": 24, "count": 28, "force": 32, "point_x": 40, "point_y": 48, "point_z": 56, "objects": 64}
+    JOINT_FIELDS = ("objects",)
 
     @staticmethod
     def type_name() -> str:
-        return "testbed.ContactState.v1"
+        return "testbed.ContactState.v2"
 
 
 class Control(ctypes.Structure):

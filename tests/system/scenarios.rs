@@ -137,18 +137,40 @@ fn a_pick_and_place_runs_the_same_in_sim_and_lockstep() {
     let args = ["--scenario", "paper_pick_place", "--duration", "6"];
     let sim = csv_of(&[&["sim"][..], &args].concat(), dir.path(), "sim.csv");
     let lockstep_csv = dir.path().join("lockstep.csv");
-    ok(testbed()
+    let run = json(&ok(testbed()
         .args(["run", "--mode", "lockstep", "--json"])
         .args(args)
         .arg("--runs-dir")
         .arg(dir.path().join("runs"))
         .arg("--csv")
-        .arg(&lockstep_csv));
+        .arg(&lockstep_csv)));
     assert_same_csv(
         "sim vs lockstep",
         &sim,
         &std::fs::read(&lockstep_csv).unwrap(),
     );
+    // The ball's pose comes with every contact sample: on the table until
+    // taken at 2.1 s, carried (lifted) after, and drawn on /arm/contact
+    // every 20 ms of sim time.
+    let (mut z, mut markers) = (Vec::new(), 0u64);
+    let mut on_message = |m: &logger::RawMessage<'_>| {
+        markers += u64::from(m.topic == logger::obstacles::CONTACT_MARKER_TOPIC);
+        if let Some(wire::Logged::ContactState(c)) = logger::decode_logged(m)? {
+            assert_eq!(c.count, 7, "{c:?}");
+            z.push(c.objects[2]);
+        }
+        Ok(())
+    };
+    logger::read_log(
+        std::path::Path::new(run["log"].as_str().unwrap()),
+        Some(&mut on_message),
+    )
+    .unwrap();
+    assert_eq!(z.len(), 6001);
+    assert!((z[1000] + 0.47).abs() < 2e-3, "resting: z = {}", z[1000]);
+    let carried = z[2100..5400].iter().copied().fold(f64::MIN, f64::max);
+    assert!(carried > z[2100] + 0.05, "never lifted: max z {carried}");
+    assert!((299..=301).contains(&markers), "{markers} object markers");
 }
 
 /// #38 item 2: the arm striking a table runs the same bits in `sim` and in

@@ -224,14 +224,15 @@ crate::data_message! {
 crate::data_message! {
     /// What contact did over the period that led to the state with the same
     /// `header.seq` (published only by a plant with `[plant.contact]`).
-    #[type_name("testbed.ContactState.v1")]
+    #[type_name("testbed.ContactState.v2")]
     pub struct ContactState {
         /// seq = k, t_ns = t_k.
         header: Header,
         /// Contact points at the period's last substep.
         points: u32 => U32,
-        /// Padding (keeps the layout explicit).
-        reserved: u32 => Pad,
+        /// Values in `objects`: 7 per free object (0 in logs before objects
+        /// were logged).
+        count: u32 => U32 | 0,
         /// Mean contact force on the arm over the period: the contact
         /// solver's normal impulses summed over contacts and substeps, over
         /// the period, N.
@@ -243,8 +244,16 @@ crate::data_message! {
         point_y: f64 => F64,
         /// Its z, m.
         point_z: f64 => F64,
+        /// Each `[[plant.contact.object]]`'s pose at the period's end, world
+        /// frame: x, y, z (m), then the quaternion x, y, z, w, one object
+        /// after another ([`MAX_OBJECTS`] at most).
+        objects: Joints => V | [0.0; MAX_DOF],
     }
 }
+
+/// The most free objects a contact scenario may have: [`ContactState`]
+/// carries 7 numbers of pose for each in its [`MAX_DOF`] values.
+pub const MAX_OBJECTS: usize = MAX_DOF / 7;
 
 crate::data_message! {
     /// Timing of one plant cycle (published by the plant, which is the clock).

@@ -128,15 +128,25 @@ impl ContactConfig {
                 "a coefficient from 0 to 100",
             ));
         }
-        for (key, n) in [
-            ("plant.contact.obstacle", self.obstacle.len()),
-            ("plant.contact.object", self.object.len()),
+        for (key, n, max, why) in [
+            (
+                "plant.contact.obstacle",
+                self.obstacle.len(),
+                MAX_OBSTACLES,
+                "",
+            ),
+            (
+                "plant.contact.object",
+                self.object.len(),
+                wire::MAX_OBJECTS,
+                " (the log carries each one's pose)",
+            ),
         ] {
-            if n > MAX_OBSTACLES {
+            if n > max {
                 return Err(invalid(
                     key,
                     format!("{n} entries"),
-                    format!("at most {MAX_OBSTACLES}"),
+                    format!("at most {max}{why}"),
                 ));
             }
         }

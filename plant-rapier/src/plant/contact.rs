@@ -10,11 +10,14 @@ use super::shapes::{pose, shape};
 use crate::{ContactConfig, PlantError};
 
 /// Arm colliders are in group 1, obstacles in group 2, free objects in 3:
-/// the arm meets obstacles, objects rest on obstacles; an object meets
-/// the arm only as part of it, once grasped.
+/// the arm meets obstacles and objects (it can push one); objects rest on
+/// obstacles and on each other. A grasped object's collider joins the
+/// arm's group, as part of its link.
 const ARM: Group = Group::GROUP_1;
 const OBSTACLES: Group = Group::GROUP_2;
 const OBJECTS: Group = Group::GROUP_3;
+/// What a free object meets.
+const OBJECT_MEETS: Group = ARM.union(OBSTACLES).union(OBJECTS);
 
 /// What contact did over the last period.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -26,6 +29,11 @@ pub struct ContactReading {
     pub points: u32,
     /// The deepest of them, world frame, m (0 with none).
     pub point: [f64; 3],
+    /// Free objects in `objects`.
+    pub n_objects: usize,
+    /// Each free object's pose at the period's end, world frame: x, y, z,
+    /// then the quaternion x, y, z, w.
+    pub objects: [[f64; 7]; wire::MAX_OBJECTS],
 }
 
 /// The colliders of one arm and what they met.
@@ -37,6 +45,8 @@ pub(super) struct Contacts {
     arm: Vec<RigidBodyHandle>,
     /// The objects a link grasps and releases.
     objects: Vec<Held>,
+    /// The arm colliders' groups (they meet each other with `self_contact`).
+    arm_groups: (Group, Group),
 }
 
 /// A free object and the link that grasps it.
@@ -56,9 +66,9 @@ pub(super) fn insert(
 ) -> Result<Contacts, PlantError> {
     super::contact_check::check_contact_shapes(model, config)?;
     let arm_filter = if config.self_contact {
-        ARM | OBSTACLES
+        ARM | OBSTACLES | OBJECTS
     } else {
-        OBSTACLES
+        OBSTACLES | OBJECTS
     };
     let material = |b: ColliderBuilder| {
         b.restitution(config.restitution)
@@ -100,7 +110,7 @@ pub(super) fn insert(
         let b = material(shape(&o.geometry(i)?)).mass(o.mass);
         objects.push(Held {
             body,
-            collider: attach(world, b, body, (OBJECTS, OBSTACLES)),
+            collider: attach(world, b, body, (OBJECTS, OBJECT_MEETS)),
             link: bodies_of_arm[link],
         });
     }
@@ -109,6 +119,7 @@ pub(super) fn insert(
         impulse: 0.0,
         arm: bodies_of_arm.to_vec(),
         objects,
+        arm_groups: (ARM, arm_filter),
     })
 }
 
@@ -119,17 +130,16 @@ fn attach(
     body: RigidBodyHandle,
     (member, filter): (Group, Group),
 ) -> ColliderHandle {
-    let collider = b
-        .collision_groups(InteractionGroups::new(
-            member,
-            filter,
-            InteractionTestMode::And,
-        ))
-        .build();
+    let collider = b.collision_groups(groups((member, filter))).build();
     let PhysicsWorld {
         colliders, bodies, ..
     } = world;
     colliders.insert_with_parent(collider, body, bodies)
+}
+
+/// Collision groups: `member` meets what `filter` names, both ways.
+fn groups((member, filter): (Group, Group)) -> InteractionGroups {
+    InteractionGroups::new(member, filter, InteractionTestMode::And)
 }
 
 impl Contacts {
@@ -181,6 +191,7 @@ impl Contacts {
         colliders.set_parent(h.collider, Some(h.link), bodies);
         if let Some(c) = colliders.get_mut(h.collider) {
             c.set_position_wrt_parent(relative);
+            c.set_collision_groups(groups(self.arm_groups));
         }
         if let Some(b) = bodies.get_mut(h.body) {
             b.set_enabled(false);
@@ -205,6 +216,7 @@ impl Contacts {
         colliders.set_parent(h.collider, Some(h.body), bodies);
         if let Some(c) = colliders.get_mut(h.collider) {
             c.set_position_wrt_parent(Pose::IDENTITY);
+            c.set_collision_groups(groups((OBJECTS, OBJECT_MEETS)));
         }
         Ok(())
     }
@@ -229,9 +241,17 @@ impl Contacts {
         Ok((h, *c.position(), link.clone()))
     }
 
-    /// Ends a period of length `dt`: the reading for it.
-    pub(super) fn end(&mut self, dt: f64) -> ContactReading {
+    /// Ends a period of length `dt`: the reading for it, with where each
+    /// object is.
+    pub(super) fn end(&mut self, dt: f64, colliders: &ColliderSet) -> ContactReading {
         self.reading.force = self.impulse / dt;
+        self.reading.n_objects = self.objects.len().min(wire::MAX_OBJECTS);
+        for (out, h) in self.reading.objects.iter_mut().zip(&self.objects) {
+            if let Some(c) = colliders.get(h.collider) {
+                let (t, r) = (c.position().translation, c.position().rotation);
+                *out = [t.x, t.y, t.z, r.x, r.y, r.z, r.w];
+            }
+        }
         self.reading
     }
 }

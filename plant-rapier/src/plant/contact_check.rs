@@ -113,7 +113,8 @@ fn usable_shapes(model: &ArmModel) -> Result<(), PlantError> {
     Ok(())
 }
 
-/// No obstacle overlaps a link's primitive with the arm at `q0`.
+/// No obstacle or free object overlaps a link's primitive with the arm
+/// at `q0`.
 fn clear_at_start(model: &ArmModel, contact: &ContactConfig, q0: &[f64]) -> Result<(), PlantError> {
     let mut dynamics = Dynamics::new(model, 1.0);
     let links: Vec<Pose> = dynamics
@@ -127,8 +128,29 @@ fn clear_at_start(model: &ArmModel, contact: &ContactConfig, q0: &[f64]) -> Resu
             )
         })
         .collect();
+    // Obstacles and free objects alike: the arm must start clear of both.
+    let mut bodies = Vec::new();
     for (i, o) in contact.obstacle.iter().enumerate() {
-        let (at, body) = (pose(&o.origin()), shape(&o.geometry(i)?).shape);
+        let key = format!("plant.contact.obstacle[{i}]");
+        bodies.push((
+            key,
+            format!("\"{}\"", o.label(i)),
+            o.origin(),
+            o.geometry(i)?,
+        ));
+    }
+    // An object grasped from the first step is part of its link at once.
+    for (i, o) in contact
+        .object
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| o.grasp_at_s > 0.0)
+    {
+        let key = format!("plant.contact.object[{i}]");
+        bodies.push((key, format!("object {}", i + 1), o.origin(), o.geometry(i)?));
+    }
+    for (key, label, origin, geometry) in bodies {
+        let (at, body) = (pose(&origin), shape(&geometry).shape);
         for (link, p) in model.links.iter().zip(&links) {
             for c in &link.collisions {
                 let (cp, cs) = (*p * pose(&c.origin), shape(&c.geometry).shape);
@@ -136,8 +158,8 @@ fn clear_at_start(model: &ArmModel, contact: &ContactConfig, q0: &[f64]) -> Resu
                     query::intersection_test(&at, &*body, &cp, &*cs).is_ok_and(|x| x.intersecting);
                 if hit {
                     return Err(invalid(
-                        format!("plant.contact.obstacle[{i}]"),
-                        format!("\"{}\"", o.label(i)),
+                        key,
+                        label,
                         format!(
                             "clear of the arm where it starts: it overlaps link '{}' at the initial q",
                             link.name

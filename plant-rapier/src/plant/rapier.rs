@@ -95,6 +95,11 @@ impl RapierArm {
             mb.set_self_contacts_enabled(true);
         }
         let n = dofs.len();
+        // Before the first period: no contact yet, the objects where they start.
+        let mut contacts = contacts;
+        let contact = contacts
+            .as_mut()
+            .map(|c| c.end(1.0, &world.colliders));
         Ok(Self {
             world,
             multibody,
@@ -105,7 +110,7 @@ impl RapierArm {
             q: vec![0.0; n],
             qd: vec![0.0; n],
             total: vec![0.0; n],
-            contact: contacts.as_ref().map(|_| ContactReading::default()),
+            contact,
             contacts,
         })
     }
@@ -195,7 +200,10 @@ impl RapierArm {
                 c.after_substep(&self.world.narrow_phase, &self.world.colliders);
             }
         }
-        self.contact = self.contacts.as_mut().map(|c| c.end(dt));
+        self.contact = self
+            .contacts
+            .as_mut()
+            .map(|c| c.end(dt, &self.world.colliders));
     }
 
     /// The link named in `[[plant.contact.object]]` `i` grasps it (`on`) or

@@ -90,6 +90,7 @@ pub fn logger(
         compression: opts.compression,
         live: opts.live.cloned(),
         obstacles: drawn_obstacles(&plan.scenario.plant.contact),
+        objects: drawn_objects(&plan.scenario.plant.contact),
     }
 }
 
@@ -103,6 +104,23 @@ fn drawn_obstacles(contact: &plant_rapier::ContactConfig) -> Vec<logger::obstacl
         .filter_map(|(i, o)| {
             let g = o.geometry(i).ok()?;
             Some(logger::obstacles::DrawnObstacle::new(&o.origin(), &g))
+        })
+        .collect()
+}
+
+/// The scenario's free objects' shapes, in order (poses come with the
+/// plant's contact samples).
+fn drawn_objects(contact: &plant_rapier::ContactConfig) -> Vec<logger::obstacles::DrawnShape> {
+    contact
+        .object
+        .iter()
+        .enumerate()
+        .map(|(i, o)| {
+            // Checked with the scenario; a dot keeps the order if not.
+            o.geometry(i).map_or(
+                logger::obstacles::DrawnShape::Sphere { radius: 0.01 },
+                |g| logger::obstacles::DrawnShape::of(&g),
+            )
         })
         .collect()
 }
