@@ -88,6 +88,7 @@ pub(super) fn diagnose(text: &str, reader_error: &str) -> Option<String> {
         .and_then(|r| r.split('`').next());
     let wanted = |p: &&Problem| match missing {
         Some(field) => p.field == field,
+        None if p.empty => reader_error.contains("found EndElement"),
         None => {
             p.number && (reader_error.contains("float") || reader_error.contains("element count"))
         }
@@ -98,6 +99,8 @@ pub(super) fn diagnose(text: &str, reader_error: &str) -> Option<String> {
 struct Problem {
     field: String,
     number: bool,
+    /// An element the reader needs something inside of, found empty.
+    empty: bool,
     message: String,
 }
 
@@ -189,6 +192,7 @@ fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut 
                 out.push(Problem {
                     field: field.to_string(),
                     number: false,
+                    empty: false,
                     message: format!("{at} has no {field}=\"…\", which the URDF format requires"),
                 });
             }
@@ -205,6 +209,7 @@ fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut 
                 out.push(Problem {
                     field: field.to_string(),
                     number: true,
+                    empty: false,
                     message: format!("{at} {field}=\"{v}\": {why}"),
                 });
             }
@@ -212,10 +217,25 @@ fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut 
     }
 }
 
+/// The shapes a `<geometry>` holds one of.
+const SHAPES: [&str; 5] = ["box", "cylinder", "sphere", "capsule", "mesh"];
+
 /// Checks that a closing element had the children it needs.
 fn closed(open: &Open, out: &mut Vec<Problem>) {
     if !open.read {
         return;
+    }
+    if open.name == "geometry" && !open.children.iter().any(|c| SHAPES.contains(&c.as_str())) {
+        out.push(Problem {
+            field: "geometry".into(),
+            number: false,
+            empty: true,
+            message: format!(
+                "{}: a <geometry> holds no shape; write one of <{}>",
+                open.owner,
+                SHAPES.join(">, <")
+            ),
+        });
     }
     for (element, required) in REQUIRED_CHILDREN {
         if *element == open.name {
@@ -226,6 +246,7 @@ fn closed(open: &Open, out: &mut Vec<Problem>) {
                 out.push(Problem {
                     field: child.to_string(),
                     number: false,
+                    empty: false,
                     message: format!(
                         "{}: <{}> has no <{child}>, which the URDF format requires{}",
                         open.owner,

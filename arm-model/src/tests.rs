@@ -502,3 +502,15 @@ fn an_effort_of_minus_one_is_no_limit() {
     );
     assert!(err(&arm(&J1.replace(r#"effort="10""#, r#"effort="-5""#), "")).contains("effort = -5"));
 }
+
+/// An empty `<geometry>` (urdf-rs says only "Expected token … found
+/// EndElement(geometry)") is named with its link and what to write.
+#[test]
+fn an_empty_geometry_is_named_with_its_link() {
+    let links = r#"<link name="b"><collision><geometry/></collision></link>"#;
+    let e = err(&arm(J1, links));
+    assert_eq!(
+        e,
+        "not a valid URDF: link 'b': a <geometry> holds no shape; write one of <box>, <cylinder>, <sphere>, <capsule>, <mesh>"
+    );
+}

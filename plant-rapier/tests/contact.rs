@@ -460,6 +460,16 @@ fn a_contact_scenario_is_checked_before_it_runs() {
     at_tip.grasp_at_s = 0.0;
     contact.object = vec![at_tip];
     plant_rapier::check_contact(&model, &contact, &[0.0]).unwrap();
+    // A material with nothing to touch.
+    let lone = ContactConfig {
+        restitution: 0.5,
+        ..ContactConfig::default()
+    };
+    let e = lone.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("plant.contact.restitution") && e.contains("nothing to touch"),
+        "{e}"
+    );
     // More objects than the log carries poses of.
     contact.object = vec![object(100.0, None); wire::MAX_OBJECTS + 1];
     let e = contact.validate().unwrap_err().to_string();

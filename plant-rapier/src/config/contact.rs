@@ -114,6 +114,22 @@ impl ContactConfig {
 
     /// Checks every entry; errors name the key.
     pub fn validate(&self) -> Result<(), PlantError> {
+        // A material with nothing to touch would silently do nothing.
+        let d = Self::default();
+        for (key, value, default) in [
+            ("plant.contact.restitution", self.restitution, d.restitution),
+            ("plant.contact.friction", self.friction, d.friction),
+        ] {
+            if value != default && self.is_off() {
+                return Err(invalid(
+                    key,
+                    value,
+                    format!(
+                        "left at its default ({default}) without obstacles, objects or self_contact: there is nothing to touch"
+                    ),
+                ));
+            }
+        }
         if !(0.0..=1.0).contains(&self.restitution) {
             return Err(invalid(
                 "plant.contact.restitution",

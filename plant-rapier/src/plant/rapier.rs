@@ -97,9 +97,7 @@ impl RapierArm {
         let n = dofs.len();
         // Before the first period: no contact yet, the objects where they start.
         let mut contacts = contacts;
-        let contact = contacts
-            .as_mut()
-            .map(|c| c.end(1.0, &world.colliders));
+        let contact = contacts.as_mut().map(|c| c.end(1.0, &world.colliders));
         Ok(Self {
             world,
             multibody,
