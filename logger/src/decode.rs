@@ -13,7 +13,7 @@ pub trait Decode: LogMessage {
     fn decode_as(encoding: Encoding, data: &[u8]) -> Result<Self, DecodeError> {
         match encoding {
             Encoding::Json => Self::parse(data),
-            Encoding::Cdr => crate::ros2::decode(data),
+            Encoding::Cdr => crate::cdr_decode::decode(data),
         }
     }
 }
@@ -39,7 +39,7 @@ pub fn decode_logged(m: &RawMessage<'_>) -> Result<Option<Logged>, DecodeError> 
 fn decode_one<M: LogMessage>(m: &RawMessage<'_>) -> Result<M, DecodeError> {
     match (m.encoding, m.schema) {
         (Encoding::Json, _) => M::parse(m.data),
-        (Encoding::Cdr, Some(schema)) => crate::ros2::decode_by(schema, m.data),
+        (Encoding::Cdr, Some(schema)) => crate::cdr_decode::decode_by(schema, m.data),
         (Encoding::Cdr, None) => Err(DecodeError(format!(
             "channel {} has no testbed_msgs schema to read its CDR by",
             m.topic

@@ -26,6 +26,7 @@
 //! [`foxglove_layout`] lays them out for either.
 
 pub mod cdr;
+pub mod cdr_decode;
 mod channels;
 mod compression;
 mod decode;

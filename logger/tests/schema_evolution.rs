@@ -7,6 +7,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use logger::cdr::CdrWriter;
+use logger::cdr_decode;
 use logger::msg_schema::{MsgSchema, SchemaKind};
 use logger::ros2;
 use wire::{FieldRef, JointState, MessageFields, NONE_U64};
@@ -93,7 +94,7 @@ fn a_log_written_before_a_field_was_added_reads_with_its_declared_default() {
     ));
     assert_eq!(older.fields.len() + 2, schema_of(&text).fields.len());
     let data = encode_by(&older, &state(), 0.0);
-    let back: JointState = ros2::decode_by(&older, &data).unwrap();
+    let back: JointState = cdr_decode::decode_by(&older, &data).unwrap();
     assert_eq!(back.command_seq, NONE_U64);
     assert_eq!(back.applied_wall_ns, 0);
     assert_eq!(
@@ -111,7 +112,7 @@ fn a_field_the_log_has_and_this_build_dropped_is_read_past() {
         "float64[] future_field  # added by a later build\nuint64 future_count\n",
     ));
     let data = encode_by(&newer, &state(), 4.0);
-    let back: JointState = ros2::decode_by(&newer, &data).unwrap();
+    let back: JointState = cdr_decode::decode_by(&newer, &data).unwrap();
     assert_eq!(back, {
         let mut s = state();
         // Padding is not logged.
@@ -125,7 +126,7 @@ fn a_required_field_the_log_lacks_is_named() {
     let text = ros2::schema_text::<JointState>();
     let without = schema_of(&edited_schema(&text, &[" q"], ""));
     let data = encode_by(&without, &state(), 0.0);
-    let e = ros2::decode_by::<JointState>(&without, &data)
+    let e = cdr_decode::decode_by::<JointState>(&without, &data)
         .unwrap_err()
         .to_string();
     assert_eq!(e, "field 'q' is missing");
@@ -140,7 +141,7 @@ fn a_field_of_another_type_is_refused_by_name() {
         "float64 deadline_misses\n",
     ));
     let data = encode_by(&changed, &state(), 0.0);
-    let e = ros2::decode_by::<JointState>(&changed, &data)
+    let e = cdr_decode::decode_by::<JointState>(&changed, &data)
         .unwrap_err()
         .to_string();
     assert!(e.contains("deadline_misses"), "{e}");
@@ -152,7 +153,7 @@ fn the_schema_this_build_writes_decodes_what_it_encodes() {
     let mut data = Vec::new();
     ros2::encode(&state(), &mut data);
     assert_eq!(data, encode_by(&own, &state(), 0.0));
-    let back: JointState = ros2::decode_by(&own, &data).unwrap();
+    let back: JointState = cdr_decode::decode_by(&own, &data).unwrap();
     assert_eq!(back.command_seq, 6);
     assert_eq!(back.applied_wall_ns, 99);
 }
