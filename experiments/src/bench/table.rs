@@ -57,16 +57,7 @@ pub fn bench_table(b: &crate::bench::types::BenchReport) -> String {
              {} samples dropped by the logger",
             r.cycles, r.deadline_misses, r.late_wakeups, r.logger_dropped
         );
-        let _ = writeln!(
-            out,
-            "    period jitter us  {}",
-            percentiles(&r.period_jitter_us)
-        );
-        let _ = writeln!(
-            out,
-            "    round trip us     {}",
-            percentiles(&r.round_trip_us)
-        );
+        jitter_and_round_trip(&mut out, r);
         let f = &a.timer_floor;
         let _ = writeln!(
             out,
@@ -92,6 +83,83 @@ pub fn bench_table(b: &crate::bench::types::BenchReport) -> String {
             .map(|(n, s)| format!("{n} {s:.3} s"))
             .collect();
         let _ = writeln!(out, "  lockstep CPU    {}", cpu.join(", "));
+    }
+    out
+}
+
+/// A real-time run's period jitter and round trip, a line each.
+fn jitter_and_round_trip(out: &mut String, r: &crate::bench::types::RealtimeFigures) {
+    let _ = writeln!(
+        out,
+        "    period jitter us  {}",
+        percentiles(&r.period_jitter_us)
+    );
+    let _ = writeln!(
+        out,
+        "    round trip us     {}",
+        percentiles(&r.round_trip_us)
+    );
+}
+
+/// The lockstep stack against the Python + MuJoCo loop, pair by pair.
+pub fn peer_table(b: &crate::bench::peer::PeerBench) -> String {
+    let mut s = format!(
+        "{} scenario, {:.1} s simulated; Python + MuJoCo (RK4, {} substeps) against `testbed run --mode lockstep` (logger on)\n",
+        b.scenario, b.sim_s, b.peer_substeps
+    );
+    let _ = writeln!(
+        s,
+        "{:<6} {:>14} {:>14} {:>8}",
+        "pair", "lockstep, s", "Python, s", "ratio"
+    );
+    for (i, (l, p)) in b.lockstep_wall_s.iter().zip(&b.peer_wall_s).enumerate() {
+        let _ = writeln!(s, "{:<6} {l:>14.3} {p:>14.3} {:>7.1}×", i + 1, p / l);
+    }
+    let _ = writeln!(
+        s,
+        "median ratio: {:.1}× (lockstep {:.0}× real time)",
+        b.speedup,
+        b.sim_s / crate::bench::types::median(b.lockstep_wall_s.clone())
+    );
+    let _ = writeln!(
+        s,
+        "max |q − q_d| after T_c: testbed {:?}, Python loop {:?} rad",
+        b.testbed_max_error_after_tc, b.peer_max_error_after_tc
+    );
+    s
+}
+
+/// The two controllers' figures, pair by pair.
+pub fn controller_table(b: &crate::bench::controller::ControllerBench) -> String {
+    let mut out = String::new();
+    let m = &b.machine;
+    let _ = writeln!(
+        out,
+        "machine: {} ({} CPUs), kernel {}\n{} with law {} in real time at {} Hz, {} pair(s) of {} s runs",
+        m.cpu, m.cores, m.kernel, b.scenario, b.law, b.rate_hz, b.pairs, b.realtime_s
+    );
+    for (i, pair) in b.testbed.iter().zip(&b.command).enumerate() {
+        let _ = writeln!(out, "\npair {}:", i + 1);
+        for c in [pair.0, pair.1] {
+            let r = &c.realtime;
+            let _ = writeln!(
+                out,
+                "  {}\n    {} cycles, {} deadline misses, {} wake-ups late by a period \
+                 (timer floor beside it: {} late)",
+                c.controller,
+                r.cycles,
+                r.deadline_misses,
+                r.late_wakeups,
+                c.timer_floor.deadline_misses
+            );
+            jitter_and_round_trip(&mut out, r);
+            let _ = writeln!(out, "    compute us        {}", percentiles(&c.compute_us));
+            let _ = writeln!(
+                out,
+                "    floor jitter us   {}",
+                percentiles(&c.timer_floor.period_jitter_us)
+            );
+        }
     }
     out
 }
