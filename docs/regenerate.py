@@ -43,6 +43,7 @@ SCENARIOS = [
     "iiwa_actuators",
     "paper_obstacle",
     "paper_pick_place",
+    "iiwa_wall",
 ]
 ARMS = ["two_link", "three_link_planar", "ur5", "iiwa14", "panda", "xarm7", "so101", "z1"]
 LAWS = "nac,nac-no-shift,nac-no-critic,nac-no-networks,blf,pd,pd-gravity,ctc,ppc,smc,cbf-ctc,mpc"

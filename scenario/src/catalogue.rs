@@ -39,6 +39,7 @@ pub const SHIPPED: &[Shipped] = shipped![
     "iiwa_actuators",
     "paper_obstacle",
     "paper_pick_place",
+    "iiwa_wall",
 ];
 
 impl Shipped {
