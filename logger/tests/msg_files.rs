@@ -1,71 +1,81 @@
 //! The ROS 2 package shipped in `logger/msg/testbed_msgs/`: each `.msg` is
 //! what the log's schema text says for its message (made from the wire's
-//! field list). `TESTBED_WRITE_MSG=1 cargo test -p logger --test msg_files`
-//! rewrites them after a message changes.
+//! field list), and its CMakeLists.txt builds each; both are made from the
+//! wire's list of logged messages. `TESTBED_WRITE_MSG=1 cargo test -p
+//! logger --test msg_files` rewrites them after a message changes.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use std::path::Path;
 
 use logger::{LogMessage, ros2};
-use wire::{
-    Command, ContactState, ControllerDiagnostics, JointState, OwnDiagnostics, ReferenceSample,
-    Timing,
-};
 
-fn check<M: LogMessage>(stale: &mut Vec<String>) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("msg/testbed_msgs/msg");
-    let path = dir.join(format!("{}.msg", ros2::msg_name::<M>()));
-    let want = ros2::msg_text::<M>();
-    if std::env::var_os("TESTBED_WRITE_MSG").is_some() {
-        std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(&path, &want).unwrap();
+/// The package's files as the wire's logged messages make them: each
+/// message's `.msg`, and the CMakeLists.txt that builds them all.
+fn package() -> Vec<(String, String)> {
+    fn msg<M: LogMessage>() -> (String, String) {
+        // The schema in the log is this definition and the standard ones it uses.
+        assert!(ros2::schema_text::<M>().starts_with(&ros2::msg_text::<M>()));
+        (
+            format!("msg/{}.msg", ros2::msg_name::<M>()),
+            ros2::msg_text::<M>(),
+        )
     }
-    let have = std::fs::read_to_string(&path).unwrap_or_default();
-    if have != want {
-        stale.push(path.display().to_string());
+    macro_rules! each {
+        ($($ty:ident => $topic:ident, $channel:literal, $schema:literal;)*) => {
+            vec![$(msg::<wire::$ty>(),)*]
+        };
     }
-    // The schema in the log is this definition and the standard ones it uses.
-    assert!(ros2::schema_text::<M>().starts_with(&want));
+    let mut files = wire::logged_messages!(each);
+    let listed: String = files.iter().map(|(f, _)| format!("  \"{f}\"\n")).collect();
+    files.push((
+        "CMakeLists.txt".into(),
+        format!(
+            "cmake_minimum_required(VERSION 3.8)\nproject(testbed_msgs)\n\
+             find_package(ament_cmake REQUIRED)\nfind_package(rosidl_default_generators REQUIRED)\n\
+             find_package(std_msgs REQUIRED)\nrosidl_generate_interfaces(${{PROJECT_NAME}}\n\
+             {listed}  DEPENDENCIES std_msgs\n)\nament_package()\n"
+        ),
+    ));
+    files
 }
 
+/// #39 row 13: the shipped ROS 2 package (`logger/msg/testbed_msgs/`) is
+/// the generated one: a `.msg` for every logged message, what the log's
+/// schema says, each built by CMakeLists.txt, and no other `.msg`.
 #[test]
-fn the_shipped_msg_files_are_the_generated_ones() {
-    let mut stale = Vec::new();
-    check::<JointState>(&mut stale);
-    check::<ReferenceSample>(&mut stale);
-    check::<Command>(&mut stale);
-    check::<ControllerDiagnostics>(&mut stale);
-    check::<Timing>(&mut stale);
-    check::<OwnDiagnostics>(&mut stale);
-    check::<ContactState>(&mut stale);
+fn the_shipped_package_is_the_generated_one() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("msg/testbed_msgs");
+    let files = package();
+    if std::env::var_os("TESTBED_WRITE_MSG").is_some() {
+        std::fs::create_dir_all(root.join("msg")).unwrap();
+        for (name, text) in &files {
+            std::fs::write(root.join(name), text).unwrap();
+        }
+    }
+    let stale: Vec<&str> = files
+        .iter()
+        .filter(|(name, text)| std::fs::read_to_string(root.join(name)).ok().as_ref() != Some(text))
+        .map(|(name, _)| name.as_str())
+        .collect();
     assert!(
         stale.is_empty(),
         "stale: {stale:?}; rewrite them: TESTBED_WRITE_MSG=1 cargo test -p logger --test msg_files"
     );
-}
-
-/// #39 row 13: every testbed_msgs type a log's channels use has its `.msg`
-/// file and is built by the package's CMakeLists.txt.
-#[test]
-fn the_package_has_every_logged_type() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("msg/testbed_msgs");
-    let cmake = std::fs::read_to_string(root.join("CMakeLists.txt")).unwrap();
+    let shipped = std::fs::read_dir(root.join("msg")).unwrap().count();
+    assert_eq!(
+        shipped,
+        files.len() - 1,
+        "a .msg file no logged message makes"
+    );
+    // Every testbed_msgs type a log's channels use is in the package.
     let prefix = format!("{}/msg/", ros2::PACKAGE);
-    let mut seen = 0;
     for spec in logger::channels() {
-        let Some(name) = spec.schema_name.strip_prefix(&prefix) else {
-            continue;
-        };
-        seen += 1;
-        let file = format!("msg/{name}.msg");
-        assert!(root.join(&file).is_file(), "{file} is missing");
-        assert!(
-            cmake.contains(&format!("\"{file}\"")),
-            "CMakeLists.txt lacks {file}"
-        );
+        if let Some(name) = spec.schema_name.strip_prefix(&prefix) {
+            let file = format!("msg/{name}.msg");
+            assert!(files.iter().any(|(f, _)| *f == file), "{file}");
+        }
     }
-    assert_eq!(seen, 7);
 }
 
 /// #39 row 13: every channel carries the QoS profile rosbag2 writes.

@@ -168,23 +168,6 @@ class ControllerDiagnostics(ctypes.Structure):
         return "testbed.ControllerDiagnostics.v3"
 
 
-class OwnDiagnostics(ctypes.Structure):
-    _fields_ = [
-        ("header", Header),
-        ("count", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
-        ("values", ctypes.c_double * MAX_DOF),
-    ]
-    SIZE = 288
-    ALIGN = 8
-    OFFSETS = {"header": 0, "count": 24, "reserved": 28, "values": 32}
-    JOINT_FIELDS = ("values",)
-
-    @staticmethod
-    def type_name() -> str:
-        return "testbed.OwnDiagnostics.v1"
-
-
 class Timing(ctypes.Structure):
     _fields_ = [
         ("header", Header),
@@ -205,6 +188,23 @@ class Timing(ctypes.Structure):
     @staticmethod
     def type_name() -> str:
         return "testbed.Timing.v2"
+
+
+class OwnDiagnostics(ctypes.Structure):
+    _fields_ = [
+        ("header", Header),
+        ("count", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("values", ctypes.c_double * MAX_DOF),
+    ]
+    SIZE = 288
+    ALIGN = 8
+    OFFSETS = {"header": 0, "count": 24, "reserved": 28, "values": 32}
+    JOINT_FIELDS = ("values",)
+
+    @staticmethod
+    def type_name() -> str:
+        return "testbed.OwnDiagnostics.v1"
 
 
 class ContactState(ctypes.Structure):
@@ -278,7 +278,7 @@ TOPICS = {
     "status": ("testbed/status", NodeStatus, 8, 8, True),
 }
 
-STRUCTURES = ("Header", "JointState", "ReferenceSample", "Command", "ControllerDiagnostics", "OwnDiagnostics", "Timing", "ContactState", "Control", "NodeStatus")
+STRUCTURES = ("Header", "JointState", "ReferenceSample", "Command", "ControllerDiagnostics", "Timing", "OwnDiagnostics", "ContactState", "Control", "NodeStatus")
 
 
 def _check_layouts() -> None:

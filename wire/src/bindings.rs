@@ -193,7 +193,7 @@ fn topics(out: &mut String) {
          # whether readers block on its events). Every service lives under the run's prefix."
     );
     let _ = writeln!(out, "TOPICS = {{");
-    for t in Topic::ALL {
+    for &t in Topic::ALL {
         let _ = writeln!(
             out,
             "    {:?}: ({:?}, {}, {}, {}, {}),",
@@ -260,7 +260,8 @@ mod tests {
         for t in crate::all_layouts() {
             assert!(py.contains(&format!("class {}(ctypes.Structure)", t.name)));
         }
-        assert!(py.contains("return \"testbed.JointState.v4\""));
+        let name = <crate::JointState as crate::WireLayout>::TYPE_NAME;
+        assert!(py.contains(&format!("return \"{name}\"")));
         assert!(py.contains("\"joint_state\": (\"testbed/joint_state\", JointState, 1, 2, True)"));
         assert!(py.contains("FAULT_NO_REFERENCE = 5"));
         assert!(py.contains("RUN_END_LOST_NODE_BASE = 10"));

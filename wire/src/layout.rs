@@ -107,28 +107,38 @@ impl TypeLayout {
 
 /// [`Header`] and every message, in dependency order (the header first).
 pub fn all_layouts() -> Vec<TypeLayout> {
-    vec![
-        TypeLayout {
-            name: "Header",
-            type_name: "",
-            size: std::mem::size_of::<Header>(),
-            align: std::mem::align_of::<Header>(),
-            fields: vec![
-                FieldLayout::of::<u64>("seq", std::mem::offset_of!(Header, seq)),
-                FieldLayout::of::<u64>("t_ns", std::mem::offset_of!(Header, t_ns)),
-                FieldLayout::of::<u64>("wall_ns", std::mem::offset_of!(Header, wall_ns)),
-            ],
-        },
-        TypeLayout::of::<crate::JointState>("JointState"),
-        TypeLayout::of::<crate::ReferenceSample>("ReferenceSample"),
-        TypeLayout::of::<crate::Command>("Command"),
-        TypeLayout::of::<crate::ControllerDiagnostics>("ControllerDiagnostics"),
-        TypeLayout::of::<crate::OwnDiagnostics>("OwnDiagnostics"),
-        TypeLayout::of::<crate::Timing>("Timing"),
-        TypeLayout::of::<crate::ContactState>("ContactState"),
-        TypeLayout::of::<crate::Control>("Control"),
-        TypeLayout::of::<crate::NodeStatus>("NodeStatus"),
-    ]
+    vec![TypeLayout {
+        name: "Header",
+        type_name: "",
+        size: std::mem::size_of::<Header>(),
+        align: std::mem::align_of::<Header>(),
+        fields: vec![
+            FieldLayout::of::<u64>("seq", std::mem::offset_of!(Header, seq)),
+            FieldLayout::of::<u64>("t_ns", std::mem::offset_of!(Header, t_ns)),
+            FieldLayout::of::<u64>("wall_ns", std::mem::offset_of!(Header, wall_ns)),
+        ],
+    }]
+    .into_iter()
+    .chain(message_layouts())
+    .collect()
+}
+
+/// Every message's layout: the logged ones, then the bus's own, from the
+/// wire's two lists of them.
+fn message_layouts() -> Vec<TypeLayout> {
+    macro_rules! logged {
+        ($($ty:ident => $topic:ident, $channel:literal, $schema:literal;)*) => {
+            vec![$(TypeLayout::of::<crate::$ty>(stringify!($ty)),)*]
+        };
+    }
+    macro_rules! unlogged {
+        ($($ty:ident => $topic:ident, $schema:literal;)*) => {
+            vec![$(TypeLayout::of::<crate::$ty>(stringify!($ty)),)*]
+        };
+    }
+    let mut all = crate::logged_messages!(logged);
+    all.extend(crate::unlogged_messages!(unlogged));
+    all
 }
 
 /// Size in bytes of a field type.
@@ -160,8 +170,13 @@ mod tests {
     #[test]
     fn type_names_are_the_ones_iceoryx2_sees() {
         let names: Vec<&str> = all_layouts().iter().map(|t| t.type_name).collect();
-        assert!(names.contains(&"testbed.JointState.v4"));
-        assert!(names.contains(&"testbed.Control.v2"));
+        assert!(names.contains(&<crate::JointState as WireLayout>::TYPE_NAME));
+        assert!(names.contains(&<crate::Control as WireLayout>::TYPE_NAME));
+        assert!(
+            names
+                .iter()
+                .all(|n| n.is_empty() || n.starts_with("testbed."))
+        );
         // The derive and the layout read the same literal.
         #[allow(unsafe_code)]
         // SAFETY: type_name only returns a static string.

@@ -30,7 +30,7 @@ pub enum Topic {
 
 impl Topic {
     /// Every topic.
-    pub const ALL: [Topic; 9] = [
+    pub const ALL: &[Topic] = &[
         Topic::JointState,
         Topic::Reference,
         Topic::Command,
