@@ -7,7 +7,10 @@ use crate::ControllerError;
 
 /// K = diag(K_i): one number for every joint, or one per joint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "a number, or a list of numbers with one per controlled joint"
+)]
 pub enum Gain {
     /// The same K_i for every joint (the paper's form).
     All(f64),
@@ -92,6 +95,24 @@ impl std::fmt::Display for Gain {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+
+    /// A value of neither form says what a gain is, not serde's "no
+    /// variant of untagged enum".
+    #[test]
+    fn a_value_of_neither_form_says_what_a_gain_is() {
+        #[derive(Debug, serde::Deserialize)]
+        struct T {
+            #[allow(dead_code)]
+            k: Gain,
+        }
+        let e = toml::from_str::<T>("k = \"[1,\"").unwrap_err().to_string();
+        assert!(
+            e.contains("a number, or a list of numbers with one per controlled joint"),
+            "{e}"
+        );
+        assert!(toml::from_str::<T>("k = 20").is_ok());
+        assert!(toml::from_str::<T>("k = [1.0, 2]").is_ok());
+    }
 
     #[test]
     fn one_number_or_one_per_joint() {

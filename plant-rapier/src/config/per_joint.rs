@@ -8,7 +8,10 @@ use crate::PlantError;
 
 /// One number for every joint, or one per joint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "a number, or a list of numbers with one per joint"
+)]
 pub enum PerJoint {
     /// The same value for every joint.
     All(f64),
