@@ -31,6 +31,7 @@ mod diagnose;
 pub mod dynamics;
 mod error;
 mod file_refs;
+mod fold;
 mod inertia;
 mod parse;
 mod prefixes;
