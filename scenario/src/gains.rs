@@ -26,6 +26,7 @@
 use plant_rapier::{ArmModel, PlantError};
 
 use crate::Scenario;
+use crate::motor_bound::{K1Floor, MotorBound};
 use crate::probe::{Probe, Prober};
 
 /// Target for Δt·λ_max(K2^½ M⁻¹ K2^½): half the stability limit.
@@ -175,6 +176,9 @@ struct Measured {
     /// Probes halfway between the reference's: for the stability check.
     between: Vec<Probe>,
     minv_diag: Vec<f64>,
+    /// The smallest M⁻¹_ii over the postures probed: how little a joint's
+    /// own torque may accelerate it.
+    minv_diag_low: Vec<f64>,
     load: Vec<f64>,
     gravity: Vec<f64>,
 }
@@ -194,6 +198,14 @@ fn measure(model: &ArmModel, s: &Scenario) -> Result<Measured, PlantError> {
         .collect::<Result<Vec<_>, _>>()?;
     let minv_diag: Vec<f64> = (0..n)
         .map(|i| probes.iter().map(|p| p.minv[(i, i)]).fold(0.0, f64::max))
+        .collect();
+    let minv_diag_low: Vec<f64> = (0..n)
+        .map(|i| {
+            probes
+                .iter()
+                .map(|p| p.minv[(i, i)])
+                .fold(f64::INFINITY, f64::min)
+        })
         .collect();
     let r = &s.reference.joints;
     let qdd_max: Vec<f64> = r.iter().map(trajectory::Signal::accel_bound).collect();
@@ -226,6 +238,7 @@ fn measure(model: &ArmModel, s: &Scenario) -> Result<Measured, PlantError> {
         probes,
         between,
         minv_diag,
+        minv_diag_low,
         load,
         gravity,
     })
@@ -291,7 +304,16 @@ pub fn choose_gains(
     let envelope: Vec<f64> = (0..n)
         .map(|i| load_kc[i].max(barrier_kc[i]).min(cap[i]))
         .collect();
-    let mut joints = joint_gains(model, &m, &k2, &need, k1_max);
+    let start = reference_at(s, 0.0);
+    let floor: Vec<K1Floor> = (0..n)
+        .map(|i| {
+            let effort = model.joints[model.actuated[i]].effort;
+            let start_error = (s.initial.q[i] - start[i]).abs();
+            let motor = MotorBound::new(effort, m.load[i], m.minv_diag_low[i], start_error, kc[i]);
+            K1Floor::at(K1_MIN.min(k1_max), motor, envelope[i])
+        })
+        .collect();
+    let mut joints = joint_gains(model, &m, &k2, &need, &floor, k1_max);
     for (i, j) in joints.iter_mut().enumerate() {
         let low = kc_low[i] * envelope[i];
         j.barrier = barrier_factor() * dt / (beta * low * low * k2[i]);
@@ -341,18 +363,19 @@ fn joint_gains(
     m: &Measured,
     k2: &[f64],
     need: &[f64],
+    floor: &[K1Floor],
     k1_max: f64,
 ) -> Vec<JointGain> {
     (0..k2.len())
         .map(|i| JointGain {
             name: model.joints[model.actuated[i]].name.clone(),
-            k1: need[i].clamp(K1_MIN.min(k1_max), k1_max),
+            k1: need[i].clamp(floor[i].k1, k1_max),
             k2: k2[i],
             minv_diag: m.minv_diag[i],
             load: m.load[i],
             gravity: m.gravity[i],
             effort: model.joints[model.actuated[i]].effort,
-            k1_reason: k1_reason(need[i], k1_max),
+            k1_reason: k1_reason(need[i], &floor[i], k1_max),
             barrier: 0.0,
             envelope_reason: None,
             armature_needed: None,
@@ -370,15 +393,21 @@ fn round2(x: f64) -> f64 {
     (x / scale).ceil() * scale
 }
 
-fn k1_reason(need: f64, k1_max: f64) -> String {
-    if need <= K1_MIN {
-        format!("the paper's {K1_MIN} already holds the load (needs {need:.2})")
-    } else if need <= k1_max {
-        "holds the load within 40 % of the envelope".into()
-    } else {
-        format!(
+fn k1_reason(need: f64, floor: &K1Floor, k1_max: f64) -> String {
+    match floor.motor {
+        Some(b) if need <= floor.k1 => format!(
+            "√(a/E) = {:.2}, under the paper's {K1_MIN}: its motor turns it at {:.3} rad/s² beyond its load, and a higher K1 overshoots from its start {:.3} rad away (the load needs {need:.2})",
+            floor.k1,
+            b.accel,
+            b.start_error(floor.envelope)
+        ),
+        _ if need <= K1_MIN => {
+            format!("the paper's {K1_MIN} already holds the load (needs {need:.2})")
+        }
+        _ if need <= k1_max => "holds the load within 40 % of the envelope".into(),
+        _ => format!(
             "capped at 0.2/Δt = {k1_max:.0} (the load needs {need:.0}): the envelope is widened"
-        )
+        ),
     }
 }
 

@@ -18,6 +18,7 @@ mod default_for_arm;
 mod effort;
 mod gains;
 mod keys;
+mod motor_bound;
 mod plan;
 mod posture;
 mod probe;
