@@ -150,3 +150,30 @@ pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Tensor, ModelErr
         )
     })))
 }
+
+/// How many times the arm's size a link's radius of gyration may be before
+/// its tensor is no body of that link's: a link lies within the arm.
+const GYRATION_PER_SIZE: f64 = 10.0;
+
+/// The arm's size for [`implausible_gyration`], m: the joints' offsets
+/// added up (no two points of the arm are further apart), at least 1 m.
+pub(super) fn arm_size(offsets: impl Iterator<Item = [f64; 3]>) -> f64 {
+    offsets
+        .map(|[x, y, z]| (x * x + y * y + z * z).sqrt())
+        .sum::<f64>()
+        .max(1.0)
+}
+
+/// A tensor whose radius of gyration √(I_max/m) is more than ten times the
+/// arm's `size` is no body of that arm (a 1e-5 kg finger given the
+/// identity tensor, 1 kg m², turns like a body 300 m across): the reason,
+/// if so.
+pub(super) fn implausible_gyration(mass: f64, i: &[f64; 6], size: f64) -> Option<String> {
+    let largest = tensor(i).symmetric_eigenvalues().max();
+    let radius = (largest / mass).sqrt();
+    (mass > 0.0 && radius > GYRATION_PER_SIZE * size).then(|| {
+        format!(
+            "its largest principal moment {largest:.3e} kg m² on {mass:e} kg is a radius of gyration of {radius:.3e} m, over {GYRATION_PER_SIZE} times the arm's size of {size:.3} m (its joint offsets added up, at least 1 m): no part of this arm turns like that"
+        )
+    })
+}

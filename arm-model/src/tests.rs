@@ -409,6 +409,46 @@ fn a_light_link_with_malformed_inertia_keeps_its_mass() {
     );
 }
 
+/// The pincher's fingers: 1e-5 kg given the identity tensor (1 kg m², a
+/// radius of gyration of 316 m on an arm under 1 m) made the whole wrist a
+/// flywheel of 3 kg m² that no gain at 1 kHz could move. A light link so
+/// is kept with its mass and a sphere's tensor, and said; a heavy one is
+/// simulated as given, and said; a plausible tensor is left alone.
+#[test]
+fn a_tensor_no_link_of_the_arm_has_is_named() {
+    let identity = r#"ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1""#;
+    let jb = J1.replace("j1", "finger").replace("\"a\"", "\"tip\"");
+    let jb = jb.replace("<parent link=\"base\"/>", "<parent link=\"a\"/>");
+    let text = arm(&format!("{J1}{jb}"), &link("tip", "0.00001", identity));
+    let m = ArmModel::from_urdf_str(&text).unwrap();
+    let tip = m.links.iter().find(|l| l.name == "tip").unwrap();
+    assert_eq!(tip.mass, 0.00001);
+    assert!(tip.inertia[0] < 1e-8, "{:?}", tip.inertia);
+    assert!(
+        m.notes.iter().any(|n| n.starts_with("link 'tip'")
+            && n.contains("radius of gyration of 3.162e2 m")
+            && n.contains("kept with its mass")),
+        "{:?}",
+        m.notes
+    );
+    // 0.5 kg (half the arm) with 1e4 kg m²: 141 m, simulated as given.
+    let huge = r#"ixx="1e4" ixy="0" ixz="0" iyy="1e4" iyz="0" izz="1e4""#;
+    let m = ArmModel::from_urdf_str(&arm(&format!("{J1}{jb}"), &link("tip", "0.5", huge))).unwrap();
+    let tip = m.links.iter().find(|l| l.name == "tip").unwrap();
+    assert_eq!(tip.inertia[0], 1e4);
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.starts_with("link 'tip'") && n.contains("simulated as given")),
+        "{:?}",
+        m.notes
+    );
+    // 0.5 kg with 1 kg m² is 1.4 m: a long link, not a placeholder.
+    let m =
+        ArmModel::from_urdf_str(&arm(&format!("{J1}{jb}"), &link("tip", "0.5", identity))).unwrap();
+    assert!(m.notes.is_empty(), "{:?}", m.notes);
+}
+
 /// iCub's head: 1.34 kg with moments ±2.4e-35 (zero but for rounding) is a
 /// point mass, noted; no refusal for a sign in the 35th decimal.
 #[test]

@@ -7,7 +7,8 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use super::fold::{Folded, merge_fixed};
 use super::inertia::{
-    NEGLIGIBLE_MASS_RATIO, PLACEHOLDER_MASS_RATIO, Tensor, check_inertia, iso, origin_of,
+    NEGLIGIBLE_MASS_RATIO, PLACEHOLDER_MASS_RATIO, Tensor, arm_size, check_inertia,
+    implausible_gyration, iso, origin_of,
 };
 use super::parse::{joint_info, link_info};
 use super::{
@@ -352,6 +353,7 @@ fn settle_masses(
         .map(|i| links[i].mass)
         .fold(0.0, f64::max);
     let threshold = NEGLIGIBLE_MASS_RATIO * heaviest;
+    let size = arm_size(joints.iter().map(|j| j.origin.xyz));
     let (mut ignored, mut notes) = (Vec::new(), Vec::new());
     for (i, l) in links.iter_mut().enumerate() {
         if !moves[i] {
@@ -379,7 +381,14 @@ fn settle_masses(
             l.inertia = [0.0; 6];
             continue;
         }
-        match check_inertia(&l.name, &l.inertia) {
+        let checked = check_inertia(&l.name, &l.inertia).map(|t| match t {
+            Tensor::Fine(note) => match implausible_gyration(l.mass, &l.inertia, size) {
+                Some(reason) => Tensor::Impossible(reason),
+                None => Tensor::Fine(note),
+            },
+            impossible => impossible,
+        });
+        match checked {
             Ok(Tensor::Fine(note)) => notes.extend(note),
             // A light link (a finger of a few grams to 100 g) with a tensor
             // no body has: its mass and centre of mass still load the arm,

@@ -353,6 +353,9 @@ pub fn plan(
         .iter()
         .map(|l| format!("link '{}' dropped from the dynamics: {}", l.name, l.reason))
         .collect();
+    // What reading the URDF took otherwise than written (a tensor replaced,
+    // a limit read as none): said before every run, as `robot` says it.
+    changes.extend(robot.model.notes.iter().cloned());
     if !scenario.plant.contact.is_off() {
         changes.extend(
             robot

@@ -437,4 +437,19 @@ fn sim_and_robot_say_what_they_changed_and_where_effort_runs_short() {
         stderr.contains(&format!("testbed: note: {said}")),
         "{stderr}"
     );
+    // A tensor taken otherwise than written (a 10 mg tool with the identity
+    // tensor) is said before the run too, not only by `robot`.
+    let tool = r#"<link name="tool"><inertial><mass value="0.00001"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link><joint name="tool_joint" type="fixed"><parent link="link2"/><child link="tool"/></joint></robot>"#;
+    let text = std::fs::read_to_string(crate::util::repo_root().join("robots/two_link.urdf"))
+        .unwrap()
+        .replace("</robot>", tool);
+    let tooled = dir.path().join("tooled.urdf");
+    std::fs::write(&tooled, text).unwrap();
+    let sim = ok(testbed().args(["sim", "--robot"]).arg(&tooled));
+    let stderr = String::from_utf8_lossy(&sim.stderr);
+    assert!(
+        stderr.contains("testbed: note: link 'tool'")
+            && stderr.contains("its tensor replaced by a uniform sphere's"),
+        "{stderr}"
+    );
 }
