@@ -88,6 +88,7 @@ pub(super) fn diagnose(text: &str, reader_error: &str) -> Option<String> {
         .and_then(|r| r.split('`').next());
     let wanted = |p: &&Problem| match missing {
         Some(field) => p.field == field,
+        None if reader_error.contains("unknown variant") => p.field == "shape",
         None if p.empty => reader_error.contains("found EndElement"),
         None => {
             p.number && (reader_error.contains("float") || reader_error.contains("element count"))
@@ -225,6 +226,21 @@ fn closed(open: &Open, out: &mut Vec<Problem>) {
     if !open.read {
         return;
     }
+    let first = open.children.first().map(String::as_str);
+    if open.name == "geometry"
+        && let Some(other) = first.filter(|c| !SHAPES.contains(c))
+    {
+        out.push(Problem {
+            field: "shape".into(),
+            number: false,
+            empty: false,
+            message: format!(
+                "{}: <geometry> holds <{other}>, which is not a URDF shape; write one of <{}> (<plane> and <cdf> are PyBullet's own)",
+                open.owner,
+                SHAPES.join(">, <")
+            ),
+        });
+    }
     if open.name == "geometry" && !open.children.iter().any(|c| SHAPES.contains(&c.as_str())) {
         out.push(Problem {
             field: "geometry".into(),
@@ -276,7 +292,12 @@ fn hint(element: &str, child: &str) -> &'static str {
 fn not_numbers(v: &str, count: usize) -> Option<String> {
     let parts: Vec<&str> = v.split_whitespace().collect();
     if let Some(bad) = parts.iter().find(|p| p.parse::<f64>().is_err()) {
-        return Some(format!("'{bad}' is not a number"));
+        let xacro = if bad.starts_with("$(") || bad.starts_with("${") {
+            " (a xacro expression: run `xacro` on the file to get a URDF)"
+        } else {
+            ""
+        };
+        return Some(format!("'{bad}' is not a number{xacro}"));
     }
     match (count, parts.len()) {
         (0, 0) => Some("no number".into()),
@@ -324,6 +345,14 @@ mod tests {
             (
                 joint(r#"<child link="a"/><limit effort="1" velocity="1"/>"#),
                 "joint 'j': <joint> has no <parent>",
+            ),
+            (
+                joint(r#"<parent link="base"/><origin xyz="$(optenv IMU_XYZ 0 0 0)"/><child link="a"/><limit effort="1" velocity="1"/>"#),
+                "joint 'j': <origin> xyz=\"$(optenv IMU_XYZ 0 0 0)\": '$(optenv' is not a number (a xacro expression: run `xacro`",
+            ),
+            (
+                r#"<link name="a"><collision><geometry><plane normal="0 0 1"/></geometry></collision></link>"#.into(),
+                "link 'a': <geometry> holds <plane>, which is not a URDF shape; write one of <box>",
             ),
         ] {
             let got = refusal(&body);

@@ -30,6 +30,7 @@ mod collision;
 mod diagnose;
 pub mod dynamics;
 mod error;
+mod extra_elements;
 mod file_refs;
 mod fold;
 mod inertia;
@@ -251,6 +252,7 @@ impl ArmModel {
         }
         let (text, undeclared) = prefixes::declare_undeclared(text);
         let (text, unnamed_files) = file_refs::fill_missing(&text);
+        let (text, read_past) = extra_elements::remove_extra(&text);
         let robot = urdf_rs::read_from_string(&text).map_err(|e| {
             let said = e.to_string();
             ModelError::Parse(diagnose::diagnose(&text, &said).unwrap_or(said))
@@ -273,6 +275,9 @@ impl ArmModel {
                      (they do not change the dynamics)"
                 )
             };
+            model.notes.insert(0, note);
+        }
+        for note in read_past.into_iter().rev() {
             model.notes.insert(0, note);
         }
         if !undeclared.is_empty() {
