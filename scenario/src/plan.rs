@@ -137,6 +137,34 @@ fn apply_set(
     Ok((text, format!("{source} with {}", said.join(" "))))
 }
 
+/// Which `--set` makes `text` no scenario, and why, in its own terms:
+/// the merged document's line numbers mean nothing to whoever typed it.
+/// None when the sets are not what fails (the caller's message stands).
+fn blame_set(text: &str, set: &[(String, toml::Value)]) -> Option<String> {
+    let mut root: toml::Table = toml::from_str(text).ok()?;
+    toml::from_str::<Scenario>(text).ok()?;
+    for (key, value) in set {
+        crate::keys::set_key(&mut root, key, value.clone()).ok()?;
+        let merged = toml::to_string(&root).ok()?;
+        if let Err(e) = toml::from_str::<Scenario>(&merged) {
+            // A value that is not TOML was taken as a string: say so.
+            let as_string = match value {
+                toml::Value::String(raw)
+                    if toml::from_str::<toml::Table>(&format!("v = {raw}")).is_err() =>
+                {
+                    format!(" ('{raw}' is not a TOML value, so it was read as a string)")
+                }
+                _ => String::new(),
+            };
+            return Some(format!(
+                "--set {key}={value}: {}{as_string}",
+                e.message().trim_end()
+            ));
+        }
+    }
+    None
+}
+
 /// The joints `--set plant.lock.J=POSITION` locks: the default scenario
 /// of an arm is chosen with them locked (a 34-joint hand runs once two are).
 fn set_locks(set: &[(String, toml::Value)]) -> Locks {
@@ -230,7 +258,8 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
         // Relative paths in the file stay relative to it.
         let mut s: Scenario = toml::from_str(&text).map_err(|e| ScenarioError::Toml {
             file: said.clone(),
-            message: e.to_string().trim_end().to_string(),
+            message: blame_set(&toml_text, &overrides.set)
+                .unwrap_or_else(|| e.to_string().trim_end().to_string()),
         })?;
         s.read_trajectory_files(base.as_deref().unwrap_or(Path::new("")), &said)?;
         s.validate(&said)?;
@@ -503,6 +532,26 @@ mod tests {
             .to_string();
         assert!(
             e.contains("controller.beta is not a parameter of law 'pd'"),
+            "{e}"
+        );
+    }
+
+    /// A `--set` the scenario cannot read is named with its own words, not
+    /// a line of the merged document it never saw; the set before it,
+    /// which is fine, is not blamed.
+    #[test]
+    fn a_bad_set_is_named_not_a_line_of_the_merged_scenario() {
+        let bad = |set: &[&str]| load(None, &overrides(None, set)).unwrap_err().to_string();
+        let e = bad(&["plant.engine=rapier", "controller.k1=[1,"]);
+        assert!(
+            e.contains("--set controller.k1=\"[1,\": a number, or a list")
+                && e.contains("'[1,' is not a TOML value, so it was read as a string")
+                && !e.contains("line "),
+            "{e}"
+        );
+        let e = bad(&["plant.nonsense=3"]);
+        assert!(
+            e.contains("--set plant.nonsense=3: unknown field `nonsense`") && !e.contains("line "),
             "{e}"
         );
     }
