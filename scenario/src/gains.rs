@@ -11,6 +11,9 @@
 //! loop; where that is not enough the joint's envelope is widened, as far
 //! as its range allows. Where that is not enough either, the joint is
 //! reported (`armature`): armature raises M_ii, hence K2, at the same rate.
+//! K1_i is at least the paper's 15, or less where a weak motor cannot
+//! follow 15 from the start's error and the load needs less
+//! ([`crate::motor_bound`]).
 //!
 //! The barrier term γ Z1γ/(β D) of the law (SPEC §7) is a position gain of
 //! its own, K_b = γ²(k_c² + Z1γ²)/(β (k_c² − Z1γ²)²), which K1 and K2 do
