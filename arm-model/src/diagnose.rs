@@ -88,13 +88,28 @@ pub(super) fn diagnose(text: &str, reader_error: &str) -> Option<String> {
         .and_then(|r| r.split('`').next());
     let wanted = |p: &&Problem| match missing {
         Some(field) => p.field == field,
-        None if reader_error.contains("unknown variant") => p.field == "shape",
+        // Only the shape the reader names: `type="bogus"` on a joint is an
+        // unknown variant too, and its own message stands.
+        None if reader_error.contains("unknown variant") => {
+            p.field == "variant"
+                && unknown_variant(reader_error).is_some_and(|v| {
+                    p.message.contains(&format!("<{v}>")) || p.message.contains(&format!("\"{v}\""))
+                })
+        }
         None if p.empty => reader_error.contains("found EndElement"),
         None => {
             p.number && (reader_error.contains("float") || reader_error.contains("element count"))
         }
     };
     walk(text).iter().find(wanted).map(|p| p.message.clone())
+}
+
+/// The variant in "unknown variant `plane`, expected …".
+fn unknown_variant(reader_error: &str) -> Option<&str> {
+    reader_error
+        .split("unknown variant `")
+        .nth(1)
+        .and_then(|r| r.split('`').next())
 }
 
 struct Problem {
@@ -199,6 +214,20 @@ fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut 
             }
         }
     }
+    if name == "joint"
+        && let Some(kind) = attr(attrs, "type")
+        && !JOINT_TYPES.contains(&kind)
+    {
+        out.push(Problem {
+            field: "variant".into(),
+            number: false,
+            empty: false,
+            message: format!(
+                "{at} type=\"{kind}\" is not a URDF joint type; write one of {}",
+                JOINT_TYPES.join(", ")
+            ),
+        });
+    }
     for (element, numbers) in NUMBERS {
         if *element != name {
             continue;
@@ -218,6 +247,17 @@ fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut 
     }
 }
 
+/// The joint types URDF has.
+const JOINT_TYPES: [&str; 7] = [
+    "revolute",
+    "continuous",
+    "prismatic",
+    "fixed",
+    "floating",
+    "planar",
+    "spherical",
+];
+
 /// The shapes a `<geometry>` holds one of.
 const SHAPES: [&str; 5] = ["box", "cylinder", "sphere", "capsule", "mesh"];
 
@@ -231,7 +271,7 @@ fn closed(open: &Open, out: &mut Vec<Problem>) {
         && let Some(other) = first.filter(|c| !SHAPES.contains(c))
     {
         out.push(Problem {
-            field: "shape".into(),
+            field: "variant".into(),
             number: false,
             empty: false,
             message: format!(
@@ -292,7 +332,7 @@ fn hint(element: &str, child: &str) -> &'static str {
 fn not_numbers(v: &str, count: usize) -> Option<String> {
     let parts: Vec<&str> = v.split_whitespace().collect();
     if let Some(bad) = parts.iter().find(|p| p.parse::<f64>().is_err()) {
-        let xacro = if bad.starts_with("$(") || bad.starts_with("${") {
+        let xacro = if bad.contains("$(") || bad.contains("${") {
             " (a xacro expression: run `xacro` on the file to get a URDF)"
         } else {
             ""
@@ -345,6 +385,10 @@ mod tests {
             (
                 joint(r#"<child link="a"/><limit effort="1" velocity="1"/>"#),
                 "joint 'j': <joint> has no <parent>",
+            ),
+            (
+                r#"<link name="a"/><joint name="j" type="bogus"><parent link="base"/><child link="a"/></joint>"#.into(),
+                "joint 'j': <joint> type=\"bogus\" is not a URDF joint type; write one of revolute",
             ),
             (
                 joint(r#"<parent link="base"/><origin xyz="$(optenv IMU_XYZ 0 0 0)"/><child link="a"/><limit effort="1" velocity="1"/>"#),

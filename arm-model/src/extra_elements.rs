@@ -1,17 +1,19 @@
-//! Elements `urdf-rs` refuses that urdfdom and PyBullet read past: a
-//! second copy of an element a joint or link holds once (Ghost Robotics'
-//! Spirit, in pybullet_data, lists `<axis>` twice on a knee), and anything
-//! after the shape inside a `<geometry>` (the MIT racecar's `<material>`
-//! there). urdfdom reads the first `<axis>` and the first shape and ignores
-//! the rest; so does the testbed, which removes them before parsing and
-//! says which.
+//! Elements `urdf-rs` refuses or misreads that urdfdom and PyBullet read
+//! past: a second copy of an element a joint or link holds once (Ghost
+//! Robotics' Spirit, in pybullet_data, lists `<axis>` twice on a knee),
+//! anything after the shape inside a `<geometry>` (the MIT racecar's
+//! `<material>` there), and an element of another namespace (`<gz:axis>`,
+//! which `urdf-rs` would take for the `<axis>` by its local name). urdfdom
+//! matches whole names, reads the first `<axis>` and the first shape, and
+//! ignores the rest; so does the testbed, which removes them before parsing
+//! and says which.
 
 use quick_xml::Reader;
 use quick_xml::events::{BytesStart, Event};
 
 /// Per element: the children it holds at most once (urdfdom reads each
 /// with `FirstChildElement`).
-const ONCE: [(&str, &[&str]); 5] = [
+const ONCE: [(&str, &[&str]); 6] = [
     (
         "joint",
         &[
@@ -28,9 +30,13 @@ const ONCE: [(&str, &[&str]); 5] = [
     ),
     ("link", &["inertial"]),
     ("inertial", &["origin", "mass", "inertia"]),
-    ("visual", &["origin", "geometry"]),
+    ("visual", &["origin", "geometry", "material"]),
     ("collision", &["origin", "geometry"]),
+    ("material", &["color", "texture"]),
 ];
+
+/// The elements right under `<robot>` whose insides `urdf-rs` reads.
+const READ: [&str; 3] = ["joint", "link", "material"];
 
 /// What a `<geometry>` holds one of.
 const SHAPES: [&str; 5] = ["box", "cylinder", "sphere", "capsule", "mesh"];
@@ -92,17 +98,19 @@ fn extra_spans(text: &str) -> (Vec<(usize, usize)>, Vec<String>) {
             Ok(_) => {}
         }
     }
-    notes.dedup();
+    let mut seen = std::collections::HashSet::new();
+    notes.retain(|n| seen.insert(n.clone()));
     (spans, notes)
 }
 
 /// A start tag under `stack`: recorded as its parent's child, and marked
 /// to be removed (with a note) if urdfdom would read past it.
 fn opened(e: &BytesStart, at: usize, stack: &mut [Open], notes: &mut Vec<String>) -> Open {
-    let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+    // The whole name: `gz:axis` is not `axis` (urdfdom compares whole names).
+    let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
     let inside_dropped = stack.iter().any(|o| o.drop_from.is_some());
     let owner = match (stack.len(), name.as_str()) {
-        (1, "joint" | "link") => {
+        (1, "joint" | "link" | "material") => {
             let n = e
                 .try_get_attribute("name")
                 .ok()
@@ -113,28 +121,18 @@ fn opened(e: &BytesStart, at: usize, stack: &mut [Open], notes: &mut Vec<String>
         }
         _ => stack.last().map(|o| o.owner.clone()).unwrap_or_default(),
     };
-    // Only what urdf-rs reads: <joint> and <link> right under <robot>.
-    let read = stack.len() >= 2 && matches!(stack[1].name.as_str(), "joint" | "link");
+    let read = stack.len() >= 2 && READ.contains(&stack[1].name.as_str());
     let mut drop_from = None;
     if let Some(parent) = stack.last_mut()
         && read
         && !inside_dropped
     {
-        let once = ONCE
-            .iter()
-            .find(|(p, _)| *p == parent.name)
-            .is_some_and(|(_, c)| c.contains(&name.as_str()));
-        let geometry = parent.name == "geometry";
-        if once && parent.children.contains(&name) {
-            notes.push(format!(
-                "{owner}: a second <{name}> in its <{}>: the first is read, as urdfdom and PyBullet do",
-                parent.name
-            ));
+        // Another namespace's element (Drake's `<drake:rotor_inertia>`)
+        // is an extension every reader ignores: removed without a note.
+        if name.contains(':') {
             drop_from = Some(at);
-        } else if geometry && parent.children.iter().any(|c| SHAPES.contains(&c.as_str())) {
-            notes.push(format!(
-                "{owner}: <{name}> after the shape in a <geometry>: ignored, as urdfdom and PyBullet do"
-            ));
+        } else if let Some(why) = read_past(&parent.name, &parent.children, &name) {
+            notes.push(format!("{owner}: {why}"));
             drop_from = Some(at);
         }
         parent.children.push(name.clone());
@@ -146,6 +144,26 @@ fn opened(e: &BytesStart, at: usize, stack: &mut [Open], notes: &mut Vec<String>
         owner,
         children: Vec::new(),
         drop_from,
+    }
+}
+
+/// Why urdfdom reads past element `name` in `parent` (which holds
+/// `children` before it), if it does.
+fn read_past(parent: &str, children: &[String], name: &str) -> Option<String> {
+    let once = ONCE
+        .iter()
+        .find(|(p, _)| *p == parent)
+        .is_some_and(|(_, c)| c.contains(&name));
+    if once && children.iter().any(|c| c == name) {
+        Some(format!(
+            "a second <{name}> in its <{parent}>: the first is read, as urdfdom and PyBullet do"
+        ))
+    } else if parent == "geometry" && children.iter().any(|c| SHAPES.contains(&c.as_str())) {
+        Some(format!(
+            "<{name}> after the shape in a <geometry>: ignored, as urdfdom and PyBullet do"
+        ))
+    } else {
+        None
     }
 }
 
@@ -171,6 +189,17 @@ mod tests {
                 "joint 'knee': a second <axis> in its <joint>: the first is read, as urdfdom and PyBullet do",
             ]
         );
+        // Another namespace's element is not the URDF one, duplicate or not;
+        // a second <material> in a visual, a second <color>, are read past.
+        let text = r#"<robot name="r" xmlns:gz="g"><joint name="j"><gz:axis xyz="0 1 0"/><axis xyz="0 0 1"/><limit/><limit/><limit/></joint><link name="l"><visual><material name="a"/><material name="b"/></visual></link><material name="m"><color rgba="1 0 0 1"/><color rgba="0 1 0 1"/></material></robot>"#;
+        let (out, notes) = remove_extra(text);
+        assert_eq!(
+            out,
+            r#"<robot name="r" xmlns:gz="g"><joint name="j"><axis xyz="0 0 1"/><limit/></joint><link name="l"><visual><material name="a"/></visual></link><material name="m"><color rgba="1 0 0 1"/></material></robot>"#
+        );
+        assert_eq!(notes.len(), 3, "{notes:?}");
+        assert!(notes[0].starts_with("joint 'j': a second <limit>"));
+        assert!(notes[2].starts_with("material 'm': a second <color>"));
         // Repeated <visual> and <collision> are valid: left alone.
         let fine =
             r#"<robot name="r"><link name="a"><visual/><collision/><visual/></link></robot>"#;

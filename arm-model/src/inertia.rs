@@ -155,8 +155,9 @@ pub(super) fn check_inertia(link: &str, i: &[f64; 6]) -> Result<Tensor, ModelErr
 /// its tensor is no body of that link's: a link lies within the arm.
 const GYRATION_PER_SIZE: f64 = 10.0;
 
-/// The arm's size for [`implausible_gyration`], m: the joints' offsets
-/// added up (no two points of the arm are further apart), at least 1 m.
+/// The arm's size for [`implausible_gyration`], m: the offsets of the
+/// joints that move something added up (no two points of what moves are
+/// further apart), at least 1 m.
 pub(super) fn arm_size(offsets: impl Iterator<Item = [f64; 3]>) -> f64 {
     offsets
         .map(|[x, y, z]| (x * x + y * y + z * z).sqrt())
@@ -173,7 +174,7 @@ pub(super) fn implausible_gyration(mass: f64, i: &[f64; 6], size: f64) -> Option
     let radius = (largest / mass).sqrt();
     (mass > 0.0 && radius > GYRATION_PER_SIZE * size).then(|| {
         format!(
-            "its largest principal moment {largest:.3e} kg m² on {mass:e} kg is a radius of gyration of {radius:.3e} m, over {GYRATION_PER_SIZE} times the arm's size of {size:.3} m (its joint offsets added up, at least 1 m): no part of this arm turns like that"
+            "its largest principal moment {largest:.3e} kg m² on {mass:e} kg is a radius of gyration of {radius:.3e} m, over {GYRATION_PER_SIZE} times the arm's size of {size:.3} m (the offsets of its moving links' joints added up, at least 1 m): no part of this arm turns like that"
         )
     })
 }

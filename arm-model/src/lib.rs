@@ -251,8 +251,9 @@ impl ArmModel {
             )));
         }
         let (text, undeclared) = prefixes::declare_undeclared(text);
-        let (text, unnamed_files) = file_refs::fill_missing(&text);
+        // What is read past goes first: a removed <axis> needs no xyz.
         let (text, read_past) = extra_elements::remove_extra(&text);
+        let (text, unnamed_files) = file_refs::fill_missing(&text);
         let robot = urdf_rs::read_from_string(&text).map_err(|e| {
             let said = e.to_string();
             ModelError::Parse(diagnose::diagnose(&text, &said).unwrap_or(said))

@@ -14,10 +14,30 @@ fn finite(field: String, v: f64) -> Result<f64, ModelError> {
     }
 }
 
+/// No robot is larger (m) or heavier (kg), nor turns like a body of more
+/// (kg m²): beyond these a URDF is in the wrong units or broken, and the
+/// arm's dynamics would overflow (a 1e308 kg link makes K2 infinite).
+const MAX_OFFSET_M: f64 = 1e4;
+const MAX_MASS_KG: f64 = 1e6;
+const MAX_MOMENT: f64 = 1e8;
+
+/// `v` if it is finite and at most `max` in size; else what is wrong.
+fn bounded(field: String, v: f64, max: f64, unit: &str) -> Result<f64, ModelError> {
+    let v = finite(field.clone(), v)?;
+    if v.abs() > max {
+        return Err(ModelError::InvalidConfig {
+            key: field,
+            value: format!("{v:e}"),
+            need: format!("at most {max:e} {unit} in size: no robot's is larger (check the units)"),
+        });
+    }
+    Ok(v)
+}
+
 fn origin(field: &str, o: &urdf_rs::Pose) -> Result<Origin, ModelError> {
     let mut out = Origin::default();
     for k in 0..3 {
-        out.xyz[k] = finite(format!("{field} origin xyz"), o.xyz.0[k])?;
+        out.xyz[k] = bounded(format!("{field} origin xyz"), o.xyz.0[k], MAX_OFFSET_M, "m")?;
         out.rpy[k] = finite(format!("{field} origin rpy"), o.rpy.0[k])?;
     }
     Ok(out)
@@ -27,7 +47,12 @@ fn origin(field: &str, o: &urdf_rs::Pose) -> Result<Origin, ModelError> {
 /// here (what a link of no mass lists is judged later).
 pub(super) fn link_info(l: &urdf_rs::Link) -> Result<LinkInfo, ModelError> {
     let field = format!("link '{}'", l.name);
-    let mass = finite(format!("{field} mass"), l.inertial.mass.value)?;
+    let mass = bounded(
+        format!("{field} mass"),
+        l.inertial.mass.value,
+        MAX_MASS_KG,
+        "kg",
+    )?;
     if mass < 0.0 {
         return Err(ModelError::BadInertia {
             link: l.name.clone(),
@@ -37,7 +62,7 @@ pub(super) fn link_info(l: &urdf_rs::Link) -> Result<LinkInfo, ModelError> {
     let i = &l.inertial.inertia;
     let inertia = [i.ixx, i.ixy, i.ixz, i.iyy, i.iyz, i.izz];
     for v in inertia {
-        finite(format!("{field} inertia"), v)?;
+        bounded(format!("{field} inertia"), v, MAX_MOMENT, "kg m²")?;
     }
     let c = super::collision::collisions(l, |o| origin(&field, o).ok());
     Ok(LinkInfo {

@@ -98,6 +98,11 @@ fn malformed_urdfs_are_named_errors() {
     assert!(err(&arm(&format!("{J1}{loop_}"), "")).contains("loop"));
     let bad = J1.replace("lower=\"-1\" upper=\"1\"", "lower=\"1\" upper=\"-1\"");
     assert!(err(&arm(&bad, "")).contains("limit lower 1 is above upper -1"));
+    // Beyond any robot (and overflowing its dynamics): refused by name.
+    let far = J1.replace("<axis", "<origin xyz=\"1e300 0 0\"/><axis");
+    assert!(err(&arm(&far, "")).contains("joint 'j1' origin xyz = 1e300 is invalid"));
+    let heavy = arm(J1, "").replace("<mass value=\"1\"/>", "<mass value=\"1e20\"/>");
+    assert!(err(&heavy).contains("link 'a' mass = 1e20 is invalid: it must be at most 1e6 kg"));
     let nan = J1.replace("0 0 1", "0 NaN 1");
     assert!(err(&arm(&nan, "")).contains("joint 'j1' axis"));
     assert!(err(&arm("", "")).contains("several root links"));
@@ -428,6 +433,22 @@ fn a_tensor_no_link_of_the_arm_has_is_named() {
         m.notes.iter().any(|n| n.starts_with("link 'tip'")
             && n.contains("radius of gyration of 3.162e2 m")
             && n.contains("kept with its mass")),
+        "{:?}",
+        m.notes
+    );
+    // A 5 m pedestal welded to the world does not make the arm 5 m long:
+    // 1e-2 kg m² on 10 mg (31.6 m) is still flagged, against 10 m, not 50.
+    let small = r#"ixx="1e-2" ixy="0" ixz="0" iyy="1e-2" iyz="0" izz="1e-2""#;
+    let pedestal = r#"<link name="world"/><joint name="weld" type="fixed"><parent link="world"/><child link="base"/><origin xyz="0 0 5"/></joint>"#;
+    let m = ArmModel::from_urdf_str(&arm(
+        &format!("{J1}{jb}{pedestal}"),
+        &link("tip", "0.00001", small),
+    ))
+    .unwrap();
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.starts_with("link 'tip'") && n.contains("kept with its mass")),
         "{:?}",
         m.notes
     );

@@ -353,7 +353,14 @@ fn settle_masses(
         .map(|i| links[i].mass)
         .fold(0.0, f64::max);
     let threshold = NEGLIGIBLE_MASS_RATIO * heaviest;
-    let size = arm_size(joints.iter().map(|j| j.origin.xyz));
+    // Only what moves: a 5 m pedestal welded to the world is no part of
+    // the arm's motion.
+    let size = arm_size(
+        joints
+            .iter()
+            .filter(|j| moves[j.child])
+            .map(|j| j.origin.xyz),
+    );
     let (mut ignored, mut notes) = (Vec::new(), Vec::new());
     for (i, l) in links.iter_mut().enumerate() {
         if !moves[i] {

@@ -82,6 +82,11 @@ pub struct JointGain {
     pub effort: Option<f64>,
     /// Why K1_i is what it is.
     pub k1_reason: String,
+    /// The least time in which the joint's motor, with what its load
+    /// leaves of its effort, brings it from its start into its envelope, s
+    /// ([`crate::motor_bound`]); none without an effort limit or with no
+    /// room beyond the load.
+    pub motor_entry_s: Option<f64>,
     /// The barrier term's share of the sampled loop's stability budget,
     /// K_b Δt/K2_i at |Z1γ| = 0.8 k_c of the chosen envelope (≤ 1 is held).
     pub barrier: f64,
@@ -308,16 +313,19 @@ pub fn choose_gains(
         .map(|i| load_kc[i].max(barrier_kc[i]).min(cap[i]))
         .collect();
     let start = reference_at(s, 0.0);
-    let floor: Vec<K1Floor> = (0..n)
+    let motor: Vec<Option<MotorBound>> = (0..n)
         .map(|i| {
             let effort = model.joints[model.actuated[i]].effort;
             let start_error = (s.initial.q[i] - start[i]).abs();
-            let motor = MotorBound::new(effort, m.load[i], m.minv_diag_low[i], start_error, kc[i]);
-            K1Floor::at(K1_MIN.min(k1_max), motor, envelope[i])
+            MotorBound::new(effort, m.load[i], m.minv_diag_low[i], start_error, kc[i])
         })
+        .collect();
+    let floor: Vec<K1Floor> = (0..n)
+        .map(|i| K1Floor::at(K1_MIN.min(k1_max), motor[i], envelope[i]))
         .collect();
     let mut joints = joint_gains(model, &m, &k2, &need, &floor, k1_max);
     for (i, j) in joints.iter_mut().enumerate() {
+        j.motor_entry_s = motor[i].map(|b| b.entry_time(envelope[i], kc_low[i]));
         let low = kc_low[i] * envelope[i];
         j.barrier = barrier_factor() * dt / (beta * low * low * k2[i]);
         j.envelope_reason = (envelope[i] > kc[i] * (1.0 + 1e-9)).then(|| {
@@ -379,6 +387,7 @@ fn joint_gains(
             gravity: m.gravity[i],
             effort: model.joints[model.actuated[i]].effort,
             k1_reason: k1_reason(need[i], &floor[i], k1_max),
+            motor_entry_s: None,
             barrier: 0.0,
             envelope_reason: None,
             armature_needed: None,
@@ -403,6 +412,10 @@ fn k1_reason(need: f64, floor: &K1Floor, k1_max: f64) -> String {
             floor.k1,
             b.accel,
             b.start_error(floor.envelope)
+        ),
+        Some(_) if need <= K1_MIN => format!(
+            "holds the load within 40 % of the envelope (needs {need:.2}; its motor's √(a/E) = {:.2} is lower, and the load comes first)",
+            floor.k1
         ),
         _ if need <= K1_MIN => {
             format!("the paper's {K1_MIN} already holds the load (needs {need:.2})")

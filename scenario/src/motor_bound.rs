@@ -56,6 +56,14 @@ impl MotorBound {
     pub fn start_error(&self, kc: f64) -> f64 {
         self.start_per_kc * kc
     }
+
+    /// The least time in which the motor brings the joint from its start
+    /// into an envelope of offset `kc`, whose smallest value is `low` of
+    /// it: accelerate half the way and brake the other, 2√(d/a), s.
+    pub fn entry_time(&self, kc: f64, low: f64) -> f64 {
+        let d = (self.start_error(kc) - low * kc).max(0.0);
+        2.0 * (d / self.accel).sqrt()
+    }
 }
 
 /// The smallest K1 a joint is given (what it gets when its load needs
@@ -102,6 +110,9 @@ mod tests {
         // A wider envelope starts further out: a lower bound.
         assert!((b.start_error(0.5) - 0.75).abs() < 1e-12);
         assert!(b.k1_at(0.5) < b.k1_at(0.25));
+        // From 0.375 rad out into an envelope whose least is 0.2 rad.
+        let t = b.entry_time(0.25, 0.8);
+        assert!((t - 2.0 * (0.175 / b.accel).sqrt()).abs() < 1e-12);
         let floor = K1Floor::at(15.0, Some(b), 0.25);
         assert_eq!(floor.k1, b.k1_at(0.25));
         assert!(floor.motor.is_some());

@@ -139,30 +139,63 @@ fn apply_set(
 
 /// Which `--set` makes `text` no scenario, and why, in its own terms:
 /// the merged document's line numbers mean nothing to whoever typed it.
-/// None when the sets are not what fails (the caller's message stands).
+/// The set without which the rest reads (a later set may replace an
+/// earlier bad one); else the first that breaks what came before. None
+/// when the sets are not what fails (the caller's message stands).
 fn blame_set(text: &str, set: &[(String, toml::Value)]) -> Option<String> {
-    let mut root: toml::Table = toml::from_str(text).ok()?;
+    let root: toml::Table = toml::from_str(text).ok()?;
     toml::from_str::<Scenario>(text).ok()?;
-    for (key, value) in set {
-        crate::keys::set_key(&mut root, key, value.clone()).ok()?;
-        let merged = toml::to_string(&root).ok()?;
-        if let Err(e) = toml::from_str::<Scenario>(&merged) {
-            // A value that is not TOML was taken as a string: say so.
-            let as_string = match value {
-                toml::Value::String(raw)
-                    if toml::from_str::<toml::Table>(&format!("v = {raw}")).is_err() =>
-                {
-                    format!(" ('{raw}' is not a TOML value, so it was read as a string)")
-                }
-                _ => String::new(),
-            };
-            return Some(format!(
-                "--set {key}={value}: {}{as_string}",
-                e.message().trim_end()
-            ));
+    let reads = |sets: &mut dyn Iterator<Item = &(String, toml::Value)>| {
+        let mut merged = root.clone();
+        for (key, value) in sets {
+            crate::keys::set_key(&mut merged, key, value.clone()).ok()?;
         }
+        let merged = toml::to_string(&merged).ok()?;
+        Some(toml::from_str::<Scenario>(&merged).map(|_| ()))
+    };
+    let culprit = (0..set.len())
+        .rev()
+        .find(|&i| {
+            let mut others = set
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| *k != i)
+                .map(|(_, s)| s);
+            matches!(reads(&mut others), Some(Ok(())))
+        })
+        .or_else(|| {
+            (1..=set.len())
+                .find(|&n| matches!(reads(&mut set[..n].iter()), Some(Err(_))))
+                .map(|n| n - 1)
+        })?;
+    let (key, value) = &set[culprit];
+    let Some(Err(e)) = reads(&mut set[..=culprit].iter()) else {
+        return None;
+    };
+    let message = e.message().trim_end();
+    Some(format!(
+        "--set {key}={value}: {message}{}",
+        as_string_hint(value, message)
+    ))
+}
+
+/// Why a `--set` value the scenario refuses may not be what was typed:
+/// a value that is not TOML is read as a string.
+fn as_string_hint(value: &toml::Value, message: &str) -> String {
+    let toml::Value::String(raw) = value else {
+        return String::new();
+    };
+    // A bare word where a word is wanted (an unknown engine) is fine.
+    if message.contains("unknown variant")
+        || toml::from_str::<toml::Table>(&format!("v = {raw}")).is_ok()
+    {
+        return String::new();
     }
-    None
+    if raw.parse::<f64>().is_ok() {
+        format!(" ('{raw}' is out of TOML's range for a number, so it was read as a string)")
+    } else {
+        format!(" ('{raw}' is not a TOML value, so it was read as a string)")
+    }
 }
 
 /// The joints `--set plant.lock.J=POSITION` locks: the default scenario
@@ -487,7 +520,7 @@ mod tests {
         );
         for i in 1..=34 {
             urdf += &format!(
-                r#"<link name="l{i}"><inertial><origin xyz="0.05 0 0"/><mass value="0.2"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link><joint name="j{i}" type="revolute"><parent link="l{p}"/><child link="l{i}"/><origin xyz="0.1 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"#,
+                r#"<link name="l{i}"><inertial><origin xyz="0.05 0 0"/><mass value="0.2"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link><joint name="j{i}" type="revolute"><parent link="l{p}"/><child link="l{i}"/><origin xyz="0.1 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="100" velocity="1"/></joint>"#,
                 p = i - 1
             );
         }
@@ -547,6 +580,21 @@ mod tests {
             e.contains("--set controller.k1=\"[1,\": a number, or a list")
                 && e.contains("'[1,' is not a TOML value, so it was read as a string")
                 && !e.contains("line "),
+            "{e}"
+        );
+        // A later set replaces an earlier bad one: the bad one still in
+        // force is named.
+        let e = bad(&[
+            "plant.engine=bogus",
+            "plant.engine=rapier",
+            "controller.k1=abc",
+        ]);
+        assert!(e.contains("--set controller.k1=\"abc\": a number"), "{e}");
+        let e = bad(&["duration_s=1e400"]);
+        assert!(e.contains("out of TOML's range"), "{e}");
+        let e = bad(&["plant.engine=nope"]);
+        assert!(
+            e.contains("unknown variant `nope`") && !e.contains("read as a string"),
             "{e}"
         );
         let e = bad(&["plant.nonsense=3"]);

@@ -173,3 +173,47 @@ fn a_joint_with_no_inertia_about_its_axis_is_locked_and_said() {
         d.changes()
     );
 }
+
+/// A weak motor: on the three-link arm turned about z (no gravity), a
+/// 0.3 N m elbow gets K1 = √(a/E) below the paper's 15, with the reason; a
+/// 0.041 N m one could not bring its joint in by T_c and is locked, and
+/// said; an arm whose only motor is that weak is refused by name.
+#[test]
+fn a_weak_motor_gets_a_gain_it_can_follow_or_is_locked() {
+    let urdf = std::fs::read_to_string(format!(
+        "{}/../robots/three_link_planar.urdf",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+    .replace("<axis xyz=\"0 -1 0\"/>", "<axis xyz=\"0 0 1\"/>");
+    let with_effort = |e: &str| {
+        let at = urdf.rfind("effort=\"").unwrap();
+        let end = at + urdf[at + 8..].find('"').unwrap() + 9;
+        format!("{}effort=\"{e}\"{}", &urdf[..at], &urdf[end..])
+    };
+    let d = ArmDefault::new(&with_effort("0.3")).unwrap();
+    let g = &d.gains.joints[2];
+    assert!(
+        g.k1 < 15.0 && g.motor_entry_s.is_some_and(|t| t < 2.0),
+        "{g:?}"
+    );
+    assert!(g.k1_reason.starts_with("√(a/E) = "), "{}", g.k1_reason);
+    let d = ArmDefault::new(&with_effort("0.041")).unwrap();
+    assert!(
+        d.changes()
+            .iter()
+            .any(|c| c.starts_with("locked joint3") && c.contains("after T_c = 2 s")),
+        "{:?}",
+        d.changes()
+    );
+    let one = r#"<robot name="r"><link name="base"/>
+      <link name="a"><inertial><mass value="1"/><origin xyz="0.3 0 0"/>
+        <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+      <joint name="j" type="revolute"><parent link="base"/><child link="a"/>
+        <axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1e-9" velocity="2"/></joint></robot>"#;
+    let e = ArmDefault::new(one).unwrap_err().to_string();
+    assert!(
+        e.contains("every controlled joint") && e.contains("'j': its motor"),
+        "{e}"
+    );
+}

@@ -48,6 +48,53 @@ pub(super) fn overloaded(d: &ArmDefault) -> Vec<(String, f64, String)> {
         .collect()
 }
 
+/// Joints whose motor cannot bring them from their start into their
+/// envelope by T_c, even at full torque (a 1e-9 N m motor, or a wrist
+/// whose load takes all of its effort). With `last`, also
+/// joints whose load is still at least their effort once the swings are
+/// cut (a wrist the other joints' motion loads through the coupling). No
+/// controller holds them within the envelope after T_c, so they are
+/// locked where the reference holds them. Locks to add, with the reason.
+pub(super) fn too_weak(d: &ArmDefault, last: bool) -> Vec<(String, f64, String)> {
+    let tc = d.scenario.controller.tc;
+    d.gains
+        .joints
+        .iter()
+        .zip(&d.scenario.reference.joints)
+        .filter_map(|(g, r)| {
+            let effort = g.effort?;
+            let why = match g.motor_entry_s {
+                Some(t) if t > tc => format!(
+                    "its motor (effort {effort} N m, load {:.3} N m) brings it from its start into its envelope in {t:.3} s at best, after T_c = {tc} s: no controller holds it there",
+                    g.load
+                ),
+                _ if last && g.load >= effort => format!(
+                    "the reference loads it with {:.3} N m even with its swing cut, at least its effort limit {effort} N m: no controller holds it",
+                    g.load
+                ),
+                _ => return None,
+            };
+            Some((g.name.clone(), r.offset, why))
+        })
+        .collect()
+}
+
+/// The refusal of an arm whose every joint is [`too_weak`] to control.
+pub(super) fn nothing_to_control(weak: &[(String, f64, String)]) -> plant_rapier::PlantError {
+    let said: Vec<String> = weak
+        .iter()
+        .map(|(name, _, why)| format!("'{name}': {why}"))
+        .collect();
+    plant_rapier::PlantError::InvalidConfig {
+        key: "<limit effort> of every controlled joint".into(),
+        value: "too weak to control".into(),
+        need: format!(
+            "enough to move the arm (check the URDF's effort limits); {}",
+            said.join("; ")
+        ),
+    }
+}
+
 /// Joints whose URDF dry friction is at least their effort limit (Drake's
 /// Allegro hand lists 10 N m of friction on 0.7 N m motors): no motor moves
 /// them, so the default turns URDF dynamics off, and says why.

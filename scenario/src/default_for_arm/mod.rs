@@ -22,8 +22,8 @@ use trajectory::{EnvelopeConfig, ReferenceConfig};
 use crate::gains::choose_gains;
 use crate::{Initial, Scenario};
 use checks::{
-    REFERENCE_EFFORT_SHARE, armature_purpose, friction_beyond_effort, overloaded, warnings,
-    within_effort,
+    REFERENCE_EFFORT_SHARE, armature_purpose, friction_beyond_effort, nothing_to_control,
+    overloaded, too_weak, warnings, within_effort,
 };
 pub use locks::GRIPPER_LOCK;
 use locks::{default_locks, lock_position};
@@ -94,6 +94,16 @@ impl ArmDefault {
             }
             let unheld = d.gains.unheld();
             attempt += 1;
+            // A motor that cannot bring its joint in by T_c is locked even
+            // after the last try: the swings were cut as far as they go.
+            let weak = too_weak(&d, attempt > ADJUSTMENTS);
+            if weak.len() == model.dof() {
+                return Err(nothing_to_control(&weak));
+            }
+            if !weak.is_empty() {
+                chosen.extend(weak);
+                continue;
+            }
             if attempt > ADJUSTMENTS {
                 return Ok(d);
             }
