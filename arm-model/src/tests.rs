@@ -414,6 +414,17 @@ fn a_light_link_with_malformed_inertia_keeps_its_mass() {
     );
 }
 
+/// That some note of `m` starts with `start` and has each of `has`.
+fn assert_noted(m: &ArmModel, start: &str, has: &[&str]) {
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.starts_with(start) && has.iter().all(|h| n.contains(h))),
+        "{:?}",
+        m.notes
+    );
+}
+
 /// The pincher's fingers: 1e-5 kg given the identity tensor (1 kg m², a
 /// radius of gyration of 316 m on an arm under 1 m) made the whole wrist a
 /// flywheel of 3 kg m² that no gain at 1 kHz could move. A light link so
@@ -429,12 +440,10 @@ fn a_tensor_no_link_of_the_arm_has_is_named() {
     let tip = m.links.iter().find(|l| l.name == "tip").unwrap();
     assert_eq!(tip.mass, 0.00001);
     assert!(tip.inertia[0] < 1e-8, "{:?}", tip.inertia);
-    assert!(
-        m.notes.iter().any(|n| n.starts_with("link 'tip'")
-            && n.contains("radius of gyration of 3.162e2 m")
-            && n.contains("kept with its mass")),
-        "{:?}",
-        m.notes
+    assert_noted(
+        &m,
+        "link 'tip'",
+        &["radius of gyration of 3.162e2 m", "kept with its mass"],
     );
     // A 5 m pedestal welded to the world does not make the arm 5 m long:
     // 1e-2 kg m² on 10 mg (31.6 m) is still flagged, against 10 m, not 50.
@@ -445,25 +454,13 @@ fn a_tensor_no_link_of_the_arm_has_is_named() {
         &link("tip", "0.00001", small),
     ))
     .unwrap();
-    assert!(
-        m.notes
-            .iter()
-            .any(|n| n.starts_with("link 'tip'") && n.contains("kept with its mass")),
-        "{:?}",
-        m.notes
-    );
+    assert_noted(&m, "link 'tip'", &["kept with its mass"]);
     // 0.5 kg (half the arm) with 1e4 kg m²: 141 m, simulated as given.
     let huge = r#"ixx="1e4" ixy="0" ixz="0" iyy="1e4" iyz="0" izz="1e4""#;
     let m = ArmModel::from_urdf_str(&arm(&format!("{J1}{jb}"), &link("tip", "0.5", huge))).unwrap();
     let tip = m.links.iter().find(|l| l.name == "tip").unwrap();
     assert_eq!(tip.inertia[0], 1e4);
-    assert!(
-        m.notes
-            .iter()
-            .any(|n| n.starts_with("link 'tip'") && n.contains("simulated as given")),
-        "{:?}",
-        m.notes
-    );
+    assert_noted(&m, "link 'tip'", &["simulated as given"]);
     // 0.5 kg with 1 kg m² is 1.4 m: a long link, not a placeholder.
     let m =
         ArmModel::from_urdf_str(&arm(&format!("{J1}{jb}"), &link("tip", "0.5", identity))).unwrap();
