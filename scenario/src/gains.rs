@@ -13,7 +13,7 @@
 //! reported (`armature`): armature raises M_ii, hence K2, at the same rate.
 //! K1_i is at least the paper's 15, or less where a weak motor cannot
 //! follow 15 from the start's error and the load needs less
-//! ([`crate::motor_bound`]).
+//! (`motor_bound.rs`).
 //!
 //! The barrier term γ Z1γ/(β D) of the law (SPEC §7) is a position gain of
 //! its own, K_b = γ²(k_c² + Z1γ²)/(β (k_c² − Z1γ²)²), which K1 and K2 do
@@ -84,7 +84,7 @@ pub struct JointGain {
     pub k1_reason: String,
     /// The least time in which the joint's motor, with what its load
     /// leaves of its effort, brings it from its start into its envelope, s
-    /// ([`crate::motor_bound`]); none without an effort limit or with no
+    /// (`motor_bound.rs`); none without an effort limit or with no
     /// room beyond the load.
     pub motor_entry_s: Option<f64>,
     /// The barrier term's share of the sampled loop's stability budget,
