@@ -1,5 +1,7 @@
 //! Statistics over seeds: quantiles, a distribution-free 95 % interval for
-//! the median, and the Wilcoxon signed-rank test on paired runs.
+//! the median, the Wilcoxon signed-rank test on paired runs, and the exact
+//! tests of yes/no outcomes (McNemar's on paired runs, the binomial bound
+//! on a rate seen without a failure).
 //!
 //! Values may be +∞ or −∞ (a failed run's metric counts as the worst), so
 //! everything here orders with `total_cmp` and never subtracts two
@@ -77,6 +79,45 @@ fn binomial_half_cdf(n: usize) -> Vec<f64> {
             Some(*acc)
         })
         .collect()
+}
+
+/// McNemar's exact test of paired yes/no outcomes (e.g. "kept the
+/// envelope") of two laws on the same seeds: only the discordant seeds
+/// count, and under H0 each is either law's with probability ½.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct McNemar {
+    /// Seeds where only the first law had the outcome.
+    pub a_only: usize,
+    /// Seeds where only the second law had it.
+    pub b_only: usize,
+    /// Two-sided exact p: 2 P(B ≤ min(a_only, b_only)), B ~ Binomial(a_only
+    /// + b_only, ½), at most 1 (1 when no seed is discordant).
+    pub p_value: f64,
+}
+
+/// [`McNemar`] from the discordant counts.
+pub fn mcnemar_exact(a_only: usize, b_only: usize) -> McNemar {
+    let n = a_only + b_only;
+    let p_value = if n == 0 {
+        1.0
+    } else {
+        (2.0 * binomial_half_cdf(n)[a_only.min(b_only)]).min(1.0)
+    };
+    McNemar {
+        a_only,
+        b_only,
+        p_value,
+    }
+}
+
+/// The exact one-sided lower confidence bound (level 1 − `alpha`) on a
+/// rate seen n times out of n (Clopper–Pearson): `alpha`^(1/n); 0 for n = 0.
+pub fn all_of_n_lower_bound(n: usize, alpha: f64) -> f64 {
+    if n == 0 {
+        0.0
+    } else {
+        alpha.powf(1.0 / n as f64)
+    }
 }
 
 /// The Wilcoxon signed-rank test of paired values a_i, b_i.
@@ -220,6 +261,26 @@ fn erfc(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mcnemar_is_the_exact_binomial_tail_of_the_discordant_seeds() {
+        // 6 to 0: 2 / 2^6.
+        assert!((mcnemar_exact(6, 0).p_value - 2.0 / 64.0).abs() < 1e-15);
+        assert_eq!(mcnemar_exact(0, 6).p_value, mcnemar_exact(6, 0).p_value);
+        // 2 to 0 and 1 to 1 show nothing: p = 0.5 and 1.
+        assert!((mcnemar_exact(2, 0).p_value - 0.5).abs() < 1e-15);
+        assert_eq!(mcnemar_exact(1, 1).p_value, 1.0);
+        assert_eq!(mcnemar_exact(0, 0).p_value, 1.0);
+        // 8 to 2: 2 (1 + 10 + 45) / 1024 (scipy.stats.binomtest(2, 10): 0.109375).
+        assert!((mcnemar_exact(8, 2).p_value - 0.109_375).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_rate_seen_every_time_has_the_clopper_pearson_bound() {
+        assert!((all_of_n_lower_bound(20, 0.05) - 0.860_891_659_331_734_8).abs() < 1e-12);
+        assert_eq!(all_of_n_lower_bound(1, 0.05), 0.05);
+        assert_eq!(all_of_n_lower_bound(0, 0.05), 0.0);
+    }
 
     #[test]
     fn quantiles_interpolate_and_keep_infinities() {

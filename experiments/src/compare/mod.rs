@@ -114,6 +114,7 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
         findings: Vec::new(),
         warnings,
         random_effects: random,
+        tuning: opts.tuning.unwrap_or(plan.scenario.controller.tuning),
     };
     c.findings = crate::compare::findings::findings(&c);
     Ok(c)

@@ -179,6 +179,8 @@ pub struct Comparison {
     pub warnings: Vec<String>,
     /// The scenario's random effects (empty: a deterministic scenario).
     pub random_effects: Vec<String>,
+    /// How the laws that take a tuning rule turned K1, K2 into their gains.
+    pub tuning: Tuning,
 }
 
 /// A paired test of the baseline (nac, else the first law) against another on one metric.
@@ -282,10 +284,15 @@ impl Envelope {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Verdict {
-    /// The rule of the claim is met.
+    /// The rule of the claim is met (for a comparison: its paired test
+    /// is significant after the Holm correction, and the effect counts).
     Holds,
-    /// It is not.
+    /// It is not: for a comparison, the paired test is significant the
+    /// other way.
     DoesNotHold,
+    /// The paired test is not significant (or the effect is under the
+    /// size that counts): the data do not show it either way.
+    NotShown,
     /// The comparison lacks a law or a situation the claim needs.
     NotTested,
     /// Every run ended before T_c: the constraint was never in force.
@@ -297,6 +304,7 @@ impl std::fmt::Display for Verdict {
         f.write_str(match self {
             Self::Holds => "holds",
             Self::DoesNotHold => "does not hold",
+            Self::NotShown => "not shown",
             Self::NotTested => "not tested",
             Self::NotJudged => "not judged",
         })

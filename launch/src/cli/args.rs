@@ -293,7 +293,8 @@ pub(crate) struct CompareArgs {
     pub(crate) plots: Option<PathBuf>,
     /// How ctc, cbf-ctc, mpc and ppc turn K1, K2 into their gains: `matched` gives every
     /// law pd's error dynamics near e = 0 (docs/baselines.md §6)
-    /// [default: the scenario's, as-given unless it says otherwise].
+    /// [default: matched with --findings; else the scenario's, as-given
+    /// unless it says otherwise].
     #[arg(long, value_name = "RULE", value_parser = ["as-given", "matched"])]
     pub(crate) tuning: Option<String>,
     /// Trade-off mode: run every law with K1 and K2 times each of these
@@ -302,6 +303,8 @@ pub(crate) struct CompareArgs {
     pub(crate) gain_scales: Vec<f64>,
     /// Print, after the table, which of the paper's claims hold on this
     /// scenario and the numbers they rest on (the JSON always has them).
+    /// Without --tuning, the laws then run under matched tuning: a claim
+    /// that one law beats another is made on a fair fight.
     #[arg(long)]
     pub(crate) findings: bool,
 }

@@ -85,6 +85,8 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
             Some("matched") => Some(controller::Tuning::Matched),
             Some("as-given") => Some(controller::Tuning::AsGiven),
             Some(other) => bail!("--tuning {other}: must be as-given or matched"),
+            // Findings compare the laws fairly unless told otherwise (#50).
+            None if args.findings => Some(controller::Tuning::Matched),
             None => None,
         },
     };
@@ -319,8 +321,16 @@ pub(crate) fn table(c: &Comparison) -> String {
 
 /// The findings, one claim per line with its evidence.
 fn findings(c: &Comparison) -> String {
+    let tuning = match c.tuning {
+        controller::Tuning::Matched => {
+            "matched tuning (every law's error dynamics near e = 0 are pd's; --tuning as-given for the textbook gains)"
+        }
+        controller::Tuning::AsGiven => {
+            "as-given tuning (the textbook gains: not a fair fight; --tuning matched for one)"
+        }
+    };
     let mut out = format!(
-        "\nfindings on {} (rules: docs/compare-and-sweeps.md#findings-the-papers-claims-checked):\n",
+        "\nfindings on {} under {tuning}\n(rules: docs/compare-and-sweeps.md#findings-the-papers-claims-checked):\n",
         c.scenario
     );
     for f in &c.findings {
