@@ -321,7 +321,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
     let own_len = own.len(n);
     let verifier = if opts.verify {
         Some(Verifier::new(
-            plan.controller_node_config()
+            plan.controller_config()
                 .machine()
                 .map_err(|e| meta_err(path, e.to_string()))?,
         ))

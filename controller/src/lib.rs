@@ -52,7 +52,7 @@ pub use dispatch::Law;
 pub use feedback::{Feedback, effective_inertia};
 pub use gain::Gain;
 pub use law_table::{BarrierParts, FeedbackKind, LawDecl, LawKind, LawName};
-pub use machine::ControllerMachine;
+pub use machine::{ControllerMachine, ControllerMachineConfig};
 pub use nac::{Controller, ControllerInput, barrier_lyapunov};
 pub use params::{
     BarrierMode, Check, ControllerParams, Integrator, MAX_MPC_HORIZON, MAX_NEURONS, ParamDoc,

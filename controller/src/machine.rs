@@ -8,6 +8,38 @@ use arm_model::ArmModel;
 
 use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Fault, Law};
 
+/// Everything a [`ControllerMachine`] is built from, and the one way to
+/// build one ([`ControllerMachineConfig::machine`]): the controller node,
+/// `testbed sim`, `replay --verify` and the Gym environment's base law all
+/// go through it.
+#[derive(Debug, Clone)]
+pub struct ControllerMachineConfig {
+    /// The law's parameters.
+    pub params: ControllerParams,
+    /// Controlled joints.
+    pub dof: usize,
+    /// Control period, ns.
+    pub period_ns: u64,
+    /// The arm's model, which only the model-based laws read (None for the
+    /// others).
+    pub model: Option<ArmModel>,
+}
+
+impl ControllerMachineConfig {
+    /// The machine this config describes (sizes checked first, as a config
+    /// written by hand may be wrong).
+    pub fn machine(&self) -> Result<ControllerMachine, ControllerError> {
+        if self.dof == 0 || self.dof > wire::MAX_DOF || self.period_ns == 0 {
+            return Err(ControllerError::InvalidParameter {
+                key: "dof".into(),
+                value: format!("{} joints, period {} ns", self.dof, self.period_ns),
+                need: format!("1 to {} joints and a period above 0", wire::MAX_DOF),
+            });
+        }
+        ControllerMachine::new(&self.params, self.dof, self.period_ns, self.model.as_ref())
+    }
+}
+
 /// The law behind wire messages.
 #[derive(Debug)]
 pub struct ControllerMachine {
@@ -19,8 +51,9 @@ pub struct ControllerMachine {
 
 impl ControllerMachine {
     /// The law with `params` for `dof` joints at a period of `period_ns`;
-    /// `model` is the arm's, which only the model-based laws read.
-    pub fn new(
+    /// `model` is the arm's, which only the model-based laws read (built
+    /// through [`ControllerMachineConfig::machine`]).
+    fn new(
         params: &ControllerParams,
         dof: usize,
         period_ns: u64,

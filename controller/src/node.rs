@@ -11,7 +11,7 @@ use wire::{Command, ControllerDiagnostics, JointState, Mode, STATE_FINAL};
 
 use arm_model::{ArmModel, Locks};
 
-use crate::{ControllerError, ControllerMachine, ControllerParams};
+use crate::{ControllerError, ControllerMachine, ControllerMachineConfig, ControllerParams};
 
 /// What the launcher hands the controller node: gains and sizes, and the
 /// arm's URDF only for a model-based law.
@@ -64,13 +64,6 @@ impl ControllerNodeConfig {
     /// The step machine this configuration describes (a config written by
     /// hand is checked like a scenario: sizes first).
     pub fn machine(&self) -> Result<ControllerMachine, ControllerError> {
-        if self.dof == 0 || self.dof > wire::MAX_DOF || self.period_ns == 0 {
-            return Err(ControllerError::InvalidParameter {
-                key: "dof".into(),
-                value: format!("{} joints, period {} ns", self.dof, self.period_ns),
-                need: format!("1 to {} joints and a period above 0", wire::MAX_DOF),
-            });
-        }
         let model = match &self.model {
             Some(m) => Some(
                 ArmModel::from_urdf_str_locked(&m.urdf, &m.lock).map_err(|e| {
@@ -83,7 +76,13 @@ impl ControllerNodeConfig {
             ),
             None => None,
         };
-        ControllerMachine::new(&self.params, self.dof, self.period_ns, model.as_ref())
+        ControllerMachineConfig {
+            params: self.params.clone(),
+            dof: self.dof,
+            period_ns: self.period_ns,
+            model,
+        }
+        .machine()
     }
 }
 

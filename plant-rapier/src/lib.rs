@@ -50,7 +50,7 @@ pub use config::{
 };
 pub use effects::Effects;
 pub use engine::EngineName;
-pub use machine::PlantMachine;
+pub use machine::{PlantMachine, PlantMachineConfig};
 pub use plant::{ContactReading, Plant, check_contact};
 pub use rig::Rig;
 

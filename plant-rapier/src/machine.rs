@@ -6,6 +6,41 @@ use wire::{Command, ContactState, Header, JointState, MAX_DOF, NONE_U64, STATE_F
 
 use crate::{ArmModel, PlantConfig, PlantError, Rig};
 
+/// Everything a [`PlantMachine`] is built from, and the one way to build
+/// one ([`PlantMachineConfig::machine`]): the plant node, `testbed sim` and
+/// the Gym environment all go through it, so they cannot drift apart.
+#[derive(Debug, Clone)]
+pub struct PlantMachineConfig {
+    /// The arm (its locked joints already held).
+    pub model: ArmModel,
+    /// Plant settings.
+    pub plant: PlantConfig,
+    /// Seed of every random effect.
+    pub seed: u64,
+    /// Control period, ns.
+    pub period_ns: u64,
+    /// Steps in the run (state `steps` is flagged final).
+    pub steps: u64,
+    /// q(0), one per controlled joint.
+    pub initial_q: Vec<f64>,
+    /// q̇(0), one per controlled joint.
+    pub initial_qd: Vec<f64>,
+}
+
+impl PlantMachineConfig {
+    /// The machine this config describes, at its initial state.
+    pub fn machine(&self) -> Result<PlantMachine, PlantError> {
+        PlantMachine::new(
+            &self.model,
+            &self.plant,
+            self.seed,
+            self.period_ns,
+            self.steps,
+            (&self.initial_q, &self.initial_qd),
+        )
+    }
+}
+
 /// The rig stepped a period at a time, its states as [`JointState`]s.
 #[derive(Debug)]
 pub struct PlantMachine {
@@ -25,8 +60,8 @@ pub struct PlantMachine {
 
 impl PlantMachine {
     /// The rig for `model` at `q0`, `qd0`, stepping periods of `period_ns`
-    /// for `steps` steps.
-    pub fn new(
+    /// for `steps` steps (built through [`PlantMachineConfig::machine`]).
+    fn new(
         model: &ArmModel,
         config: &PlantConfig,
         seed: u64,

@@ -10,7 +10,7 @@ use bus::{NodeError, NodeLink, TopicPublisher, TopicSubscriber, monotonic_ns};
 use serde::{Deserialize, Serialize};
 use wire::{Command, ContactState, JointState, Mode, NODE_RUNNING, Timing};
 
-use crate::{ArmModel, PlantConfig, PlantError, PlantMachine};
+use crate::{ArmModel, PlantConfig, PlantError, PlantMachine, PlantMachineConfig};
 
 /// Steps between progress reports on the status topic.
 const PROGRESS_EVERY: u64 = 256;
@@ -40,15 +40,16 @@ pub struct PlantNodeConfig {
 impl PlantNodeConfig {
     /// The machine this config describes.
     pub fn machine(&self) -> Result<PlantMachine, PlantError> {
-        let model = ArmModel::from_urdf_str_locked(&self.urdf, &self.plant.lock)?;
-        PlantMachine::new(
-            &model,
-            &self.plant,
-            self.seed,
-            self.period_ns,
-            self.steps,
-            (&self.initial_q, &self.initial_qd),
-        )
+        PlantMachineConfig {
+            model: ArmModel::from_urdf_str_locked(&self.urdf, &self.plant.lock)?,
+            plant: self.plant.clone(),
+            seed: self.seed,
+            period_ns: self.period_ns,
+            steps: self.steps,
+            initial_q: self.initial_q.clone(),
+            initial_qd: self.initial_qd.clone(),
+        }
+        .machine()
     }
 }
 

@@ -53,24 +53,45 @@ impl Plan {
         })
     }
 
-    /// What the controller node needs of this plan: gains and sizes, and
-    /// the URDF only for a model-based law.
-    pub fn controller_node_config(&self) -> controller::node::ControllerNodeConfig {
-        let params = &self.scenario.controller;
-        controller::node::ControllerNodeConfig {
-            params: params.clone(),
+    /// What the plant's step machine is built from.
+    pub fn plant_config(&self) -> plant_rapier::PlantMachineConfig {
+        let s = &self.scenario;
+        plant_rapier::PlantMachineConfig {
+            model: self.robot.model.clone(),
+            plant: s.plant.clone(),
+            seed: s.seed,
+            period_ns: self.period_ns,
+            steps: self.steps,
+            initial_q: s.initial.q.clone(),
+            initial_qd: s.initial.qd.clone(),
+        }
+    }
+
+    /// What the controller's step machine is built from: the scenario's
+    /// law, with the arm's model only for a model-based law.
+    pub fn controller_config(&self) -> controller::ControllerMachineConfig {
+        self.controller_config_for(self.scenario.controller.clone())
+    }
+
+    /// [`Plan::controller_config`] with other parameters (another law on
+    /// the same arm and period).
+    pub fn controller_config_for(
+        &self,
+        params: controller::ControllerParams,
+    ) -> controller::ControllerMachineConfig {
+        controller::ControllerMachineConfig {
+            model: params.law.model_based().then(|| self.robot.model.clone()),
+            params,
             dof: self.robot.model.dof(),
             period_ns: self.period_ns,
+        }
+    }
+
+    /// What the trajectory's step machine is built from.
+    pub fn trajectory_config(&self) -> trajectory::TrajectoryMachineConfig {
+        trajectory::TrajectoryMachineConfig {
+            reference: self.reference.clone(),
             reference_period_ns: self.reference_period_ns,
-            model: params
-                .law
-                .model_based()
-                .then(|| controller::node::NodeModel {
-                    urdf: self.robot.urdf.clone(),
-                    lock: self.scenario.plant.lock.clone(),
-                }),
-            own_params: serde_json::Map::new(),
-            own_diagnostics: String::new(),
         }
     }
 

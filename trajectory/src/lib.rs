@@ -26,7 +26,7 @@ mod signal;
 mod sinusoid;
 mod waypoints;
 
-pub use machine::TrajectoryMachine;
+pub use machine::{TrajectoryMachine, TrajectoryMachineConfig};
 pub use reference::{Reference, ReferenceSample};
 pub use samples::{MAX_ROWS, Samples};
 pub use signal::{Ramp, Signal, Sine, Step};

@@ -5,6 +5,24 @@ use wire::{Header, joints};
 
 use crate::{Reference, ReferenceSample};
 
+/// Everything a [`TrajectoryMachine`] is built from, and the one way to
+/// build one ([`TrajectoryMachineConfig::machine`]): the trajectory node,
+/// `testbed sim` and the Gym environment all go through it.
+#[derive(Debug, Clone)]
+pub struct TrajectoryMachineConfig {
+    /// The checked reference and envelope.
+    pub reference: Reference,
+    /// Period of the samples, ns (0 is taken as 1).
+    pub reference_period_ns: u64,
+}
+
+impl TrajectoryMachineConfig {
+    /// The machine this config describes.
+    pub fn machine(&self) -> TrajectoryMachine {
+        TrajectoryMachine::new(self.reference.clone(), self.reference_period_ns)
+    }
+}
+
 /// Sample j describes t_j = j × the reference period.
 #[derive(Debug, Clone)]
 pub struct TrajectoryMachine {
@@ -14,8 +32,9 @@ pub struct TrajectoryMachine {
 }
 
 impl TrajectoryMachine {
-    /// Samples of `reference` every `period_ns` (> 0).
-    pub fn new(reference: Reference, period_ns: u64) -> Self {
+    /// Samples of `reference` every `period_ns` (> 0; built through
+    /// [`TrajectoryMachineConfig::machine`]).
+    fn new(reference: Reference, period_ns: u64) -> Self {
         Self {
             buf: ReferenceSample::new(reference.dof()),
             reference,

@@ -15,7 +15,10 @@ use bus::{NodeError, NodeLink, monotonic_ns};
 use serde::{Deserialize, Serialize};
 use wire::{JointState, Mode, ReferenceSample};
 
-use crate::{EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError, TrajectoryMachine};
+use crate::{
+    EnvelopeConfig, Reference, ReferenceConfig, TrajectoryError, TrajectoryMachine,
+    TrajectoryMachineConfig,
+};
 
 /// Samples the lockstep trajectory may publish beyond the plant's newest
 /// state: well inside a subscriber's buffer, so it never waits on a reader.
@@ -52,7 +55,11 @@ impl TrajectoryNodeConfig {
             &self.limits,
             &self.joint_names,
         )?;
-        Ok(TrajectoryMachine::new(r, self.reference_period_ns))
+        Ok(TrajectoryMachineConfig {
+            reference: r,
+            reference_period_ns: self.reference_period_ns,
+        }
+        .machine())
     }
 }
 

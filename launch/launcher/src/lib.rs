@@ -16,3 +16,4 @@ pub mod mode;
 pub mod node;
 pub mod run;
 pub mod sim;
+pub mod stepper;

@@ -1,12 +1,13 @@
 //! `testbed sim`: the run in one process. The plant, trajectory and
-//! controller step machines are called in order with the same messages the
-//! nodes exchange, and the step records come from the same assembler that
+//! controller step machines are called in order ([`Stepper`]) with the same
+//! messages the nodes exchange, and the step records come from the same assembler that
 //! reads a multi-process run's log: so lockstep reproduces this bit for bit.
 
 use controller::ControllerError;
 use plant_rapier::PlantError;
 use scenario::Plan;
-use trajectory::TrajectoryMachine;
+
+use crate::stepper::Stepper;
 
 use analysis::assemble::RecordAssembler;
 use analysis::record::StepRecord;
@@ -64,28 +65,25 @@ pub fn run_measured(
         robot: plan.robot.label(),
         cause,
     };
-    let mut plant = crate::node::configs::plant(plan)
-        .machine()
-        .map_err(plant_err)?;
-    let n = plant.dof();
-    let mut controller = crate::node::configs::controller(plan).machine()?;
-    let mut reference = TrajectoryMachine::new(plan.reference.clone(), plan.reference_period_ns);
-    let mut records = RecordAssembler::new(n, plan.dt(), plan.steps);
-    let mut state = plant.state(0, 0);
+    let mut stepper = Stepper::new(plan).map_err(plant_err)?;
+    let mut controller = plan.controller_config().machine()?;
+    let mut records = RecordAssembler::new(stepper.dof(), plan.dt(), plan.steps);
     for k in 0..plan.steps {
-        let r = reference.sample(reference.index_at(state.header.t_ns), 0);
+        let before = *stepper.state();
         let t0 = std::time::Instant::now();
-        let (command, diagnostics) = controller.step(&state, Some(&r));
+        let (command, diagnostics) = stepper.command(&mut controller);
         let t1 = std::time::Instant::now();
-        plant.step(Some(&command)).map_err(plant_err)?;
+        let stepped = stepper.advance(&command);
+        // The plant's time includes reading state k+1 and its reference
+        // sample, which the loop did outside the clock before the stepper.
         if let Some(c) = costs.as_mut() {
             c.controller_us.add((t1 - t0).as_nanos() as f64 / 1e3);
             c.plant_us.add(t1.elapsed().as_nanos() as f64 / 1e3);
         }
-        records.push_state(state);
+        stepped.map_err(plant_err)?;
+        records.push_state(before);
         records.push_diag(diagnostics);
-        state = plant.state(k + 1, 0);
-        records.push_state(state);
+        records.push_state(*stepper.state());
         records
             .emit(&mut on_step)
             .map_err(|cause| LoopError::Sink { step: k, cause })?;

@@ -4,10 +4,9 @@
 //! it, the built-in laws as objects, `compare`, and the Gymnasium
 //! environment's core, one arm or many stepped in one call.
 //!
-//! Where it sits: beside the `testbed` binary, on the same libraries. It
-//! drives the role crates' step machines ([`plant_rapier::PlantMachine`],
-//! [`trajectory::TrajectoryMachine`], [`controller::ControllerMachine`]) as
-//! `testbed sim` does, so a run from Python has the same bits. No I/O, no
+//! Where it sits: beside the `testbed` binary, on the same libraries:
+//! `sim` is [`launcher::sim`], the environment is the `gym-env` crate, so
+//! a run from Python has the same bits; this crate only converts. No I/O, no
 //! IPC; nothing here may panic across the boundary: every error becomes a
 //! Python exception that names its cause.
 
@@ -44,8 +43,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add_class::<robot::Robot>()?;
     m.add_class::<laws::PyLaw>()?;
-    m.add_class::<env::py::EnvCore>()?;
-    m.add_class::<env::py::VecEnvCore>()?;
+    m.add_class::<env::EnvCore>()?;
+    m.add_class::<env::VecEnvCore>()?;
     m.add_function(wrap_pyfunction!(runs::sim, m)?)?;
     m.add_function(wrap_pyfunction!(runs::compare, m)?)?;
     m.add_function(wrap_pyfunction!(runs::scenario_toml, m)?)?;

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use bus::{ConfigError, write_config};
-use controller::node::ControllerNodeConfig;
+use controller::node::{ControllerNodeConfig, NodeModel};
 use logger::live::LiveConfig;
 use logger::node::LoggerNodeConfig;
 use logger::{LogCompression, RunMetadata};
@@ -32,10 +32,22 @@ pub fn plant(plan: &Plan) -> PlantNodeConfig {
 }
 
 /// The controller's part: gains and sizes, and the URDF only for a
-/// model-based law ([`Plan::controller_node_config`], which `replay
-/// --verify` rebuilds the controller from too).
+/// model-based law (the node reads it into the model of
+/// [`Plan::controller_config`]).
 pub fn controller(plan: &Plan) -> ControllerNodeConfig {
-    plan.controller_node_config()
+    let params = &plan.scenario.controller;
+    ControllerNodeConfig {
+        params: params.clone(),
+        dof: plan.robot.model.dof(),
+        period_ns: plan.period_ns,
+        reference_period_ns: plan.reference_period_ns,
+        model: params.law.model_based().then(|| NodeModel {
+            urdf: plan.robot.urdf.clone(),
+            lock: plan.scenario.plant.lock.clone(),
+        }),
+        own_params: serde_json::Map::new(),
+        own_diagnostics: String::new(),
+    }
 }
 
 /// The trajectory's part.
