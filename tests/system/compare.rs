@@ -373,7 +373,14 @@ fn randomised_trials_differ_per_seed_and_repeat_per_seed() {
         findings[5]["evidence"]
             .as_str()
             .unwrap()
-            .contains("Wilcoxon p")
+            .contains("Wilcoxon signed-rank p = ")
+    );
+    // #50: the effect is paired, seed by seed.
+    assert!(
+        findings[5]["evidence"]
+            .as_str()
+            .unwrap()
+            .contains("median per-seed difference nac − pd")
     );
     // Seed 3's row is `sim` of the scenario with seed 3, and lockstep too.
     let base =
@@ -537,13 +544,22 @@ fn breaches_are_a_fact_and_the_findings_count_every_law_alike() {
     let evidence = f[0]["evidence"].as_str().unwrap();
     assert!(evidence.contains("ctc: kept 0, left 6"), "{evidence}");
     assert!(f[4]["claim"].as_str().unwrap().contains("vs ctc"));
-    assert_eq!(f[4]["verdict"], "holds", "{:?}", f[4]);
+    let evidence = f[4]["evidence"].as_str().unwrap();
     assert!(
-        f[4]["evidence"]
-            .as_str()
-            .unwrap()
-            .starts_with("nac kept it and ctc left it on 6 seeds, the reverse on 0")
+        evidence.starts_with("nac kept it and ctc left it on 6 seeds, the reverse on 0"),
+        "{evidence}"
     );
+    // #50: 6 to 0 is exact McNemar p = 2/64; Holm over the findings'
+    // tests decides, and "holds" needs Holm p < 0.05.
+    assert!(evidence.contains("exact McNemar p = 3.12e-2"), "{evidence}");
+    let holm: f64 = evidence
+        .split("Holm p = ")
+        .nth(1)
+        .and_then(|t| t.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .unwrap();
+    let want = if holm < 0.05 { "holds" } else { "not-shown" };
+    assert_eq!(f[4]["verdict"], want, "{evidence}");
 }
 
 /// #37 item 3: identical seeds are one run (a note, no paired test); one
@@ -579,7 +595,7 @@ fn what_the_seeds_cannot_say_is_not_said() {
         "--json",
     ])));
     let f = one["findings"].as_array().unwrap();
-    assert_eq!(f[5]["verdict"], "not-tested", "{:?}", f[5]);
+    assert_eq!(f[5]["verdict"], "not-shown", "{:?}", f[5]);
     assert!(
         f[5]["evidence"]
             .as_str()

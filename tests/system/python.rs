@@ -220,16 +220,65 @@ fn a_python_pd_runs_in_real_time_at_1khz() {
 }
 
 fn crash_script(dir: &Path) -> PathBuf {
-    let path = dir.join("crash.py");
+    crash_script_at(dir, 100)
+}
+
+/// A Python controller that raises at step `step`.
+fn crash_script_at(dir: &Path, step: u64) -> PathBuf {
+    let path = dir.join(format!("crash{step}.py"));
     std::fs::write(
         &path,
-        "import numpy as np\nimport testbed_controller as tc\n\n\
-         class Crash(tc.Controller):\n    def step(self, state, ref):\n        \
-         if state.seq == 100:\n            raise RuntimeError('boom at step 100')\n        \
-         return np.zeros(2)\n\ntc.run(Crash())\n",
+        format!(
+            "import numpy as np\nimport testbed_controller as tc\n\n\
+             class Crash(tc.Controller):\n    def step(self, state, ref):\n        \
+             if state.seq == {step}:\n            raise RuntimeError('boom at step {step}')\n        \
+             return np.zeros(2)\n\ntc.run(Crash())\n"
+        ),
     )
     .unwrap();
     path
+}
+
+/// #50 item 5: a user law that crashes after T_c is a failed run that
+/// left the envelope, never "not judged".
+#[test]
+fn a_user_law_that_crashes_after_tc_is_failed_not_unjudged() {
+    let dir = tempfile::tempdir().unwrap();
+    let cmd = format!(
+        "{} {}",
+        python(),
+        crash_script_at(dir.path(), 2500).display()
+    );
+    let out = testbed()
+        .args([
+            "compare",
+            "--laws",
+            "pd",
+            "--duration",
+            "3",
+            "--json",
+            "--runs-dir",
+        ])
+        .arg(dir.path())
+        .args(["--controller-cmd", &format!("crash={cmd}")])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let c: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let row = c["laws"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|l| l["name"] == "crash")
+        .unwrap()
+        .clone();
+    assert_eq!(row["failed"], 1, "{row}");
+    assert_eq!(row["not_judged"], 0, "{row}");
+    assert_eq!(row["left_envelope"], 1, "{row}");
 }
 
 /// The run stops, names the controller and shows its traceback, and no

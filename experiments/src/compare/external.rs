@@ -66,13 +66,20 @@ pub(crate) fn external_row(
                 let why = format!("the run failed: {e}");
                 let names = plan.robot.model.joint_names();
                 let empty = SummaryBuilder::new(names, plan.dt(), plan.scenario.controller.tc);
-                scored(
+                let mut run = scored(
                     seed,
                     Some(why),
                     empty.finish(),
                     Percentiles::of(Vec::new()),
                     None,
-                )
+                );
+                // A run meant to reach T_c that crashed did not keep the
+                // envelope: "not judged" is for runs that end before T_c
+                // by design (#50).
+                if plan.steps as f64 * plan.dt() > plan.scenario.controller.tc {
+                    run.envelope = crate::compare::types::Envelope::Left;
+                }
+                run
             }
         });
     }

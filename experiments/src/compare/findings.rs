@@ -412,12 +412,12 @@ fn better(
         );
     }
     let (a, b) = (values(nac, metric, runs), values(o, metric, runs));
-    if identical(nac, o, runs) {
+    if a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()) {
         return done(
             Verdict::NotTested,
             format!(
-                "identical, not tested: nac and {other} gave the same runs bit for bit on every seed ({metric} {})",
-                num(a.first().copied())
+                "identical, not tested: nac and {other} gave the same {metric} bit for bit on every seed (median {})",
+                num(nac.median.get(metric))
             ),
         );
     }
@@ -461,18 +461,6 @@ fn values(r: &LawRow, metric: &str, runs: usize) -> Vec<f64> {
 
 fn value(run: &LawRun, metric: &str) -> f64 {
     stats_of(run).get(metric).unwrap_or(f64::NAN)
-}
-
-/// Whether two laws gave the same runs on every seed (every metric bit for
-/// bit; compute times, which are the machine's, left out).
-fn identical(a: &LawRow, b: &LawRow, runs: usize) -> bool {
-    a.runs.iter().zip(&b.runs).take(runs).all(|(x, y)| {
-        let (x, y) = (stats_of(x), stats_of(y));
-        x.0.iter()
-            .zip(&y.0)
-            .filter(|((k, _), _)| !k.starts_with("compute_"))
-            .all(|((_, p), (_, q))| p.to_bits() == q.to_bits())
-    })
 }
 
 /// The median over seeds of (a_i − b_i) / |b_i|: −∞ where only b failed
