@@ -1,12 +1,13 @@
 """The Gymnasium environments: `testbed/ArmTracking-v0` and its vector form.
 
-A step is one control period of a scenario (1 ms in the paper's): the
-agent's action becomes the joint torques, or a residual on a built-in law,
-the arm (the testbed's plant, with every effect the scenario turns on) steps
-one period, and the environment returns the next observation, a tracking
-reward, and, in `info["cost"]`, whether the constraint |e_i| < k_c,i(t) was
-broken (Safety-Gymnasium's convention). The loop runs in Rust
-(`testbed._native`); docs/python.md has the whole contract.
+A step is one decision of the agent: its action is held for `decimation`
+plant periods (default 20 of the paper's 1 ms: a 50 Hz policy) and becomes
+the joint torques, or a residual on a built-in law; the arm (the testbed's
+plant, with every effect the scenario turns on) steps, and the environment
+returns the next observation, a tracking reward, and, in `info["cost"]`,
+whether the deferred constraint |e_i| < k_c,i(t) was broken after T_c. The
+loop runs in Rust (the `gym-env` crate, through `testbed._native`);
+docs/python.md has the whole contract.
 """
 
 from __future__ import annotations
@@ -24,6 +25,12 @@ from ._native import EnvCore, VecEnvCore
 #: the time fraction t / T.
 OBSERVATION = ("e", "e_dot", "q", "qd", "q_d", "qd_d", "kc")
 
+#: The render modes: None (no picture) or "rgb_array".
+RENDER_MODES = ["rgb_array"]
+
+#: The side of a rendered picture, pixels.
+RENDER_SIZE = 480
+
 
 def observation_names(dof: int) -> list:
     """The observation's entries by name: e0, e1, …, kc{n-1}, time_fraction."""
@@ -40,54 +47,62 @@ def _seed_from(rng: np.random.Generator) -> int:
     return int(rng.integers(0, 2**63 - 1))
 
 
+def _render_mode(render_mode):
+    if render_mode is not None and render_mode not in RENDER_MODES:
+        raise ValueError(f"render_mode = {render_mode!r}: the modes are None and 'rgb_array'")
+    return render_mode
+
+
 class ArmTrackingEnv(gymnasium.Env):
     """Track a scenario's reference with an arm under its deferred constraint.
 
-    Arguments (all optional): `scenario` (a file or a shipped name; default
-    the paper's), `robot` (a URDF; alone, its default scenario), `set`
-    (`--set` overrides, a dict or "key=value" strings), `duration` (s),
-    `base_law` (None: the action is the torque; a law's name: a residual
-    on it), `residual_scale` (the residual's span as a fraction of the
-    torque scale, default 0.2), `effort_weight` (default 0.01),
-    `breach_factor` (end the episode once, after T_c, an error passes this
-    many times its envelope; default 2, None: never), `torque_scale` (torque
-    per unit of action; default the effort limits).
+    Arguments (all optional, docs/python.md has units and defaults):
+    `scenario`, `robot`, `set`, `episode_s` (default 4 s; `duration` is its
+    old name), `decimation` (default 20 plant periods per decision),
+    `base_law` (None: the action is the torque; a law's name: a residual on
+    it), `residual_scale` (0.2), `torque_scale` (default derived from the
+    arm), `effort_weight` (0.01), `breach_factor` (2; None: never end
+    early), `safe` (False), `scale_obs` (True), `render_mode` (None or
+    "rgb_array").
 
     - action: n numbers in [-1, 1] (clipped), float32; τ_i = a_i · scale_i,
-      or τ = τ_law + a_i · residual_scale · scale_i.
-    - observation: float64, 7n + 1 numbers: e = q − q_d, ė = q̇ − q̇_d, q,
-      q̇ (as measured), q_d, q̇_d, k_c, t / T (`observation_names`).
-    - reward: −mean_i (e_i / k_c,i)² − effort_weight · mean_i (τ_i / scale_i)²,
-      with the true error after the step.
-    - info["cost"]: 1.0 when, at or after T_c, some |e_i| ≥ k_c,i; else 0.
-    - terminated: the state is not finite (reward −100), or breached.
-    - truncated: the scenario's end (duration_s).
-    - reset(seed=s): the scenario's `[randomise]` table drawn with seed s,
-      and the plant's noise seeded by it (the run of `testbed sim --set
-      seed=s`); without a seed, one is drawn from the environment's RNG.
+      or τ = τ_law + a_i · residual_scale · scale_i, held `decimation`
+      plant periods.
+    - observation: float64, 7n + 1 numbers: e/k_c, ė/v, q, q̇/v, q_d,
+      q̇_d/v, k_c, t / T, v the velocity scale (`scale_obs=False`: e, ė, q,
+      q̇, q_d, q̇_d, k_c, t / T unscaled; `observation_names`).
+    - reward: the mean over the held periods of −mean_i min((e_i/k_c,i)²,
+      100) − effort_weight · mean_i a_i²; an early end adds the worst reward
+      (−100 − effort_weight) for every decision it skips.
+    - info["cost"]: 1.0 when, at or after T_c, some |e_i| ≥ k_c,i after a
+      held period; else 0.
+    - terminated: the state is not finite, or (not safe) some |e_i| >
+      breach_factor · k_c,i after T_c. truncated: the episode's end.
+    - reset(seed=s, options={"initial_q": [...], "initial_qd": [...]}):
+      the scenario's `[randomise]` table drawn with seed s, the plant's
+      noise seeded by it; without a seed, one drawn from the env's RNG.
     """
 
-    metadata = {"render_modes": [], "render_fps": 1000}
+    metadata = {"render_modes": RENDER_MODES, "render_fps": 50}
 
     def __init__(self, scenario=None, *, render_mode=None, **kwargs):
-        if render_mode is not None:
-            raise ValueError("ArmTrackingEnv has no render mode; watch a run in Foxglove instead")
+        self.render_mode = _render_mode(render_mode)
         self._core = EnvCore(scenario, **kwargs)
         self.observation_space, self.action_space = _spaces(self._core)
-        self.metadata = dict(self.metadata, render_fps=int(round(1.0 / self._core.dt)))
+        self.metadata = dict(self.metadata, render_fps=max(1, int(round(1.0 / self._core.dt))))
         self._ended = True
 
     @property
     def core(self) -> EnvCore:
-        """The Rust core (dt, steps, tc, joint_names, torque_scale, true_state…)."""
+        """The Rust core (dt, decimation, steps, tc, joint_names, torque_scale, true_state…)."""
         return self._core
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
-        if options:
-            raise ValueError(f"reset: options {sorted(options)} are not taken; pass seed= only")
+        if options is not None and not isinstance(options, dict):
+            raise TypeError(f"reset: options must be a dict, got {type(options).__name__}")
         episode_seed = seed if seed is not None else _seed_from(self.np_random)
-        obs = self._core.reset(int(episode_seed))
+        obs = self._core.reset(int(episode_seed), options or None)
         self._ended = False
         return obs, {"seed": int(episode_seed)}
 
@@ -98,28 +113,37 @@ class ArmTrackingEnv(gymnasium.Env):
         self._ended = out[2] or out[3]
         return out
 
+    def render(self):
+        """The arm (dark, joints red) over its reference pose (light), as an
+        (480, 480, 3) uint8 array with render_mode="rgb_array"; else None."""
+        if self.render_mode == "rgb_array":
+            return self._core.render(RENDER_SIZE, RENDER_SIZE)
+        return None
+
 
 class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
     """`num_envs` arms of one scenario stepped in Rust in one call.
 
     The same arguments and contract as `ArmTrackingEnv`, batched: actions
-    of shape (num_envs, n), observations (num_envs, 7n + 1), rewards,
-    terminated and truncated of shape (num_envs,), and `info["cost"]`.
-    An arm whose episode ended resets on the next step (Gymnasium's
-    NEXT_STEP autoreset: that step ignores its action and returns its first
-    observation, reward 0). `reset(seed=s)` gives arm i the seed s + i.
+    of shape (num_envs, n) (any memory order), observations (num_envs,
+    7n + 1), rewards, terminated and truncated of shape (num_envs,), and
+    `info["cost"]`. An arm whose episode ended resets on the next step
+    (Gymnasium's NEXT_STEP autoreset: that step ignores its action and
+    returns its first observation, reward 0). `reset(seed=s)` gives arm i
+    the seed s + i. `render()` gives one picture per arm.
     """
 
-    metadata = {"autoreset_mode": gymnasium.vector.AutoresetMode.NEXT_STEP, "render_modes": []}
+    metadata = {"autoreset_mode": gymnasium.vector.AutoresetMode.NEXT_STEP,
+                "render_modes": RENDER_MODES}
 
     def __init__(self, num_envs: int = 1, scenario=None, *, render_mode=None, **kwargs):
-        if render_mode is not None:
-            raise ValueError("ArmTrackingVecEnv has no render mode")
+        self.render_mode = _render_mode(render_mode)
         self._core = VecEnvCore(operator.index(num_envs), scenario, **kwargs)
         self.num_envs = self._core.num_envs
         self.single_observation_space, self.single_action_space = _spaces(self._core)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.metadata = dict(self.metadata, render_fps=max(1, int(round(1.0 / self._core.dt))))
         self._all = np.ones(self.num_envs, dtype=bool)
 
     @property
@@ -129,7 +153,8 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
 
     def reset(self, *, seed=None, options=None):
         if options:
-            raise ValueError(f"reset: options {sorted(options)} are not taken; pass seed= only")
+            raise ValueError(f"reset: options {sorted(options)} are not taken by the vector form; "
+                             "pass seed= only")
         if seed is not None and not isinstance(seed, (int, np.integer)):
             seeds = [operator.index(s) for s in seed]
             if not seeds or seeds != [seeds[0] + i for i in range(self.num_envs)]:
@@ -142,6 +167,12 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         return obs, {}
 
     def step(self, actions):
-        actions = np.ascontiguousarray(actions, dtype=np.float64)
+        actions = np.asarray(actions, dtype=np.float64)
         obs, rewards, terminated, truncated, costs = self._core.step(actions)
         return obs, rewards, terminated, truncated, {"cost": costs, "_cost": self._all}
+
+    def render(self):
+        """One picture per arm with render_mode="rgb_array"; else None."""
+        if self.render_mode != "rgb_array":
+            return None
+        return tuple(self._core.render(i, RENDER_SIZE, RENDER_SIZE) for i in range(self.num_envs))

@@ -61,6 +61,16 @@ class LinearPolicy:
         scale = np.asarray(env["torque_scale"])
         if scale.shape != (dof,) or not np.issubdtype(scale.dtype, np.number):
             raise ValueError(f"{where}: env.torque_scale must be {dof} numbers")
+        # Files from before decimation and scaled observations: 1 kHz, raw.
+        decimation = env.get("decimation", 1)
+        if not (isinstance(decimation, int) and not isinstance(decimation, bool) and decimation >= 1):
+            raise ValueError(f"{where}: env.decimation = {decimation!r}; it must be an integer ≥ 1")
+        if not isinstance(env.get("scale_obs", False), bool):
+            raise ValueError(f"{where}: env.scale_obs must be true or false")
+        if env.get("scale_obs", False):
+            v = np.asarray(env.get("velocity_scale", []))
+            if v.shape != (dof,) or not np.issubdtype(v.dtype, np.number) or not np.all(v > 0):
+                raise ValueError(f"{where}: env.velocity_scale must be {dof} positive numbers")
         w, b = np.asarray(self.weights), np.asarray(self.bias)
         if w.shape != (dof, obs_dim) or b.shape != (dof,):
             raise ValueError(f"{where}: weights {w.shape} and bias {b.shape}; "
@@ -74,10 +84,14 @@ class LinearPolicy:
 
 
 def env_record(env) -> dict:
-    """What a policy file keeps of an `ArmTrackingEnv` made with `make_kwargs`."""
+    """What a policy file keeps of an `ArmTrackingEnv`: its sizes, and what
+    `testbed.policy_node` needs to act as the environment does (plant
+    periods per decision, the torque and velocity scales, whether the
+    observation is scaled)."""
     core = env.unwrapped.core
     return {"dof": core.dof, "obs_dim": core.obs_dim, "steps": core.steps,
-            "torque_scale": core.torque_scale.tolist()}
+            "torque_scale": core.torque_scale.tolist(), "decimation": core.decimation,
+            "scale_obs": core.scale_obs, "velocity_scale": core.velocity_scale.tolist()}
 
 
 def episode_return(env, policy: LinearPolicy, seed: int) -> float:

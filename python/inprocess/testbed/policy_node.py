@@ -3,11 +3,12 @@
     testbed run --controller-cmd "python -m testbed.policy_node --policy POLICY.npz"
     testbed compare --controller-cmd policy="python -m testbed.policy_node --policy POLICY.npz"
 
-Each step builds the environment's observation from the measured state and
-the reference sample, exactly as `ArmTrackingEnv` does, and applies the
-torque the environment would (the residual on the same built-in law, from
-the policy's scenario): a lockstep run of the scenario with the episode's
-seed reproduces the environment's episode.
+Each decision (every `decimation` steps, as the environment's) builds the
+environment's observation from the measured state and the reference
+sample, exactly as `ArmTrackingEnv` does (scaled or not), and every step
+applies the torque the environment would (the held residual on the same
+built-in law, from the policy's scenario): a lockstep run of the scenario
+with the episode's seed reproduces the environment's episode.
 """
 
 from __future__ import annotations
@@ -37,8 +38,12 @@ class PolicyController(tc.Controller):
         if self.base_law is not None and self.base_law not in LAWS:
             raise ValueError(f"env.base_law = {self.base_law!r} is not a law ({', '.join(LAWS)})")
         self.span = float(env.get("residual_scale", 0.2)) if self.base_law else 1.0
+        self.decimation = int(env.get("decimation", 1))
+        self.scale_obs = bool(env.get("scale_obs", False))
+        self.velocity = np.asarray(env.get("velocity_scale", np.ones(self.n)), dtype=np.float64)
         self.law = None
         self.obs = np.empty(7 * self.n + 1)
+        self.residual = np.zeros(self.n)
 
     def setup(self, run: tc.RunInfo) -> None:
         if run.dof != self.n:
@@ -49,22 +54,28 @@ class PolicyController(tc.Controller):
                            set=env.get("set"))
 
     def step(self, state: tc.State, ref: tc.Reference) -> np.ndarray:
-        n, o = self.n, self.obs
-        o[0:n] = state.q - ref.q_d
-        o[n:2 * n] = state.qd - ref.qd_d
-        o[2 * n:3 * n] = state.q
-        o[3 * n:4 * n] = state.qd
-        o[4 * n:5 * n] = ref.q_d
-        o[5 * n:6 * n] = ref.qd_d
-        o[6 * n:7 * n] = ref.kc
-        o[7 * n] = state.seq / self.steps
-        a = self.policy.act(o)
-        residual = a * self.span * self.scale
+        if state.seq % self.decimation == 0:
+            n, o = self.n, self.obs
+            o[0:n] = state.q - ref.q_d
+            o[n:2 * n] = state.qd - ref.qd_d
+            o[2 * n:3 * n] = state.q
+            o[3 * n:4 * n] = state.qd
+            o[4 * n:5 * n] = ref.q_d
+            o[5 * n:6 * n] = ref.qd_d
+            o[6 * n:7 * n] = ref.kc
+            o[7 * n] = state.seq / self.steps
+            if self.scale_obs:
+                # The same divisions as the environment's, in the same order.
+                o[0:n] = o[0:n] / ref.kc
+                for k in (1, 3, 5):
+                    o[k * n:(k + 1) * n] = o[k * n:(k + 1) * n] / self.velocity
+            a = self.policy.act(o)
+            self.residual = a * self.span * self.scale
         if self.law is None:
-            return residual
+            return self.residual
         base = self.law.step(state.t, state.q, state.qd, ref.q_d, ref.qd_d, ref.qdd_d, ref.kc,
                              ref.kc_dot)
-        return base + residual
+        return base + self.residual
 
 
 def main(argv=None) -> None:

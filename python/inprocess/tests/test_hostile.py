@@ -68,7 +68,7 @@ class Boundary(unittest.TestCase):
             testbed.Robot().gravity(b"\0\0")
 
     def test_the_raw_core_stops_at_the_episodes_end(self):
-        core = testbed.EnvCore(duration=0.002)
+        core = testbed.EnvCore(duration=0.002, decimation=1)
         core.reset(0)
         core.step(np.zeros(2))
         *_, truncated, _ = core.step(np.zeros(2))
