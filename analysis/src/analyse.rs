@@ -3,6 +3,7 @@
 //! `testbed run` and `testbed replay` both call [`analyse`], so a summary
 //! never depends on how it is produced: the log alone decides it.
 
+use std::collections::HashMap;
 use std::io::Write;
 use std::path::Path;
 
@@ -231,10 +232,18 @@ struct Analyser<'a, 'o> {
     /// Values an own-diagnostics sample carries (0: none declared).
     own_len: usize,
     own: OwnStats,
+    /// Messages read per topic, to tell whether the log is the whole run.
+    topics: HashMap<String, u64>,
 }
 
 impl Analyser<'_, '_> {
     fn on_message(&mut self, m: &RawMessage<'_>) -> Result<(), MessageError> {
+        match self.topics.get_mut(m.topic) {
+            Some(n) => *n += 1,
+            None => {
+                self.topics.insert(m.topic.to_string(), 1);
+            }
+        }
         // Every logged message has its arm: the match is over the wire's
         // one list of them.
         match logger::decode_logged(m)? {
@@ -360,6 +369,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         wall: (u64::MAX, 0),
         own_len,
         own: OwnStats::new(own, n),
+        topics: HashMap::new(),
     };
     let contents = match read_log(path, Some(&mut |m| a.on_message(m))) {
         Err(LogError::Sink { cause, .. }) => return Err(out_err(cause)),
@@ -382,12 +392,19 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
     // A log of format 1 has no data-path stamps to recount from.
     let data_path = (contents.log_format().unwrap_or(0) >= 2).then(|| a.data_path.finish());
     let mut timing = a.timing.finish(mode, plan.scenario.rate_hz, data_path);
+    // A log read only in part says so already.
+    let not_whole = match contents.cut_short {
+        Some(_) => Vec::new(),
+        None => crate::whole::gaps(&contents, &a.topics, own_len > 0),
+    };
     judge(
         &mut timing,
         &RunFacts {
             missing_rows,
             run_end: contents.run_end(),
             cut_short: contents.cut_short.as_deref(),
+            not_whole: &not_whole,
+            unchecked: contents.unchecked.as_deref(),
             first_non_finite_s: summary.first_non_finite_s,
             period_ns: plan.period_ns,
         },

@@ -5,7 +5,7 @@
 //! step ([`assemble::RecordAssembler`] → [`record::StepRecord`]), and feeds
 //! the summary ([`summary`]), the CSV ([`csv_out`]), the figures
 //! ([`plots`]), `--verify` ([`verify`]), the timing statistics and the
-//! verdict ([`timing`], [`data_path`]). `testbed run`, `replay`, `compare`
+//! verdict ([`timing`], [`data_path`], [`whole`]). `testbed run`, `replay`, `compare`
 //! and `sweep` all take their numbers from here, and `testbed sim` feeds the
 //! same assembler and summary in process; [`report`] is what they print.
 //! Nothing here starts a process or knows the launcher.
@@ -24,5 +24,6 @@ pub mod stats;
 pub mod summary;
 pub mod timing;
 pub mod verify;
+pub mod whole;
 
 pub use analyse::{AnalyseOptions, AnalysisError, LogAnalysis, Series, analyse};

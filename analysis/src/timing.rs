@@ -138,8 +138,10 @@ pub enum Verdict {
     /// command, a stale reference, or more late wake-ups than a quiet timer
     /// shows. Its figures are not the law's alone.
     Degraded,
-    /// The log is not the whole run: rows lost, a node lost, the run
-    /// unfinished, or the log's recount differs from the live counts.
+    /// The log is not the whole run: rows lost, a topic or messages
+    /// missing, a node lost, the run unfinished, or the log's recount
+    /// differs from the live counts; or the log cannot be checked (its
+    /// data section has no checksum).
     Invalid,
 }
 
@@ -182,6 +184,10 @@ pub struct RunFacts<'a> {
     pub run_end: Option<&'a str>,
     /// Why the log was read only in part, if it was.
     pub cut_short: Option<&'a str>,
+    /// Why the log, read in full, is not the whole run ([`crate::whole`]).
+    pub not_whole: &'a [String],
+    /// Why the log's integrity cannot be checked, if it cannot.
+    pub unchecked: Option<&'a str>,
     /// Sim time of the first non-finite or faulted step.
     pub first_non_finite_s: Option<f64>,
     /// Control period, ns.
@@ -194,6 +200,15 @@ pub fn judge(t: &mut TimingSummary, facts: &RunFacts<'_>) {
     let mut degraded = Vec::new();
     if let Some(cut) = facts.cut_short {
         invalid.push(format!("the log was read only in part ({cut})"));
+    }
+    if !facts.not_whole.is_empty() {
+        invalid.push(format!(
+            "the log is not the whole run: {}",
+            facts.not_whole.join("; ")
+        ));
+    }
+    if let Some(why) = facts.unchecked {
+        invalid.push(format!("the log cannot be checked: {why}"));
     }
     match facts.run_end {
         Some("finished") => {}
@@ -437,6 +452,37 @@ mod verdict_tests {
         );
         assert_eq!(t.verdict, Verdict::Invalid);
         assert_eq!(t.reasons.len(), 2, "{:?}", t.reasons);
+    }
+
+    /// Issue 48 item 1: a log without whole topics, or without a data
+    /// checksum, is never clean.
+    #[test]
+    fn a_log_not_whole_or_unchecked_is_invalid() {
+        let gaps = ["it has no /timing messages".to_string()];
+        for (not_whole, unchecked, said) in [
+            (
+                &gaps[..],
+                None,
+                "the log is not the whole run: it has no /timing messages",
+            ),
+            (
+                &[][..],
+                Some("its checksum is 0"),
+                "the log cannot be checked: its checksum is 0",
+            ),
+        ] {
+            let mut t = summary(0, 0, 10);
+            judge(
+                &mut t,
+                &RunFacts {
+                    not_whole,
+                    unchecked,
+                    ..finished()
+                },
+            );
+            assert_eq!(t.verdict, Verdict::Invalid, "{said}");
+            assert_eq!(t.reasons, [said]);
+        }
     }
 
     #[test]

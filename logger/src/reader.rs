@@ -26,6 +26,11 @@ pub struct LogContents {
     pub complete: bool,
     /// Why reading stopped early, if it did.
     pub cut_short: Option<String>,
+    /// Why the log's integrity cannot be checked, if it cannot: its data
+    /// section's checksum is 0 (MCAP's "not computed", which other writers
+    /// leave) or it has no DataEnd record. A record changed after writing
+    /// would then go unseen, so such a log is never judged clean.
+    pub unchecked: Option<String>,
 }
 
 impl LogContents {
@@ -205,6 +210,7 @@ fn stream(
                 walk.damaged = Some(why);
                 break;
             }
+            walk.data_end = Some(stored_crc(&part[start..]));
         } else if !head_only {
             data_crc.update(&part[mcap::MAGIC.len()..]);
         }
@@ -226,8 +232,17 @@ fn stream(
 /// The DataEnd record's opcode.
 const OP_DATA_END: u8 = 0x0F;
 
+/// The data section's checksum a DataEnd record's `body` holds (0: not
+/// computed, or a body too short to hold one).
+fn stored_crc(body: &[u8]) -> u32 {
+    body.get(..4)
+        .and_then(|b| b.try_into().ok())
+        .map_or(0, u32::from_le_bytes)
+}
+
 /// Why the data section's checksum in DataEnd's `body` does not match
-/// `crc` (None when it does, or when the writer left it 0: not computed).
+/// `crc` (None when it does, or when the writer left it 0: not computed,
+/// which [`Walk::finish`] reports as a log that cannot be checked).
 fn data_crc_differs(body: &[u8], crc: &crc32fast::Hasher) -> Option<String> {
     let stored = u32::from_le_bytes(body.get(..4)?.try_into().ok()?);
     let computed = crc.clone().finalize();
@@ -265,6 +280,8 @@ fn read(
     // Only the soundly framed part goes to the reader (see `scan`).
     let (end, damaged) = crate::scan::sound_prefix(buf);
     walk.damaged = damaged;
+    // The `mcap` reader checks a non-zero checksum; a zero one is noted.
+    walk.data_end = crate::scan::find_record(&buf[..end], OP_DATA_END).map(stored_crc);
     walk.feed(
         crate::records::Records::new(&buf[..end]),
         &mut on_message,
@@ -282,6 +299,9 @@ struct Walk {
     schemas: HashMap<u16, Result<Arc<MsgSchema>, String>>,
     /// Where the framing stopped being sound, if it did.
     damaged: Option<String>,
+    /// The data section's checksum its DataEnd record holds (None: no
+    /// DataEnd read).
+    data_end: Option<u32>,
 }
 
 impl Walk {
@@ -295,6 +315,7 @@ impl Walk {
             topics: HashMap::new(),
             schemas: HashMap::new(),
             damaged: None,
+            data_end: None,
         }
     }
 
@@ -380,6 +401,23 @@ impl Walk {
         }
         if !out.complete && out.cut_short.is_none() && !head_only {
             out.cut_short = Some("the logger never finished the file (no footer)".into());
+        }
+        if out.cut_short.is_none() && !head_only {
+            out.unchecked = match self.data_end {
+                // testbed's logger always computes it (0 by chance: once in 2³²).
+                Some(0) => Some(
+                    "its data section's checksum is 0 (MCAP's \"not computed\", as Python's \
+                     mcap writer leaves it; testbed's logger always computes it), so a record \
+                     changed after writing would go unseen"
+                        .into(),
+                ),
+                Some(_) => None,
+                None => Some(
+                    "it has no DataEnd record, so no checksum covers its data section and a \
+                     record changed after writing would go unseen"
+                        .into(),
+                ),
+            };
         }
         Ok(self.out)
     }

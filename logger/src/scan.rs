@@ -52,6 +52,21 @@ pub fn sound_prefix(buf: &[u8]) -> (usize, Option<String>) {
     (buf.len(), None)
 }
 
+/// The body of the first top-level record of opcode `op` in `buf` (a
+/// soundly framed MCAP file, as [`sound_prefix`] cuts it).
+pub(crate) fn find_record(buf: &[u8], op: u8) -> Option<&[u8]> {
+    let mut at = mcap::MAGIC.len();
+    while at + 9 <= buf.len() {
+        let len = usize::try_from(u64::from_le_bytes(le8(&buf[at + 1..at + 9]))).ok()?;
+        let body = buf.get(at + 9..(at + 9).checked_add(len)?)?;
+        if buf[at] == op {
+            return Some(body);
+        }
+        at += 9 + len;
+    }
+    None
+}
+
 /// A chunk's sizes agree with its body and are plausible.
 pub(crate) fn check_chunk(body: &[u8]) -> Option<String> {
     // start, end, uncompressed size (u64 each), crc (u32), compression (u32 length + text).

@@ -10,7 +10,7 @@ use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 
 use crate::run_cli::{newest_log, wait_until_running};
-use crate::util::{nodes_of, ok, shm_files, testbed, wait_for_nodes};
+use crate::util::{nodes_of, shm_files, testbed, wait_for_nodes};
 
 /// Starts a run of `secs` in `mode`, stops node `node` once it is under way,
 /// and returns the launcher's stderr once it has ended (watchdog: 60 s)
@@ -33,7 +33,9 @@ fn stop_node(mode: &str, secs: &str, node: &str) -> (String, serde_json::Value) 
     assert!(nodes_of(launcher.id()).is_empty(), "nodes left running");
     assert_eq!(shm_files(&prefix), Vec::<String>::new());
     let log = newest_log(dir.path());
-    let summary = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
+    let summary = crate::util::json(&crate::util::replayed(
+        testbed().arg("replay").arg(&log).arg("--json"),
+    ));
     (err, summary)
 }
 

@@ -278,7 +278,7 @@ fn truncated_logs_are_analysed_as_far_as_they_go() {
     for frac in [0.2, 0.45, 0.7, 0.9] {
         let cut = dir.path().join(format!("cut-{frac}.mcap"));
         std::fs::write(&cut, &full[..(full.len() as f64 * frac) as usize]).unwrap();
-        let out = ok(testbed().arg("replay").arg(&cut).arg("--json"));
+        let out = crate::util::replayed(testbed().arg("replay").arg(&cut).arg("--json"));
         let s = json(&out);
         let steps = s["steps"].as_u64().unwrap();
         // A cut loses its whole (compressed) chunk, and two cuts can fall in
@@ -298,7 +298,9 @@ fn truncated_logs_are_analysed_as_far_as_they_go() {
     // still reported as unfinished.
     let cut = dir.path().join("cut-summary.mcap");
     std::fs::write(&cut, &full[..full.len() - 40]).unwrap();
-    let s = json(&ok(testbed().arg("replay").arg(&cut).arg("--json")));
+    let s = json(&crate::util::replayed(
+        testbed().arg("replay").arg(&cut).arg("--json"),
+    ));
     assert_eq!(s["steps"], 3000);
     assert!(
         s["warning"]

@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod compare;
+mod false_success;
 mod hardening;
 mod hardening3;
 mod hardening4;

@@ -50,7 +50,9 @@ fn realtime_run(args: &[&str]) -> Value {
     );
     // The log alone gives the same figures: replay recounts them.
     let log = s["log"].as_str().unwrap();
-    let replayed = json(&ok(testbed().args(["replay", "--json", log])));
+    let replayed = json(&crate::util::replayed(
+        testbed().args(["replay", "--json", log]),
+    ));
     for key in [
         "verdict",
         "reasons",

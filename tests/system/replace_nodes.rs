@@ -146,7 +146,7 @@ fn a_replacement_trajectory_is_followed_in_lockstep_and_real_time() {
         // The log's diagnostics hold the reference the controller used.
         let log = s["log"].as_str().unwrap();
         let csv = dir.path().join("r.csv");
-        crate::util::ok(testbed().args(["replay", log, "--csv"]).arg(&csv));
+        crate::util::replayed(testbed().args(["replay", log, "--csv"]).arg(&csv));
         let text = std::fs::read_to_string(&csv).unwrap();
         let mut rows = text.lines();
         let header: Vec<&str> = rows.next().unwrap().split(',').collect();

@@ -131,7 +131,9 @@ fn killing_any_node_fails_the_run_cleanly() {
         if victim != "logger" {
             // The log says the run did not finish, and which node it lost.
             let log = newest_log(dir.path());
-            let s = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
+            let s = crate::util::json(&crate::util::replayed(
+                testbed().arg("replay").arg(&log).arg("--json"),
+            ));
             let w = s["warning"].as_str().unwrap_or_default();
             assert!(
                 w.contains(&format!("the run did not finish (lost the {victim})")),
@@ -141,7 +143,7 @@ fn killing_any_node_fails_the_run_cleanly() {
         if victim == "logger" {
             // The unfinished log keeps what was flushed before the kill.
             let log = newest_log(dir.path());
-            let out = ok(testbed().arg("replay").arg(&log).arg("--json"));
+            let out = crate::util::replayed(testbed().arg("replay").arg(&log).arg("--json"));
             let s = crate::util::json(&out);
             assert!(s["steps"].as_u64().unwrap() > 0, "{s}");
             assert!(s["warning"].as_str().unwrap().contains("recovered"), "{s}");
@@ -178,7 +180,9 @@ fn ctrl_c_stops_everything() {
     assert!(nodes_of(launcher.id()).is_empty());
     assert_eq!(shm_files(&nodes[0].2), Vec::<String>::new());
     let log = newest_log(dir.path());
-    let s = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
+    let s = crate::util::json(&crate::util::replayed(
+        testbed().arg("replay").arg(&log).arg("--json"),
+    ));
     let w = s["warning"].as_str().unwrap_or_default();
     assert!(w.contains("the run did not finish (interrupted)"), "{s}");
 }
@@ -209,7 +213,9 @@ fn nodes_exit_when_the_launcher_is_killed() {
     }
     // The logger finished the file and says the launcher vanished.
     let log = newest_log(dir.path());
-    let s = crate::util::json(&ok(testbed().arg("replay").arg(&log).arg("--json")));
+    let s = crate::util::json(&crate::util::replayed(
+        testbed().arg("replay").arg(&log).arg("--json"),
+    ));
     let w = s["warning"].as_str().unwrap_or_default();
     assert!(
         w.contains(&format!(

@@ -41,6 +41,29 @@ pub fn ran(cmd: &mut Command) -> Output {
     out
 }
 
+/// Runs `testbed replay` of a log whatever its verdict: the exit status
+/// must be the verdict's (0 clean, 3 degraded, 4 invalid), as its JSON
+/// summary (when printed) says; anything else fails the test with stderr.
+pub fn replayed(cmd: &mut Command) -> Output {
+    let out = cmd.output().expect("spawn testbed");
+    let verdict = serde_json::from_slice::<serde_json::Value>(&out.stdout)
+        .ok()
+        .and_then(|s| s["timing"]["verdict"].as_str().map(str::to_string));
+    let expected = match verdict.as_deref() {
+        Some("clean") => vec![0],
+        Some("degraded") => vec![3],
+        Some("invalid") => vec![4],
+        _ => vec![0, 3, 4],
+    };
+    assert!(
+        out.status.code().is_some_and(|c| expected.contains(&c)),
+        "{cmd:?} exited {:?} (verdict {verdict:?})\nstderr:\n{}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// Runs, expects a non-zero exit, and returns stderr.
 pub fn fails(cmd: &mut Command) -> String {
     let out = cmd.output().expect("spawn testbed");

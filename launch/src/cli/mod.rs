@@ -173,6 +173,24 @@ pub(crate) const EXIT_DEGRADED: u8 = 3;
 /// Exit status of `run` when the run's verdict is `invalid`.
 pub(crate) const EXIT_INVALID: u8 = 4;
 
+/// The exit status of a verdict (`run`'s and `replay`'s alike), said on
+/// stderr when it is not clean: one meaning per status, so that scripts
+/// can tell a trustworthy result from one that is not (docs: running).
+/// `what` is "run" or "log".
+pub(crate) fn verdict_status(verdict: analysis::timing::Verdict, what: &str) -> ExitCode {
+    use analysis::timing::Verdict;
+    let code = match verdict {
+        Verdict::Clean => return ExitCode::SUCCESS,
+        Verdict::Degraded => EXIT_DEGRADED,
+        Verdict::Invalid => EXIT_INVALID,
+    };
+    eprintln!(
+        "testbed: the {what}'s timing verdict is {} (exit status {code})",
+        verdict.as_str()
+    );
+    ExitCode::from(code)
+}
+
 /// Parses the command line and runs it.
 pub fn run() -> Result<ExitCode> {
     let cli = Cli::parse();

@@ -40,8 +40,12 @@ pub(crate) fn replay(args: ReplayArgs) -> Result<ExitCode> {
     // Re-driving nothing proves nothing: a difference of 0 over 0 steps
     // is not a verification.
     if matches!(analysis.verify, Some((_, 0))) {
+        let why = match analysis.timing.reasons.as_slice() {
+            [] => String::new(),
+            reasons => format!("; the log is invalid: {}", reasons.join("; ")),
+        };
         anyhow::bail!(
-            "{}: --verify found no step to re-drive (the log holds no complete step)",
+            "{}: --verify found no step to re-drive (the log holds no complete step){why}",
             args.log.display()
         );
     }
@@ -50,6 +54,8 @@ pub(crate) fn replay(args: ReplayArgs) -> Result<ExitCode> {
             .with_context(|| format!("writing figures to {}", dir.display()))?;
         eprintln!("testbed: wrote {} figures to {}", written, dir.display());
     }
+    let verdict = analysis.timing.verdict;
     print_report(&Report::from_log(analysis), args.json)?;
-    Ok(ExitCode::SUCCESS)
+    // As `run` exits: a script must not take an invalid log's figures.
+    Ok(super::verdict_status(verdict, "log"))
 }

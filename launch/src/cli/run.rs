@@ -3,12 +3,11 @@
 use std::io::IsTerminal;
 use std::process::ExitCode;
 
-use analysis::timing::Verdict;
 use anyhow::{Context, Result};
 use launcher::run::{self, RunError, RunOptions};
 
 use super::args::RunArgs;
-use super::{EXIT_DEGRADED, EXIT_INTERRUPTED, EXIT_INVALID, load, print_report};
+use super::{EXIT_INTERRUPTED, load, print_report};
 use analysis::report::Report;
 
 pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
@@ -52,19 +51,5 @@ pub(crate) fn run_stack(args: RunArgs, verbose: bool) -> Result<ExitCode> {
     let mut report = Report::from_log(outcome.analysis);
     report.run_dir = Some(outcome.run_dir.display().to_string());
     print_report(&report, args.common.json)?;
-    // One meaning per status, so that scripts can tell a trustworthy
-    // result from one that timing changed (docs: running).
-    Ok(match verdict {
-        Verdict::Clean => ExitCode::SUCCESS,
-        Verdict::Degraded => {
-            eprintln!(
-                "testbed: the run's timing verdict is degraded (exit status {EXIT_DEGRADED})"
-            );
-            ExitCode::from(EXIT_DEGRADED)
-        }
-        Verdict::Invalid => {
-            eprintln!("testbed: the run's timing verdict is invalid (exit status {EXIT_INVALID})");
-            ExitCode::from(EXIT_INVALID)
-        }
-    })
+    Ok(super::verdict_status(verdict, "run"))
 }

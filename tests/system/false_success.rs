@@ -1,0 +1,185 @@
+//! Issue 48, "false success, wrong results, leaks": a log that is not the
+//! whole run, or that cannot be checked, is never `clean`, and `replay`
+//! exits as `run` does for its verdict.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use mcap::records::Record;
+
+use crate::util::{lockstep_log, testbed};
+
+/// Copies the MCAP log `from` to `to` record by record with `mcap`'s own
+/// writer, as a tool that edits logs does: only the messages of topics
+/// `keep` accepts, the logger's counts of the others left out too when
+/// `drop_counts`, every `thin`-th message of topic `thin.0` dropped, and
+/// the data section's checksum computed only when `data_crc`.
+fn rewrite(
+    from: &Path,
+    to: &Path,
+    keep: &dyn Fn(&str) -> bool,
+    drop_counts: bool,
+    thin: Option<(&str, u32)>,
+    data_crc: bool,
+) {
+    let bytes = std::fs::read(from).unwrap();
+    let mut w = mcap::WriteOptions::new()
+        .profile("ros2")
+        .calculate_data_section_crc(data_crc)
+        .create(std::io::BufWriter::new(std::fs::File::create(to).unwrap()))
+        .unwrap();
+    let (mut schemas, mut channels) = (BTreeMap::new(), BTreeMap::new());
+    let mut seen = 0u32;
+    for record in mcap::read::ChunkFlattener::new(&bytes).unwrap() {
+        match record.unwrap() {
+            Record::Schema { header, data } => {
+                let id = w.add_schema(&header.name, &header.encoding, &data).unwrap();
+                schemas.insert(header.id, id);
+            }
+            Record::Channel(c) if keep(&c.topic) => {
+                let id = w
+                    .add_channel(
+                        schemas[&c.schema_id],
+                        &c.topic,
+                        &c.message_encoding,
+                        &c.metadata,
+                    )
+                    .unwrap();
+                channels.insert(c.id, (id, c.topic));
+            }
+            Record::Message { mut header, data } => {
+                let Some((id, topic)) = channels.get(&header.channel_id) else {
+                    continue;
+                };
+                if let Some((t, every)) = thin
+                    && t == topic
+                {
+                    seen += 1;
+                    if seen.is_multiple_of(every) {
+                        continue;
+                    }
+                }
+                header.channel_id = *id;
+                w.write_to_known_channel(&header, &data).unwrap();
+            }
+            Record::Metadata(mut m) => {
+                if drop_counts && m.name == "testbed.log_stats" {
+                    m.metadata.retain(|k, _| {
+                        let name = k.rsplit_once('.').map_or(k.as_str(), |(n, _)| n);
+                        keep(&format!("/{name}"))
+                    });
+                }
+                w.write_metadata(&m).unwrap();
+            }
+            Record::Attachment { header, data, .. } => w
+                .attach(&mcap::Attachment {
+                    log_time: header.log_time,
+                    create_time: header.create_time,
+                    name: header.name,
+                    media_type: header.media_type,
+                    data,
+                })
+                .unwrap(),
+            _ => {}
+        }
+    }
+    w.finish().unwrap();
+}
+
+/// `replay ARGS LOG`: its exit code, its JSON summary (if it printed
+/// one) and its stderr.
+fn replay(args: &[&str], log: &Path) -> (Option<i32>, Option<serde_json::Value>, String) {
+    let out = testbed()
+        .arg("replay")
+        .args(args)
+        .arg(log)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!err.contains("panicked"), "{err}");
+    (
+        out.status.code(),
+        serde_json::from_slice(&out.stdout).ok(),
+        err,
+    )
+}
+
+/// Item 1 (D2): a log rewritten without /timing, without /command, or
+/// with only the states and diagnostics (so its rows are all complete)
+/// replays `invalid` with exit 4, naming the topics, with and without
+/// `--verify`; so does a log holding fewer messages than the logger
+/// received. The rewrite itself, keeping everything, stays clean.
+#[test]
+fn a_log_without_whole_topics_replays_invalid() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = lockstep_log(dir.path());
+    let copy = dir.path().join("copy.mcap");
+    rewrite(&log, &copy, &|_| true, true, None, true);
+    let (code, s, err) = replay(&["--json", "--verify"], &copy);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(s.unwrap()["timing"]["verdict"], "clean");
+
+    let only_rows = ["/joint_state", "/controller/diagnostics"];
+    // What the rewrite keeps, and the topics then missing.
+    type Case<'a> = (&'a dyn Fn(&str) -> bool, &'a [&'a str]);
+    let cases: [Case<'_>; 3] = [
+        (&|t| t != "/timing", &["/timing"]),
+        (&|t| t != "/command", &["/command"]),
+        (
+            &|t| only_rows.contains(&t),
+            &["/reference", "/command", "/timing"],
+        ),
+    ];
+    for (keep, missing) in cases {
+        let cut = dir.path().join("cut.mcap");
+        rewrite(&log, &cut, keep, true, None, true);
+        for args in [&["--json"][..], &["--json", "--verify"]] {
+            let (code, s, err) = replay(args, &cut);
+            assert_ne!(code, Some(0), "{missing:?} {args:?}: {err}");
+            let said = match s {
+                Some(s) => {
+                    assert_eq!(s["timing"]["verdict"], "invalid", "{s}");
+                    assert_eq!(code, Some(4), "{err}");
+                    s["timing"]["reasons"].to_string()
+                }
+                // --verify without /command has nothing to re-drive.
+                None => err,
+            };
+            assert!(said.contains("the log is not the whole run"), "{said}");
+            for topic in missing {
+                assert!(said.contains(topic), "{topic} not named: {said}");
+            }
+        }
+    }
+    // Every 7th /timing message gone, the logger's counts kept.
+    let thin = dir.path().join("thin.mcap");
+    rewrite(&log, &thin, &|_| true, false, Some(("/timing", 7)), true);
+    let (code, s, err) = replay(&["--json"], &thin);
+    assert_eq!(code, Some(4), "{err}");
+    let reasons = s.unwrap()["timing"]["reasons"].to_string();
+    assert!(
+        reasons.contains("/timing messages where the logger received 300"),
+        "{reasons}"
+    );
+}
+
+/// Item 1: a data section whose checksum is 0 (MCAP's "not computed", as
+/// Python's mcap writer leaves it) does not turn the integrity check off:
+/// the log is said to be one that cannot be checked, never clean.
+#[test]
+fn a_log_without_a_data_checksum_cannot_be_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = lockstep_log(dir.path());
+    let copy = dir.path().join("no-crc.mcap");
+    rewrite(&log, &copy, &|_| true, false, None, false);
+    let (code, s, err) = replay(&["--json"], &copy);
+    assert_eq!(code, Some(4), "{err}");
+    let s = s.unwrap();
+    assert_eq!(s["timing"]["verdict"], "invalid", "{s}");
+    let reasons = s["timing"]["reasons"].to_string();
+    assert!(
+        reasons.contains("the log cannot be checked") && reasons.contains("checksum is 0"),
+        "{reasons}"
+    );
+    assert!(err.contains("verdict is invalid (exit status 4)"), "{err}");
+}
