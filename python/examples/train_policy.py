@@ -34,7 +34,14 @@ def main():
               "base_law": None if a.base_law == "none" else a.base_law}
     env = gymnasium.make(testbed.ENV_ID, **kwargs)
     core = env.unwrapped.core
-    policy = LinearPolicy.zeros(core.dof, core.obs_dim, {**kwargs, **env_record(env)})
+    record = {**kwargs, **env_record(env)}
+    if a.scenario not in testbed.SCENARIOS:
+        # A policy file names only shipped scenarios: one of your own goes
+        # in with it (it must name no file: pass the robot as --robot).
+        with open(a.scenario, encoding="utf-8") as f:
+            record["scenario_toml"] = f.read()
+        del record["scenario"]
+    policy = LinearPolicy.zeros(core.dof, core.obs_dim, record)
     print(f"return of the zero policy: {episode_return(env, policy, a.seed):.2f}")
     policy = random_search(env, policy, iterations=a.iterations, directions=a.directions,
                            top=max(1, a.directions // 2), episode_seed=a.seed,

@@ -11,6 +11,18 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from ._native import SCENARIOS
+
+try:  # Python 3.11 and later: an embedded scenario is checked before use.
+    import tomllib
+except ImportError:  # pragma: no cover
+    tomllib = None
+
+#: Longest value of a policy file quoted in a refusal.
+QUOTE_CHARS = 80
+#: Largest embedded scenario (env.scenario_toml), bytes.
+MAX_SCENARIO_TOML = 1 << 20
+
 
 @dataclass
 class LinearPolicy:
@@ -80,7 +92,73 @@ class LinearPolicy:
                 raise ValueError(f"{where}: {name} has dtype {x.dtype}, not real numbers")
             if not np.all(np.isfinite(x)):
                 raise ValueError(f"{where}: {name} has a value that is not finite")
+        check_scenario(env, where)
         self.weights, self.bias = w.astype(np.float64), b.astype(np.float64)
+
+
+def quote(value) -> str:
+    """A value of a policy file as a refusal shows it: repr, cut short."""
+    text = repr(value)
+    return text if len(text) <= QUOTE_CHARS else text[:QUOTE_CHARS] + "…"
+
+
+def _names_a_file(key: str) -> bool:
+    """A scenario key (dotted) whose value is a path: `robot`, a trajectory `file`."""
+    return key == "robot" or key.rsplit(".", 1)[-1] == "file"
+
+
+def _file_keys(table: dict, prefix: str = ""):
+    for k, v in table.items():
+        key = f"{prefix}{k}"
+        if _names_a_file(key):
+            yield key
+        if isinstance(v, dict):
+            yield from _file_keys(v, key + ".")
+
+
+def check_scenario(env: dict, where: str) -> None:
+    """Refuses a policy whose scenario the testbed would have to read from
+    a file the policy names (issue 48, N2: env.scenario = "/etc/passwd" put
+    that file's first line into stderr, the controller's log and `compare
+    --json`). A policy names a shipped scenario (`testbed.SCENARIOS`) or
+    embeds its own (env.scenario_toml) holding no path; env.robot must be
+    a `.urdf` file, whose errors are never quoted (see policy_node)."""
+    scenario, text = env.get("scenario"), env.get("scenario_toml")
+    if scenario is not None and text is not None:
+        raise ValueError(f"{where}: env.scenario and env.scenario_toml are both set; a policy has one scenario")
+    if scenario is not None and (not isinstance(scenario, str) or scenario not in SCENARIOS):
+        raise ValueError(f"{where}: env.scenario = {quote(scenario)} is not a shipped scenario "
+                         f"({', '.join(SCENARIOS)}); a policy names one of those or embeds its own "
+                         "as env.scenario_toml, and no other file is read")
+    if text is not None:
+        if not isinstance(text, str) or len(text.encode("utf-8", "replace")) > MAX_SCENARIO_TOML:
+            raise ValueError(f"{where}: env.scenario_toml must be the scenario's TOML text, "
+                             f"at most {MAX_SCENARIO_TOML} bytes")
+        if tomllib is None:
+            raise ValueError(f"{where}: env.scenario_toml needs Python 3.11 or later to be checked")
+        try:
+            table = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as e:
+            raise ValueError(f"{where}: env.scenario_toml is not TOML: {e}") from None
+        for key in _file_keys(table):
+            raise ValueError(f"{where}: env.scenario_toml sets {key}, which names a file; an embedded "
+                             "scenario holds its data (a trajectory as samples, the robot as env.robot)")
+    robot = env.get("robot")
+    if robot is not None and not (isinstance(robot, str) and robot.endswith(".urdf")
+                                  and len(robot) <= 4096):
+        raise ValueError(f"{where}: env.robot = {quote(robot)} is not a path to a .urdf file")
+    overrides = env.get("set")
+    if overrides is None:
+        return
+    if isinstance(overrides, str):
+        overrides = [overrides]
+    if not isinstance(overrides, (list, tuple)) or not all(isinstance(o, str) for o in overrides):
+        raise ValueError(f"{where}: env.set must be a list of \"key=value\" texts")
+    for o in overrides:
+        key = o.split("=", 1)[0].strip()
+        if _names_a_file(key):
+            raise ValueError(f"{where}: env.set sets {quote(key)}, which names a file; a policy file "
+                             "names no file but env.robot")
 
 
 def env_record(env) -> dict:
@@ -89,9 +167,14 @@ def env_record(env) -> dict:
     periods per decision, the torque and velocity scales, whether the
     observation is scaled)."""
     core = env.unwrapped.core
-    return {"dof": core.dof, "obs_dim": core.obs_dim, "steps": core.steps,
-            "torque_scale": core.torque_scale.tolist(), "decimation": core.decimation,
-            "scale_obs": core.scale_obs, "velocity_scale": core.velocity_scale.tolist()}
+    record = {"dof": core.dof, "obs_dim": core.obs_dim, "steps": core.steps,
+              "torque_scale": core.torque_scale.tolist(), "decimation": core.decimation,
+              "scale_obs": core.scale_obs, "velocity_scale": core.velocity_scale.tolist(),
+              # What `policy_node` checks against the run it is put in.
+              "period_ns": round(core.plant_dt * 1e9)}
+    if tomllib is not None:
+        record["controller"] = tomllib.loads(core.scenario_toml).get("controller", {})
+    return record
 
 
 def episode_return(env, policy: LinearPolicy, seed: int) -> float:

@@ -15,13 +15,37 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
+from pathlib import Path
 
 import numpy as np
 
 import testbed_controller as tc
 
-from ._native import LAWS, Law
-from .policy import LinearPolicy
+from ._native import LAWS, Law, TestbedError
+from .policy import LinearPolicy, quote
+
+#: Settings of the run's `[controller]` table a policy is refused on when
+#: they differ from its training scenario's: the prescribed time and the
+#: gains shape the torque it learnt a residual on and the error it saw.
+#: The others (and `law`, the run's own) are warned about.
+ESSENTIAL = ("tc", "k1", "k2")
+
+
+def _as_joints(value, n: int):
+    """A per-joint setting (a number, or one per joint) as n floats; None
+    when it is neither."""
+    try:
+        return np.broadcast_to(np.asarray(value, dtype=np.float64), (n,))
+    except (TypeError, ValueError):
+        return None
+
+
+def _differs(a, b, n: int) -> bool:
+    x, y = _as_joints(a, n), _as_joints(b, n)
+    if x is None or y is None:
+        return a != b
+    return not np.array_equal(x, y)
 
 
 class PolicyController(tc.Controller):
@@ -49,11 +73,66 @@ class PolicyController(tc.Controller):
         if run.dof != self.n:
             raise ValueError(f"the policy is for {self.n} joints; this run's arm has {run.dof}")
         if self.base_law:
-            env = self.policy.env
-            self.law = Law(self.base_law, scenario=env.get("scenario"), robot=env.get("robot"),
-                           set=env.get("set"))
+            self.law = self._base_law()
+        self._check_run(run)
+
+    def _base_law(self) -> Law:
+        """The built-in law the policy's residual is added to, from the
+        policy's own scenario (a shipped one, or the one it embeds)."""
+        env = self.policy.env
+        robot = env.get("robot")
+        with tempfile.TemporaryDirectory(prefix="testbed-policy-") as tmp:
+            scenario = env.get("scenario")
+            if env.get("scenario_toml") is not None:
+                scenario = Path(tmp) / "policy-scenario.toml"
+                scenario.write_text(env["scenario_toml"], encoding="utf-8")
+            try:
+                return Law(self.base_law, scenario=scenario, robot=robot, set=env.get("set"))
+            except TestbedError:
+                if robot is None:
+                    raise
+                # A file the policy names is never quoted (issue 48, N2).
+                raise ValueError(f"env.robot = {quote(robot)}: the base law cannot be built on it "
+                                 "(a file a policy names is not quoted; testbed.Robot(path) "
+                                 "says why)") from None
+
+    def _check_run(self, run: tc.RunInfo) -> None:
+        """Refuses a run whose period or essential controller settings are
+        not the policy's training scenario's (issue 48, N8: a policy trained
+        with k1 = 1 ran as a row on the paper's scenario without a word);
+        says on stderr which other settings differ."""
+        env, notes = self.policy.env, []
+        period = env.get("period_ns")
+        if period is None:
+            notes.append("the policy does not record its period (env.period_ns): not checked")
+        elif period != run.period_ns:
+            raise ValueError(f"the policy was trained at a control period of {quote(period)} ns "
+                             f"(env.period_ns); this run's is {run.period_ns} ns")
+        trained = env.get("controller")
+        if not isinstance(trained, dict):
+            trained = dict(self.law.params) if self.law is not None else None
+        if trained is None:
+            notes.append("the policy does not record its scenario's [controller] (env.controller): "
+                         "not checked")
+        else:
+            for key in ESSENTIAL:
+                if key in trained and key in run.params and _differs(trained[key], run.params[key], self.n):
+                    raise ValueError(f"the policy was trained with controller.{key} = {quote(trained[key])}; "
+                                     f"this run's controller.{key} is {quote(run.params[key])}")
+            other = [k for k in sorted(set(trained) & set(run.params))
+                     if k not in ESSENTIAL and k != "law" and _differs(trained[k], run.params[k], self.n)]
+            if other:
+                notes.append("this run's " + ", ".join(
+                    f"controller.{k} = {quote(run.params[k])} (trained: {quote(trained[k])})" for k in other))
+        for note in notes:
+            print(f"testbed.policy_node: warning: {note}", file=sys.stderr, flush=True)
 
     def step(self, state: tc.State, ref: tc.Reference) -> np.ndarray:
+        if state.seq == self.steps:
+            # Past its episode the time feature exceeds 1: never seen in training.
+            print(f"testbed.policy_node: warning: the run has passed the policy's episode of "
+                  f"{self.steps} steps (env.steps); it acts on times it never saw",
+                  file=sys.stderr, flush=True)
         if state.seq % self.decimation == 0:
             n, o = self.n, self.obs
             o[0:n] = state.q - ref.q_d
