@@ -17,6 +17,7 @@ fn paper_compare(c: &mut Criterion) {
     group.sample_size(10);
     for threads in [cores, 1] {
         let opts = CompareOptions {
+            law_sets: Vec::new(),
             external: Vec::new(),
             runs_dir: std::path::PathBuf::from("runs"),
             progress: false,
@@ -43,6 +44,7 @@ fn randomised_compare(c: &mut Criterion) {
     };
     let plan = scenario::load(Some(&path), &overrides).unwrap();
     let opts = CompareOptions {
+        law_sets: Vec::new(),
         external: Vec::new(),
         runs_dir: std::path::PathBuf::from("runs"),
         progress: false,

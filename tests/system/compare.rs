@@ -620,3 +620,60 @@ fn what_the_seeds_cannot_say_is_not_said() {
     );
     assert!(!short.contains("[does not hold]"), "{short}");
 }
+
+/// #50 item 5: a baseline's own key, set per law, changes that law's runs
+/// only; a key the law does not take, or a bad value, is refused by name.
+#[test]
+fn a_law_set_reaches_its_law_only() {
+    let run = |extra: &[&str]| {
+        let mut cmd = testbed();
+        cmd.args([
+            "compare",
+            "--laws",
+            "nac,mpc",
+            "--duration",
+            "2.5",
+            "--json",
+        ]);
+        cmd.args(extra);
+        json(&ok(&mut cmd))
+    };
+    let median = |c: &serde_json::Value, law: &str| {
+        c["laws"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|l| l["name"] == law)
+            .unwrap()["median"]["iae"]
+            .as_f64()
+            .unwrap()
+    };
+    let plain = run(&[]);
+    let set = run(&["--law-set", "mpc:controller.mpc_step=0.05"]);
+    assert_eq!(
+        median(&plain, "nac").to_bits(),
+        median(&set, "nac").to_bits()
+    );
+    assert_ne!(
+        median(&plain, "mpc").to_bits(),
+        median(&set, "mpc").to_bits()
+    );
+    let err = fails(testbed().args([
+        "compare",
+        "--laws",
+        "nac,mpc",
+        "--law-set",
+        "mpc:controller.beta=2",
+    ]));
+    assert!(err.contains("mpc does not take controller.beta"), "{err}");
+    let err = fails(testbed().args([
+        "compare",
+        "--laws",
+        "nac,mpc",
+        "--duration",
+        "1",
+        "--law-set",
+        "mpc:controller.mpc_step=-1",
+    ]));
+    assert!(err.contains("controller.mpc_step = -1 is invalid"), "{err}");
+}

@@ -25,7 +25,7 @@ pub(crate) fn external_row(
     let mut runs = Vec::new();
     let mut declared = None;
     for s in 0..opts.seeds {
-        let p = plan_for(plan, law, s, opts.tuning)?;
+        let p = plan_for(plan, law, s, opts.tuning, &opts.law_sets)?;
         let seed = p.scenario.seed;
         let run = launcher::run::run(launcher::run::RunOptions {
             plan: p,

@@ -146,8 +146,10 @@ struct Tested {
     /// Which way the data lean: `nac` better on more seeds, or the other.
     nac_ahead: bool,
     other_ahead: bool,
-    /// The effect is large enough to count (always true for kept/left).
+    /// The effect is large enough to count (always true for kept/left):
+    /// in `nac`'s favour, and against it.
     matters: bool,
+    matters_against: bool,
 }
 
 /// Holm-corrects every test of the findings together, then gives each its
@@ -176,10 +178,12 @@ fn decide(drafts: Vec<Draft>) -> Vec<Finding> {
 
 fn verdict_of(t: Tested, p_holm: f64, family: usize) -> Finding {
     let significant = p_holm < ALPHA;
-    let (verdict, why) = match (significant, t.nac_ahead, t.other_ahead, t.matters) {
-        (true, true, _, true) => (Verdict::Holds, ""),
-        (true, _, true, _) => (Verdict::DoesNotHold, ": significant the other way"),
-        (true, true, _, false) => (
+    let (verdict, why) = match (significant, t.nac_ahead, t.other_ahead) {
+        (true, true, _) if t.matters => (Verdict::Holds, ""),
+        (true, _, true) if t.matters_against => {
+            (Verdict::DoesNotHold, ": significant the other way")
+        }
+        (true, _, _) => (
             Verdict::NotShown,
             ": significant, but the paired effect is under the 1 % that counts",
         ),
@@ -378,6 +382,7 @@ fn separates(c: &Comparison, nac: &LawRow, other: LawName, claim: &str, runs: us
         nac_ahead: a_only > b_only,
         other_ahead: b_only > a_only,
         matters: true,
+        matters_against: true,
     })
 }
 
@@ -450,6 +455,7 @@ fn better(
         nac_ahead: test.a_smaller > test.b_smaller,
         other_ahead: test.b_smaller > test.a_smaller,
         matters: rel <= -MATTERS,
+        matters_against: rel >= MATTERS,
     })
 }
 
@@ -561,6 +567,7 @@ mod tests {
         )
         .unwrap();
         let opts = CompareOptions {
+            law_sets: Vec::new(),
             external: Vec::new(),
             runs_dir: std::path::PathBuf::from("runs"),
             progress: false,
@@ -608,6 +615,7 @@ mod tests {
             nac_ahead,
             other_ahead,
             matters,
+            matters_against: matters,
         })
     }
 

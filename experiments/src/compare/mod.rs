@@ -34,7 +34,7 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
     let mut jobs = Vec::new();
     for &law in &opts.laws {
         for s in 0..opts.seeds {
-            jobs.push((law, s, plan_for(plan, law, s, opts.tuning)?));
+            jobs.push((law, s, plan_for(plan, law, s, opts.tuning, &opts.law_sets)?));
         }
     }
     let threads = opts
@@ -128,6 +128,7 @@ mod tests {
     fn no_law_is_an_error() {
         let plan = scenario::load(None, &scenario::Overrides::default()).unwrap();
         let opts = CompareOptions {
+            law_sets: Vec::new(),
             external: Vec::new(),
             runs_dir: std::path::PathBuf::from("runs"),
             progress: false,

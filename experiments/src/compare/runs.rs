@@ -7,8 +7,8 @@ use launcher::sim::{self, StepCosts};
 use scenario::Plan;
 
 use crate::compare::scores::scored;
-use crate::compare::types::{CompareError, LawRun, LawSeries};
-use controller::{LawName, Tuning};
+use crate::compare::types::{CompareError, LawRun, LawSeries, LawSet};
+use controller::{ControllerParams, LawName, Tuning};
 
 /// The plan of `testbed sim --law <law>` with seed `plan.seed + s`: the
 /// scenario before its draws, for `law`, with that seed's `[randomise]`
@@ -18,9 +18,13 @@ pub fn plan_for(
     law: LawName,
     s: u64,
     tuning: Option<Tuning>,
+    law_sets: &[LawSet],
 ) -> Result<Plan, CompareError> {
     let mut scenario = plan.undrawn.clone();
     scenario.controller = scenario.controller.for_law(law);
+    for set in law_sets.iter().filter(|x| x.law == law) {
+        scenario.controller = with_key(&scenario.controller, set)?;
+    }
     if let Some(t) = tuning.filter(|_| law.takes("tuning")) {
         scenario.controller.tuning = t;
     }
@@ -35,6 +39,19 @@ pub fn plan_for(
         plan.robot.clone(),
     )
     .map_err(fail)
+}
+
+/// `params` with one of its keys set as the scenario file would set it.
+fn with_key(params: &ControllerParams, set: &LawSet) -> Result<ControllerParams, CompareError> {
+    let fail = |cause| CompareError::LawSet {
+        law: set.law,
+        key: set.key.clone(),
+        cause,
+    };
+    let mut table =
+        toml::Table::try_from(params).map_err(|e| fail(serde::de::Error::custom(e.to_string())))?;
+    table.insert(set.key.clone(), set.value.clone());
+    table.try_into().map_err(fail)
 }
 
 /// What a seed changes in `plan` besides nothing: its `[randomise]` table

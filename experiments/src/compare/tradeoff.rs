@@ -201,6 +201,7 @@ mod tests {
         assert_eq!(s.undrawn.controller.k1, Gain::All(30.0));
         assert_eq!(s.scenario.controller.k2, Gain::All(30.0));
         let opts = CompareOptions {
+            law_sets: Vec::new(),
             external: Vec::new(),
             runs_dir: std::path::PathBuf::from("runs"),
             progress: false,

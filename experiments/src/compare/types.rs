@@ -55,6 +55,16 @@ pub enum CompareError {
     /// Nothing to run.
     #[error("{0}")]
     Empty(&'static str),
+    /// A `--law-set` that the law's parameters cannot take.
+    #[error("--law-set {law}:controller.{key}: {}", cause.message())]
+    LawSet {
+        /// The law.
+        law: LawName,
+        /// The key.
+        key: String,
+        /// Why the parameters do not read with it.
+        cause: toml::de::Error,
+    },
 }
 
 /// What to run.
@@ -77,6 +87,20 @@ pub struct CompareOptions {
     pub runs_dir: std::path::PathBuf,
     /// Show a progress bar on standard error (a terminal).
     pub progress: bool,
+    /// One law's own keys (`--law-set mpc:controller.mpc_step=0.02`), set
+    /// on that law's parameters only, after the scenario's.
+    pub law_sets: Vec<LawSet>,
+}
+
+/// A controller key set for one law of a comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LawSet {
+    /// The law whose runs get it.
+    pub law: LawName,
+    /// The key under `[controller]` (without the `controller.` prefix).
+    pub key: String,
+    /// Its value, checked like the scenario file.
+    pub value: toml::Value,
 }
 
 /// The first seed's curves of one law, for the overlay figures.

@@ -301,12 +301,41 @@ pub(crate) struct CompareArgs {
     /// scales and report IAE after T_c against effort (a Pareto front per law).
     #[arg(long, value_name = "S,…", value_delimiter = ',')]
     pub(crate) gain_scales: Vec<f64>,
+    /// One law's own key (repeatable), e.g. `--law-set
+    /// mpc:controller.mpc_step=0.02`: set on that law's runs only, so a
+    /// baseline's own keys need no change of the scenario's law.
+    #[arg(long = "law-set", value_name = "LAW:controller.KEY=VALUE", value_parser = parse_law_set)]
+    pub(crate) law_set: Vec<experiments::compare::LawSet>,
     /// Print, after the table, which of the paper's claims hold on this
     /// scenario and the numbers they rest on (the JSON always has them).
     /// Without --tuning, the laws then run under matched tuning: a claim
     /// that one law beats another is made on a fair fight.
     #[arg(long)]
     pub(crate) findings: bool,
+}
+
+/// `--law-set LAW:controller.KEY=VALUE`: the law by name, a key it takes,
+/// a TOML value.
+fn parse_law_set(arg: &str) -> Result<experiments::compare::LawSet, String> {
+    let Some((law, set)) = arg.split_once(':') else {
+        return Err(format!("{arg:?} is not LAW:controller.KEY=VALUE"));
+    };
+    let law: controller::LawName = law.trim().parse()?;
+    let (key, value) = scenario::parse_set(set).map_err(|e| e.to_string())?;
+    let Some(key) = key.strip_prefix("controller.") else {
+        return Err(format!("{key}: only controller keys are set per law"));
+    };
+    if !law.takes(key) {
+        return Err(format!(
+            "{law} does not take controller.{key} (it takes {})",
+            law.keys().join(", ")
+        ));
+    }
+    Ok(experiments::compare::LawSet {
+        law,
+        key: key.to_string(),
+        value,
+    })
 }
 
 /// `--law` and `--laws`: the names come from the law table, and `--help`

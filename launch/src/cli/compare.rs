@@ -81,6 +81,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
         seeds: args.seeds,
         threads: super::worker_threads(args.threads),
         series: args.plots.is_some(),
+        law_sets: args.law_set.clone(),
         tuning: match args.tuning.as_deref() {
             Some("matched") => Some(controller::Tuning::Matched),
             Some("as-given") => Some(controller::Tuning::AsGiven),
