@@ -183,3 +183,79 @@ fn a_log_without_a_data_checksum_cannot_be_checked() {
     );
     assert!(err.contains("verdict is invalid (exit status 4)"), "{err}");
 }
+
+/// Item 16 (D19): a `--runs-dir` that is a file (`/dev/null`, a regular
+/// file) is named as not a folder, not "File exists".
+#[test]
+fn a_runs_dir_that_is_a_file_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("runs");
+    std::fs::write(&file, "a file").unwrap();
+    for runs in [Path::new("/dev/null"), &file] {
+        let e = crate::util::fails(
+            testbed()
+                .args([
+                    "run",
+                    "--mode",
+                    "lockstep",
+                    "--duration",
+                    "0.1",
+                    "--runs-dir",
+                ])
+                .arg(runs),
+        );
+        assert!(
+            e.contains(&runs.display().to_string())
+                && e.contains("not a folder")
+                && !e.contains("File exists"),
+            "{e}"
+        );
+    }
+}
+
+/// Item 16 (N14): `robot --write-scenario` never replaces an existing file
+/// without `--force`, and never writes through a symbolic link, even with it.
+#[test]
+fn write_scenario_keeps_what_exists_and_follows_no_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = crate::util::repo_root().join("robots/two_link.urdf");
+    let write = |out: &Path, force: bool| {
+        let mut cmd = testbed();
+        cmd.arg("robot").arg(&urdf).arg("--write-scenario").arg(out);
+        if force {
+            cmd.arg("--force");
+        }
+        cmd
+    };
+    let mine = dir.path().join("s.toml");
+    std::fs::write(&mine, "# my edits\n").unwrap();
+    let e = crate::util::fails(&mut write(&mine, false));
+    assert!(e.contains("exists; --force replaces it"), "{e}");
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "# my edits\n");
+    crate::util::ok(&mut write(&mine, true));
+    let text = std::fs::read_to_string(&mine).unwrap();
+    assert!(text.starts_with("# The default scenario"), "{text}");
+
+    let victim = dir.path().join("victim.txt");
+    std::fs::write(&victim, "victim\n").unwrap();
+    let link = dir.path().join("link.toml");
+    std::os::unix::fs::symlink(&victim, &link).unwrap();
+    let dangling = dir.path().join("dangling.toml");
+    let nowhere = dir.path().join("nowhere.toml");
+    std::os::unix::fs::symlink(&nowhere, &dangling).unwrap();
+    for (out, force) in [
+        (&link, false),
+        (&link, true),
+        (&dangling, false),
+        (&dangling, true),
+    ] {
+        let e = crate::util::fails(&mut write(out, force));
+        assert!(e.contains("symbolic link"), "{e}");
+    }
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "victim\n");
+    assert!(!nowhere.exists());
+    // A new file is written as before.
+    let fresh = dir.path().join("fresh.toml");
+    crate::util::ok(&mut write(&fresh, false));
+    assert!(fresh.is_file());
+}

@@ -70,6 +70,10 @@ enum Command {
         /// with `testbed sim --scenario FILE` (its `robot` key names the URDF).
         #[arg(long, value_name = "FILE")]
         write_scenario: Option<PathBuf>,
+        /// Replace FILE of --write-scenario if it exists (a symbolic link
+        /// is never written through).
+        #[arg(long, requires = "write_scenario")]
+        force: bool,
     },
     /// Measure speed and timing on this machine: in process, lockstep, real
     /// time, and the machine's own timer floor.
@@ -232,9 +236,10 @@ pub fn run() -> Result<ExitCode> {
         Command::Robot {
             path,
             write_scenario,
+            force,
         } => {
             if let Some(out) = &write_scenario {
-                robot::write_scenario(&path, out)?;
+                robot::write_scenario(&path, out, force)?;
             }
             write_stdout(&robot::describe(&path)?)?;
             if let Some(out) = &write_scenario {

@@ -49,8 +49,25 @@ pub fn describe(path: &Path) -> Result<String> {
 
 /// Writes the default scenario for the arm at `path` to `out` as TOML,
 /// naming the URDF by its absolute path so the file runs from anywhere.
-pub fn write_scenario(path: &Path, out: &Path) -> Result<()> {
+pub fn write_scenario(path: &Path, out: &Path, force: bool) -> Result<()> {
     super::outputs::refuse_input("--write-scenario", out, &[path.to_path_buf()])?;
+    // An edited scenario is work: never lost to a second call, and a link
+    // planted at FILE never redirects the write elsewhere (#48 item 16).
+    match std::fs::symlink_metadata(out) {
+        Ok(m) if m.file_type().is_symlink() => anyhow::bail!(
+            "--write-scenario {}: a symbolic link; not written through it (name the file itself)",
+            out.display()
+        ),
+        Ok(m) if !m.is_file() => anyhow::bail!(
+            "--write-scenario {}: exists and is not a regular file",
+            out.display()
+        ),
+        Ok(_) if !force => anyhow::bail!(
+            "--write-scenario {}: exists; --force replaces it",
+            out.display()
+        ),
+        _ => {}
+    }
     let robot = RobotSource::from_file(path, &Locks::new())?;
     let mut s = scenario::Scenario::for_arm(&robot.urdf).map_err(|cause| {
         scenario::ScenarioError::Plant {
@@ -67,7 +84,34 @@ pub fn write_scenario(path: &Path, out: &Path) -> Result<()> {
         path.display(),
         out.display()
     );
-    std::fs::write(out, header + &text).with_context(|| format!("writing {}", out.display()))
+    write_new(out, (header + &text).as_bytes(), force)
+        .with_context(|| format!("writing {}", out.display()))
+}
+
+/// Writes `text` to `out`: a file made afresh (`create_new`, which never
+/// follows a link), or with `force` a fresh file beside it renamed over it
+/// (the rename replaces a link planted since the check, not its target).
+fn write_new(out: &Path, text: &[u8], force: bool) -> std::io::Result<()> {
+    use std::io::Write as _;
+    let fresh = |p: &Path| {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(p)
+    };
+    if !force {
+        return fresh(out)?.write_all(text);
+    }
+    let mut name = out.file_name().unwrap_or_default().to_os_string();
+    name.push(format!(".testbed-{}.tmp", std::process::id()));
+    let tmp = out.with_file_name(name);
+    let written = fresh(&tmp)
+        .and_then(|mut f| f.write_all(text))
+        .and_then(|()| std::fs::rename(&tmp, out));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
 }
 
 /// The Foxglove layout (pretty JSON) for the arm at `path`, or the paper's.

@@ -64,6 +64,18 @@ impl RunFiles {
             let p = p.display().to_string();
             move |e| RunError::Output(p.clone(), e)
         };
+        // A file there (/dev/null) made create_dir_all say "File exists".
+        if let Ok(m) = std::fs::metadata(&opts.runs_dir)
+            && !m.is_dir()
+        {
+            return Err(RunError::Output(
+                opts.runs_dir.display().to_string(),
+                std::io::Error::new(
+                    std::io::ErrorKind::NotADirectory,
+                    "not a folder: --runs-dir names the folder each run's folder is made in",
+                ),
+            ));
+        }
         std::fs::create_dir_all(&opts.runs_dir).map_err(out(&opts.runs_dir))?;
         let run_dir = new_folder(&opts.runs_dir, opts.name.as_deref())?;
         let scenario_file = run_dir.join("scenario.toml");
