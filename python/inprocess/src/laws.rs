@@ -4,8 +4,9 @@
 use std::path::PathBuf;
 
 use numpy::PyArray1;
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 
 use controller::{ControllerInput, Diagnostics, Law, LawName};
 
@@ -91,28 +92,27 @@ impl PyLaw {
     }
 
     /// One step: the torque for the measured state (q, qd) at sim time t
-    /// and the reference sample (q_d, qd_d, qdd_d, kc, kc_dot).
-    #[allow(clippy::too_many_arguments)]
+    /// and the reference sample (q_d, qd_d, qdd_d, kc, kc_dot):
+    /// `step(t, q, qd, q_d, qd_d, qdd_d, kc, kc_dot)`, the seven arrays
+    /// taken as a tuple and read by name.
+    #[pyo3(signature = (t, *arrays))]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         t: f64,
-        q: &Bound<'py, PyAny>,
-        qd: &Bound<'py, PyAny>,
-        q_d: &Bound<'py, PyAny>,
-        qd_d: &Bound<'py, PyAny>,
-        qdd_d: &Bound<'py, PyAny>,
-        kc: &Bound<'py, PyAny>,
-        kc_dot: &Bound<'py, PyAny>,
+        arrays: &Bound<'py, PyTuple>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let names = ["q", "qd", "q_d", "qd_d", "qdd_d", "kc", "kc_dot"];
-        for ((b, x), what) in self
-            .buf
-            .iter_mut()
-            .zip([q, qd, q_d, qd_d, qdd_d, kc, kc_dot])
-            .zip(names)
-        {
-            read_into(what, x, b)?;
+        if arrays.len() != names.len() {
+            return Err(PyTypeError::new_err(format!(
+                "step: expected t and {} arrays ({}), got {}",
+                names.len(),
+                names.join(", "),
+                arrays.len()
+            )));
+        }
+        for ((b, x), what) in self.buf.iter_mut().zip(arrays.iter()).zip(names) {
+            read_into(what, &x, b)?;
         }
         let [q, qd, q_d, qd_d, qdd_d, kc, kc_dot] = &self.buf;
         let input = ControllerInput {

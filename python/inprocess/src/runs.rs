@@ -143,25 +143,36 @@ pub fn sim<'py>(
 /// --json` prints them (a dict; `laws` holds each law's row).
 #[pyfunction]
 #[pyo3(signature = (scenario=None, *, laws=None, seeds=1, robot=None, set=None, duration=None, threads=None))]
-#[allow(clippy::too_many_arguments)]
-pub fn compare<'py>(
-    py: Python<'py>,
+pub fn compare(
     scenario: Option<PathBuf>,
     laws: Option<Vec<String>>,
     seeds: u64,
     robot: Option<PathBuf>,
-    set: Option<&Bound<'py, PyAny>>,
+    set: Option<&Bound<'_, PyAny>>,
     duration: Option<f64>,
     threads: Option<usize>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let plan = ScenarioArgs {
+) -> PyResult<Py<PyAny>> {
+    // The interpreter is attached already (a Python call): this takes its
+    // token without one more argument.
+    let args = ScenarioArgs {
         scenario,
         robot,
         set,
         duration,
         law: None,
-    }
-    .load()?;
+    };
+    Python::attach(|py| compare_in(py, &args, laws, seeds, threads))
+}
+
+/// [`compare`] with the interpreter's token.
+fn compare_in(
+    py: Python<'_>,
+    args: &ScenarioArgs<'_, '_>,
+    laws: Option<Vec<String>>,
+    seeds: u64,
+    threads: Option<usize>,
+) -> PyResult<Py<PyAny>> {
+    let plan = args.load()?;
     no_external(&plan)?;
     let laws = match laws {
         None => DEFAULT_LAWS.to_vec(),
@@ -183,6 +194,7 @@ pub fn compare<'py>(
     let cap = 4 * launcher::node::placement::cpu_count();
     let threads = threads.map(|t| t.min(cap));
     let opts = CompareOptions {
+        law_sets: Vec::new(),
         laws,
         seeds,
         threads,
@@ -195,7 +207,7 @@ pub fn compare<'py>(
     let result = py
         .detach(|| experiments::compare::compare(&plan, &opts).map_err(|e| e.to_string()))
         .map_err(err)?;
-    json_to_py(py, &result)
+    json_to_py(py, &result).map(Bound::unbind)
 }
 
 /// The scenario as it would run (overrides applied), as TOML text.
