@@ -259,3 +259,31 @@ fn write_scenario_keeps_what_exists_and_follows_no_link() {
     crate::util::ok(&mut write(&fresh, false));
     assert!(fresh.is_file());
 }
+
+/// Item 13 (D15): two rows of one name (`--laws pd,pd`, one label given
+/// to two `--controller-cmd`s, a label that is a default row's law) are
+/// refused by name before any run, not shown as two rows no reader can
+/// tell apart.
+#[test]
+fn compare_refuses_two_rows_of_one_name() {
+    let ext = format!("ext={}", env!("CARGO_BIN_EXE_example-pd-controller"));
+    let nac = format!("nac={}", env!("CARGO_BIN_EXE_example-pd-controller"));
+    let compare = || {
+        let mut cmd = testbed();
+        cmd.args(["compare", "--duration", "0.1", "--seeds", "1", "--json"]);
+        cmd
+    };
+    let e = crate::util::fails(compare().args(["--laws", "pd,pd"]));
+    assert!(e.contains("--laws names pd twice"), "{e}");
+    let e = crate::util::fails(compare().args([
+        "--laws",
+        "pd",
+        "--controller-cmd",
+        &ext,
+        "--controller-cmd",
+        &ext,
+    ]));
+    assert!(e.contains("--controller-cmd ext=… is given twice"), "{e}");
+    let e = crate::util::fails(compare().args(["--controller-cmd", &nac]));
+    assert!(e.contains("nac is a built-in law's name"), "{e}");
+}

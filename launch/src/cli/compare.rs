@@ -53,11 +53,31 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     if args.controller_cmd.is_empty() {
         super::no_external(&plan, "compare")?;
     }
+    let laws = if args.laws.is_empty() {
+        compare::DEFAULT_LAWS.to_vec()
+    } else {
+        args.laws.clone()
+    };
+    // A row is known by its name in the table, the JSON, the CSV and the
+    // findings: two rows of one name once merged without a word (#48 item 13).
+    let mut names = std::collections::BTreeSet::new();
+    for law in &laws {
+        if !names.insert(law.to_string()) {
+            bail!("--laws names {law} twice: each row of the table has its own name");
+        }
+    }
     let mut external = Vec::new();
     for (label, cmd) in &args.controller_cmd {
-        if args.laws.iter().any(|l| l.to_string() == *label) {
+        if laws.iter().any(|l| l.to_string() == *label) {
             anyhow::bail!(
-                "--controller-cmd {label}=…: {label} is a built-in law's name; name your row otherwise"
+                "--controller-cmd {label}=…: {label} is a built-in law's name (a row of this \
+                 table); name your row otherwise"
+            );
+        }
+        if !names.insert(label.clone()) {
+            bail!(
+                "--controller-cmd {label}=… is given twice: each row of the table has its own \
+                 name; name the second otherwise"
             );
         }
         let command = super::args::command_words(cmd)?;
@@ -68,11 +88,6 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
             command,
         });
     }
-    let laws = if args.laws.is_empty() {
-        compare::DEFAULT_LAWS.to_vec()
-    } else {
-        args.laws.clone()
-    };
     let opts = CompareOptions {
         external,
         runs_dir: args.runs_dir.clone(),
