@@ -265,7 +265,7 @@ STRESS = [
      [0.5, 0.75, 1.0, 1.5, 2.0, 3.0], lambda v: fixed("mass_scale", v)),
     ("payload at the tip of link 2 from t = 0", "kg",
      [0.5, 1.0, 2.0, 4.0, 8.0], lambda v: PAYLOAD + [f"plant.payload.mass={v:g}"]),
-    ("torque limit (saturation)", "N m", [500, 100, 50, 30, 20, 15],
+    ("torque limit (saturation; the arm's gravity hold is a few N m)", "N m", [50, 20, 10, 7, 5, 4],
      lambda v: [f"plant.effort_limit={v:g}"]),
     ("actuation delay", "ms", [0, 1, 2, 3, 5], lambda v: [f"plant.actuation.delay_periods={int(v)}"]),
     ("sensor noise on q", "rad", [0.0, 0.001, 0.003, 0.01, 0.03], lambda v: fixed("q_noise_std", v)),
@@ -288,6 +288,57 @@ def stress_runs() -> list[tuple[str, str, list, list[dict], list[str]]]:
             results.append(run_json(args))
         out.append((family, unit, levels, results, sets(levels[-1])))
     return out
+
+
+#: False under --check, which writes nothing.
+WRITE_FIGURES = True
+
+COLOURS = ["#d62728", "#ff7f0e", "#bcbd22", "#8c564b", "#1f77b4", "#17becf",
+           "#2ca02c", "#9467bd", "#e377c2", "#7f7f7f"]
+
+
+def curves_svg(title: str, unit: str, levels: list, results: list[dict], laws: list[str]) -> str:
+    """Median IAE after T_c (log scale) against the level, one line per law;
+    an open circle where the law left the envelope on some seed."""
+    import math
+    w, h, left, right, top, bottom = 760, 380, 70, 150, 30, 50
+    iae = {law: [next(r for r in c["laws"] if r["name"] == law)["median"]["iae"] for c in results]
+           for law in laws}
+    finite = [v for vs in iae.values() for v in vs if v is not None and v > 0]
+    lo, hi = math.floor(math.log10(min(finite))), math.ceil(math.log10(max(finite)))
+    hi = max(hi, lo + 1)
+    x = lambda i: left + (w - left - right) * (i / max(1, len(levels) - 1))
+    y = lambda v: top + (h - top - bottom) * (1 - (math.log10(v) - lo) / (hi - lo))
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="12">',
+           f'<rect width="{w}" height="{h}" fill="white"/>',
+           f'<text x="{left}" y="18" font-size="14">{title}</text>']
+    for d in range(lo, hi + 1):
+        out.append(f'<line x1="{left}" x2="{w - right}" y1="{y(10 ** d):.1f}" y2="{y(10 ** d):.1f}" stroke="#ddd"/>')
+        out.append(f'<text x="{left - 6}" y="{y(10 ** d) + 4:.1f}" text-anchor="end">1e{d}</text>')
+    for i, v in enumerate(levels):
+        out.append(f'<text x="{x(i):.1f}" y="{h - bottom + 18}" text-anchor="middle">{v:g}</text>')
+    out.append(f'<text x="{(left + w - right) / 2}" y="{h - 12}" text-anchor="middle">{unit}</text>')
+    out.append(f'<text x="16" y="{(top + h - bottom) / 2}" transform="rotate(-90 16 {(top + h - bottom) / 2})" '
+               'text-anchor="middle">median IAE after T_c (rad s)</text>')
+    for k, law in enumerate(laws):
+        colour = COLOURS[k % len(COLOURS)]
+        pts = [(x(i), y(v)) for i, v in enumerate(iae[law]) if v is not None and v > 0]
+        out.append(f'<polyline fill="none" stroke="{colour}" stroke-width="1.5" points="'
+                   + " ".join(f"{a:.1f},{b:.1f}" for a, b in pts) + '"/>')
+        for i, c in enumerate(results):
+            row = next(r for r in c["laws"] if r["name"] == law)
+            v = iae[law][i]
+            if v is None or v <= 0:
+                continue
+            kept = row["kept_envelope"] == len(row["runs"])
+            out.append(f'<circle cx="{x(i):.1f}" cy="{y(v):.1f}" r="3.5" stroke="{colour}" '
+                       f'fill="{colour if kept else "white"}"/>')
+        ly = top + 16 * k
+        out.append(f'<line x1="{w - right + 12}" x2="{w - right + 32}" y1="{ly}" y2="{ly}" stroke="{colour}" stroke-width="2"/>')
+        out.append(f'<text x="{w - right + 38}" y="{ly + 4}">{law}</text>')
+    out.append(f'<text x="{w - right + 12}" y="{top + 16 * len(laws) + 10}" font-size="11">○ left on some seed</text>')
+    out.append("</svg>")
+    return "\n".join(out) + "\n"
 
 
 def first_left(levels: list, results: list[dict], law: str, need: int) -> str:
@@ -315,8 +366,11 @@ def robustness_page() -> str:
         "critic adds (nac vs nac-no-critic), by the findings' rules (paired Wilcoxon, Holm, ≥ 1 %).",
         "",
     ]
-    for family, unit, levels, results, _ in stress_runs():
-        lines += [f"## {family}", ""]
+    for k, (family, unit, levels, results, _) in enumerate(stress_runs()):
+        figure = f"robustness-{k + 1}.svg"
+        if WRITE_FIGURES:  # --check compares the page only; the figure is drawn from the same runs
+            (OUT / figure).write_text(curves_svg(family, unit, levels, results, laws))
+        lines += [f"## {family}", "", f"![{family}]({figure})", ""]
         lines += ["| " + unit + " | " + " | ".join(laws) + " |", "|---" * (len(laws) + 1) + "|"]
         for v, c in zip(levels, results):
             cells = []
@@ -406,6 +460,8 @@ def main() -> int:
     if unknown:
         p.error(f"no page {', '.join(unknown)}: the pages are {', '.join(PAGES)}")
     OUT.mkdir(exist_ok=True)
+    global WRITE_FIGURES
+    WRITE_FIGURES = not args.check
     stale = []
     for name, make in PAGES.items():
         if args.pages and name not in args.pages:

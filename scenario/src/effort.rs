@@ -77,7 +77,8 @@ fn loads(plan: &Plan) -> Result<(Vec<f64>, Vec<f64>), PlantError> {
     let (model, s) = (&plan.robot.model, &plan.scenario);
     let n = model.dof();
     let armature = s.plant.armature.resolve("plant.armature", n)?;
-    let mut prober = Prober::new(model, &armature)?;
+    // The run's own gravity: with none, the reference needs no holding torque.
+    let mut prober = Prober::with_gravity(model, &armature, s.plant.gravity)?;
     let count = (s.duration_s / SPACING_S).ceil().max(1.0) as usize;
     let (mut load, mut gravity) = (vec![0.0; n], vec![0.0; n]);
     for k in 0..=count {
@@ -98,4 +99,44 @@ fn loads(plan: &Plan) -> Result<(Vec<f64>, Vec<f64>), PlantError> {
         }
     }
     Ok((load, gravity))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's arm with motors of 5 N m, under `gravity`: the note
+    /// for joint 1, where the load is mostly gravity.
+    fn note(gravity: &str) -> String {
+        let plan = crate::load(
+            None,
+            &crate::Overrides {
+                set: vec![
+                    crate::parse_set("plant.effort_limit=5").unwrap(),
+                    crate::parse_set(&format!("plant.gravity={gravity}")).unwrap(),
+                ],
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        effort_warnings(&plan)
+            .unwrap()
+            .into_iter()
+            .find(|w| w.contains("joint1"))
+            .unwrap_or_default()
+    }
+
+    /// #50 item 5: the load is the run's own, so a scenario without gravity
+    /// counts none.
+    #[test]
+    fn the_load_counts_the_runs_own_gravity() {
+        let with = note("[0.0, 0.0, -9.81]");
+        assert!(with.contains("gravity up to"), "{with}");
+        assert!(!with.contains("gravity up to 0.000"), "{with}");
+        let without = note("[0.0, 0.0, 0.0]");
+        assert!(
+            without.is_empty() || without.contains("gravity up to 0.000"),
+            "{without}"
+        );
+    }
 }

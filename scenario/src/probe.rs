@@ -26,13 +26,25 @@ pub struct Prober {
 }
 
 impl Prober {
-    /// The plant of `model` with `armature` (per joint) added, to probe.
+    /// The plant of `model` with `armature` (per joint) added, to probe,
+    /// under the default gravity (what the gains are chosen for).
     pub fn new(model: &ArmModel, armature: &[f64]) -> Result<Self, PlantError> {
+        Self::with_gravity(model, armature, PlantConfig::default().gravity)
+    }
+
+    /// [`Prober::new`] under `gravity` (m/s², world frame): a run's own
+    /// loads, e.g. none in a scenario with `plant.gravity` zero.
+    pub fn with_gravity(
+        model: &ArmModel,
+        armature: &[f64],
+        gravity: [f64; 3],
+    ) -> Result<Self, PlantError> {
         let config = PlantConfig {
             engine: EngineName::Articulated,
             saturate: false,
             urdf_dynamics: false,
             armature: plant_rapier::PerJoint::Each(armature.to_vec()),
+            gravity,
             ..PlantConfig::default()
         };
         Ok(Self {
