@@ -30,6 +30,20 @@ pub enum OwnLayoutError {
         /// Joints.
         dof: usize,
     },
+    /// Two diagnostics that would name one CSV column and summary entry
+    /// (`a:joints` and `a1:scalar` both give `a1`).
+    #[error(
+        "diagnostics {first:?} and {second:?} both name the column {column:?} (a per-joint \
+         diagnostic's columns are its name and each joint's index): rename one"
+    )]
+    SameColumn {
+        /// The column.
+        column: String,
+        /// The diagnostic declared first.
+        first: String,
+        /// The one declared after it.
+        second: String,
+    },
     /// An entry of the text that is not `name:shape`.
     #[error("{0:?} is not name:shape")]
     Entry(String),
@@ -102,6 +116,23 @@ impl OwnLayout {
         let len = layout.len(dof);
         if len > MAX_OWN_DIAGNOSTICS {
             return Err(OwnLayoutError::TooMany { len, dof });
+        }
+        // Columns are what the CSV and the summary know a value by: two of
+        // one name once gave two `own.a1` (#48 item 13, D16).
+        let mut seen = std::collections::HashMap::new();
+        for (name, shape) in &layout.entries {
+            let one = Self {
+                entries: vec![(name.clone(), *shape)],
+            };
+            for column in one.columns(dof) {
+                if let Some(first) = seen.insert(column.clone(), name) {
+                    return Err(OwnLayoutError::SameColumn {
+                        column,
+                        first: first.clone(),
+                        second: name.clone(),
+                    });
+                }
+            }
         }
         Ok(layout)
     }
@@ -190,6 +221,14 @@ mod tests {
             ("a:joints,b:joints", "at most 32"),
             ("Integral:scalar", "starting with a letter"),
             ("x:scalar,x:joints", "declared twice"),
+            (
+                "a:joints,a1:scalar",
+                "diagnostics \"a\" and \"a1\" both name the column \"a1\"",
+            ),
+            (
+                "a12:scalar,a1:joints",
+                "diagnostics \"a12\" and \"a1\" both name the column \"a12\"",
+            ),
             ("x:vector", "\"scalar\" or \"joints\""),
             ("x", "not name:shape"),
         ] {
