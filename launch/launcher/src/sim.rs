@@ -69,7 +69,9 @@ pub fn run_measured(
     let mut controller = plan.controller_config().machine()?;
     let mut records = RecordAssembler::new(stepper.dof(), plan.dt(), plan.steps);
     for k in 0..plan.steps {
-        let before = *stepper.state();
+        // State k goes in first: the rows come out as before, with no copy
+        // of it kept for later.
+        records.push_state(*stepper.state());
         let t0 = std::time::Instant::now();
         let (command, diagnostics) = stepper.command(&mut controller);
         let t1 = std::time::Instant::now();
@@ -81,7 +83,6 @@ pub fn run_measured(
             c.plant_us.add(t1.elapsed().as_nanos() as f64 / 1e3);
         }
         stepped.map_err(plant_err)?;
-        records.push_state(before);
         records.push_diag(diagnostics);
         records.push_state(*stepper.state());
         records
