@@ -321,10 +321,44 @@ fn outside(c: &Comparison, nac: &LawRow) -> Finding {
     }
 }
 
+/// The row `nac` is tested against, or the final finding when there is
+/// nothing to test: `other` did not run, or no `nac` run reached T_c.
+fn opponent<'a>(
+    c: &'a Comparison,
+    nac: &LawRow,
+    other: LawName,
+    claim: &str,
+) -> Result<&'a LawRow, Draft> {
+    let done = |verdict, evidence| {
+        Draft::Done(Finding {
+            claim: claim.to_string(),
+            verdict,
+            evidence,
+        })
+    };
+    let Some(o) = row(c, other) else {
+        return Err(done(
+            Verdict::NotTested,
+            format!("{other} is not in the comparison"),
+        ));
+    };
+    if nac.not_judged == nac.runs.len() as u64 {
+        return Err(done(
+            Verdict::NotJudged,
+            format!("every run ended before T_c = {} s", tc(nac)),
+        ));
+    }
+    Ok(o)
+}
+
 /// `nac` against `other`, seed by seed, on keeping the envelope (claims 3
 /// and 5): McNemar's exact test on the discordant seeds.
 fn separates(c: &Comparison, nac: &LawRow, other: LawName, claim: &str, runs: usize) -> Draft {
     let claim = format!("{claim} (vs {other})");
+    let o = match opponent(c, nac, other, &claim) {
+        Ok(o) => o,
+        Err(done) => return done,
+    };
     let done = |verdict, evidence| {
         Draft::Done(Finding {
             claim: claim.clone(),
@@ -332,18 +366,6 @@ fn separates(c: &Comparison, nac: &LawRow, other: LawName, claim: &str, runs: us
             evidence,
         })
     };
-    let Some(o) = row(c, other) else {
-        return done(
-            Verdict::NotTested,
-            format!("{other} is not in the comparison"),
-        );
-    };
-    if nac.not_judged == nac.runs.len() as u64 {
-        return done(
-            Verdict::NotJudged,
-            format!("every run ended before T_c = {} s", tc(nac)),
-        );
-    }
     let pairs = || nac.runs.iter().zip(&o.runs).take(runs);
     let only = |a: Envelope, b: Envelope| {
         pairs()
@@ -397,6 +419,10 @@ fn better(
     runs: usize,
 ) -> Draft {
     let claim = format!("{claim} (vs {other}, {metric})");
+    let o = match opponent(c, nac, other, &claim) {
+        Ok(o) => o,
+        Err(done) => return done,
+    };
     let done = |verdict, evidence| {
         Draft::Done(Finding {
             claim: claim.clone(),
@@ -404,18 +430,6 @@ fn better(
             evidence,
         })
     };
-    let Some(o) = row(c, other) else {
-        return done(
-            Verdict::NotTested,
-            format!("{other} is not in the comparison"),
-        );
-    };
-    if nac.not_judged == nac.runs.len() as u64 {
-        return done(
-            Verdict::NotJudged,
-            format!("every run ended before T_c = {} s", tc(nac)),
-        );
-    }
     let (a, b) = (values(nac, metric, runs), values(o, metric, runs));
     if a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()) {
         return done(
