@@ -65,8 +65,9 @@ pub struct EnvOptions {
     /// worst reward for every step it skips; None: never (default: 2).
     pub breach_factor: Option<f64>,
     /// Torque per unit of action, per joint, N m or N (default: derived
-    /// from the arm, see [`EnvOptions::torque_scale`]'s rule in
-    /// `derived_torque_scale`).
+    /// from the arm: per joint, the larger of twice its largest gravity
+    /// torque along the reference and a tenth of its effort limit, at most
+    /// that limit).
     pub torque_scale: Option<Vec<f64>>,
     /// Plant periods per decision: the action is held that long (default:
     /// [`DEFAULT_DECIMATION`]).
