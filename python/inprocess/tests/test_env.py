@@ -35,6 +35,12 @@ class Checker(unittest.TestCase):
                 # Unbounded observations are what they are (MuJoCo's are too).
                 warnings.filterwarnings("ignore", message=".*infinity.*")
                 check_env(gymnasium.make(ENV, **kwargs).unwrapped, skip_render_check=True)
+            # And its rgb_array render, which the checker steps and draws.
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message=".*infinity.*")
+                warnings.filterwarnings("ignore", message=".*alternative render modes.*")
+                check_env(testbed.ArmTrackingEnv(render_mode="rgb_array", **kwargs),
+                          skip_render_check=False)
 
     def test_spaces(self):
         env = gymnasium.make(ENV)
