@@ -140,6 +140,14 @@ fn parse(text: &str, dof: usize) -> Result<Declared, String> {
             v["name"]
         ));
     }
+    // The summary, the log and compare's table name the law that ran by
+    // this name: a built-in law's would pass the controller off as it.
+    if name.parse::<controller::LawName>().is_ok() {
+        return Err(format!(
+            "`--describe` gave the name {name:?}, a built-in law's: name your law otherwise \
+             (a run would be taken for the built-in {name})"
+        ));
+    }
     let params = match &v["params"] {
         Value::Null => Map::new(),
         Value::Object(m) => m.clone(),
@@ -277,6 +285,11 @@ mod tests {
                 .contains("1 to 40")
         );
         assert!(parse("nope", 2).unwrap_err().contains("no JSON"));
+        // #48 item 13 (D15): a controller never passes itself off as a built-in law.
+        for builtin in ["pd", "nac", "cbf-ctc"] {
+            let e = parse(&format!(r#"{{"name": "{builtin}"}}"#), 2).unwrap_err();
+            assert!(e.contains("a built-in law's"), "{e}");
+        }
         assert!(parse(r#"{"name": "a", "params": {"k": null}}"#, 2).is_err());
         let e = parse(r#"{"name": "a", "diagnostics": {"x": 3}}"#, 2).unwrap_err();
         assert!(e.contains("diagnostic x"), "{e}");
