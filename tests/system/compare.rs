@@ -2,20 +2,15 @@
 
 use crate::util::{assert_same_csv, fails, json, ok, testbed};
 
-const LAWS: [&str; 12] = [
-    "nac",
-    "nac-no-shift",
-    "nac-no-critic",
-    "nac-no-networks",
-    "blf",
-    "pd",
-    "pd-gravity",
-    "ctc",
-    "ppc",
-    "smc",
-    "cbf-ctc",
-    "mpc",
-];
+use controller::LawName;
+
+/// The laws, as `--laws` takes them (a comma-separated list).
+fn laws(list: &[LawName]) -> String {
+    list.iter()
+        .map(|l| l.as_str())
+        .collect::<Vec<_>>()
+        .join(",")
+}
 
 /// The summary's own keys (a report flattens them beside its own).
 const SUMMARY_KEYS: [&str; 10] = [
@@ -36,7 +31,7 @@ const SUMMARY_KEYS: [&str; 10] = [
 #[test]
 fn every_law_in_lockstep_equals_its_sim_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
-    for law in LAWS {
+    for law in LawName::ALL.iter().map(|l| l.as_str()) {
         let (run_csv, sim_csv) = (
             dir.path().join(format!("{law}-run.csv")),
             dir.path().join(format!("{law}-sim.csv")),
@@ -105,7 +100,8 @@ fn compare_rows_equal_single_law_sim_runs() {
         std::fs::read_to_string(crate::util::repo_root().join("scenarios/friction_noise.toml"))
             .unwrap();
     assert!(base.contains("\nseed = 7\n"), "friction_noise's own seed");
-    let laws = "nac,nac-no-shift,blf,pd,pd-gravity,ctc,ppc";
+    use LawName::*;
+    let laws = laws(&[Nac, NacNoShift, Blf, Pd, PdGravity, Ctc, Ppc]);
     let cmp = json(&ok(testbed()
         .args([
             "compare",
@@ -114,7 +110,7 @@ fn compare_rows_equal_single_law_sim_runs() {
             "--duration",
             "2.5",
         ])
-        .args(["--laws", laws, "--seeds", "2", "--json"])));
+        .args(["--laws", &laws, "--seeds", "2", "--json"])));
     assert!(cmp["threads"].as_u64().unwrap() >= 1);
     let rows = cmp["laws"].as_array().unwrap();
     assert_eq!(rows.len(), 7);
@@ -261,7 +257,7 @@ fn a_faulted_run_is_a_failure_everywhere() {
         "--scenario",
         "paper_per_input",
         "--laws",
-        "nac,nac-no-shift",
+        &laws(&[LawName::Nac, LawName::NacNoShift]),
     ];
     let c = json(&ok(testbed().args(args).arg("--json")));
     let laws = c["laws"].as_array().unwrap();
