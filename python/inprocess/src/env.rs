@@ -11,7 +11,7 @@ use numpy::{
 };
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBool, PyDict};
 
 use crate::convert::{ScenarioArgs, array, err, read_into};
 
@@ -65,6 +65,12 @@ fn load(
             )));
         }
         let none = v.is_none();
+        // A bool is an int to Python: refused where a number is meant.
+        if v.is_instance_of::<PyBool>() && !matches!(key.as_str(), "safe" | "scale_obs") {
+            return Err(PyTypeError::new_err(format!(
+                "{key}: expected a number, got bool"
+            )));
+        }
         match key.as_str() {
             "robot" if !none => robot = Some(take::<PathBuf>(&key, &v, "a path")?),
             "set" if !none => set = Some(v),

@@ -154,6 +154,8 @@ class Contract(unittest.TestCase):
             gymnasium.make(ENV, decimation=-3)
         with self.assertRaisesRegex(TypeError, "decimation: expected a whole number"):
             gymnasium.make(ENV, decimation=2.5)
+        with self.assertRaisesRegex(TypeError, "decimation: expected a number, got bool"):
+            gymnasium.make(ENV, decimation=True)
         with self.assertRaisesRegex(TypeError, "safe: expected True or False"):
             gymnasium.make(ENV, safe="yes")
         with self.assertRaisesRegex(testbed.TestbedError, "episode_s = 0: must be"):
