@@ -31,6 +31,11 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
             "compare needs at least one law and one seed",
         ));
     }
+    for (k, law) in opts.laws.iter().enumerate() {
+        if opts.laws[..k].contains(law) {
+            return Err(CompareError::DuplicateLaw(*law));
+        }
+    }
     let mut jobs = Vec::new();
     for &law in &opts.laws {
         for s in 0..opts.seeds {
@@ -123,6 +128,28 @@ pub fn compare(plan: &Plan, opts: &CompareOptions) -> Result<Comparison, Compare
 #[cfg(test)]
 mod tests {
     use super::*;
+    use controller::LawName;
+
+    #[test]
+    fn a_law_twice_is_an_error() {
+        let plan = scenario::load(None, &scenario::Overrides::default()).unwrap();
+        let opts = CompareOptions {
+            law_sets: Vec::new(),
+            external: Vec::new(),
+            runs_dir: std::path::PathBuf::from("runs"),
+            progress: false,
+            laws: vec![LawName::Pd, LawName::Nac, LawName::Pd],
+            seeds: 1,
+            threads: Some(1),
+            series: false,
+            tuning: None,
+        };
+        let err = compare(&plan, &opts).unwrap_err();
+        assert!(
+            matches!(err, CompareError::DuplicateLaw(LawName::Pd)),
+            "{err}"
+        );
+    }
 
     #[test]
     fn no_law_is_an_error() {

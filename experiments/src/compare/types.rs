@@ -55,6 +55,9 @@ pub enum CompareError {
     /// Nothing to run.
     #[error("{0}")]
     Empty(&'static str),
+    /// A law listed twice: two rows of one name.
+    #[error("{0} is listed twice: each law is one row of the table")]
+    DuplicateLaw(LawName),
     /// A `--law-set` that the law's parameters cannot take.
     #[error("--law-set {law}:controller.{key}: {}", cause.message())]
     LawSet {
