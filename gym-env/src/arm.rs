@@ -207,12 +207,7 @@ impl ArmEnv {
             ActionMode::Torque => 1.0,
             ActionMode::Residual(_) => self.opts.residual_scale,
         };
-        let mut effort = 0.0;
-        for (i, a) in action.iter().enumerate().take(self.n) {
-            let a = a.clamp(-1.0, 1.0);
-            self.add[i] = a * span * self.scale[i];
-            effort += a * a;
-        }
+        let effort = crate::action_torque(action, span, &self.scale, &mut self.add);
         let effort = self.opts.effort_weight * effort / self.n as f64;
         let (mut reward, mut periods, mut cost, mut breached) = (0.0, 0u32, 0.0, false);
         let mut finite = true;
@@ -304,27 +299,15 @@ impl ArmEnv {
     /// The observation of the current state: what a controller sees
     /// (measured q, q̇) and the reference sample due.
     fn observe(&self, obs: &mut [f64]) {
-        let (n, s, r) = (self.n, self.stepper.state(), self.stepper.reference());
-        for i in 0..n {
-            let e = s.q_measured[i] - r.q_d[i];
-            let ed = s.qd_measured[i] - r.qd_d[i];
-            if self.opts.scale_obs {
-                let v = self.velocity[i];
-                obs[i] = e / r.kc[i];
-                obs[n + i] = ed / v;
-                obs[3 * n + i] = s.qd_measured[i] / v;
-                obs[5 * n + i] = r.qd_d[i] / v;
-            } else {
-                obs[i] = e;
-                obs[n + i] = ed;
-                obs[3 * n + i] = s.qd_measured[i];
-                obs[5 * n + i] = r.qd_d[i];
-            }
-            obs[2 * n + i] = s.q_measured[i];
-            obs[4 * n + i] = r.q_d[i];
-            obs[6 * n + i] = r.kc[i];
-        }
-        obs[7 * n] = self.stepper.k() as f64 / self.stepper.steps() as f64;
+        crate::observe(
+            self.stepper.state(),
+            self.stepper.reference(),
+            self.stepper.k(),
+            self.stepper.steps(),
+            self.opts.scale_obs,
+            &self.velocity,
+            obs,
+        );
     }
 
     /// A picture of the arm now (dark) over its reference pose (light), as

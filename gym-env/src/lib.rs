@@ -34,13 +34,15 @@
 
 mod arm;
 mod options;
+mod policy_io;
 mod render;
 mod vector;
 
-pub use arm::{ArmEnv, Outcome, ResetOptions};
+pub use arm::{ArmEnv, Outcome, ResetOptions, obs_dim};
 pub use options::{
     ActionMode, DEFAULT_DECIMATION, DEFAULT_EPISODE_S, ERROR_CAP, EnvError, EnvOptions,
     check_episode_s,
 };
+pub use policy_io::{action_torque, observe};
 pub use render::{Picture, Projection};
 pub use vector::{ArmEnvs, MAX_ENVS, SeedStream};

@@ -45,6 +45,13 @@ class LinearPolicy:
         """Writes the policy as .npz (weights, bias, the environment as JSON)."""
         np.savez(path, weights=self.weights, bias=self.bias, env=json.dumps(self.env))
 
+    def save_onnx(self, path) -> None:
+        """Writes the policy as ONNX for the Rust node `testbed-policy`
+        (needs the `onnx` package; see `testbed.onnx_export`)."""
+        from .onnx_export import save_linear
+
+        save_linear(self, path)
+
     @classmethod
     def load(cls, path) -> "LinearPolicy":
         with np.load(path, allow_pickle=False) as f:
