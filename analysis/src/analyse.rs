@@ -135,6 +135,10 @@ pub struct LogAnalysis {
     pub expected_rows: u64,
     /// Rows whose samples were dropped or never came (of a finished run).
     pub missing_rows: u64,
+    /// Rows whose samples are in the log but came too late in the file
+    /// for the reader ([`crate::assemble::PENDING_ROWS`] steps behind the
+    /// other topics): not lost, but not in the figures either.
+    pub out_of_order_rows: u64,
     /// Largest |τ_replayed − τ_logged| and steps compared, with `verify`.
     pub verify: Option<(f64, u64)>,
     /// Per-row values, with `series`.
@@ -401,6 +405,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         &mut timing,
         &RunFacts {
             missing_rows,
+            out_of_order_rows: a.assembler.out_of_order(),
             run_end: contents.run_end(),
             cut_short: contents.cut_short.as_deref(),
             not_whole: &not_whole,
@@ -414,6 +419,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         wall_window_ns: wall,
         expected_rows: plan.steps,
         missing_rows,
+        out_of_order_rows: a.assembler.out_of_order(),
         summary,
         timing,
         verify: a.verifier.map(|v| (v.max_abs_torque_diff, v.steps)),

@@ -49,6 +49,12 @@ pub struct RecordAssembler {
     newest_own: Option<u64>,
     owns: BTreeMap<u64, Box<OwnDiagnostics>>,
     missing: u64,
+    /// Rows given up, as ranges `start -> end` (end exclusive): a sample
+    /// that comes for one of them later shows the log out of order, not
+    /// the row lost.
+    given_up: BTreeMap<u64, u64>,
+    /// Rows given up whose samples came later in the file.
+    late: u64,
     qdd: Vec<f64>,
 }
 
@@ -68,6 +74,8 @@ impl RecordAssembler {
             newest_own: None,
             owns: BTreeMap::new(),
             missing: 0,
+            given_up: BTreeMap::new(),
+            late: 0,
             qdd: vec![0.0; n],
         }
     }
@@ -85,6 +93,9 @@ impl RecordAssembler {
         if self.own_len.is_some() {
             self.make_room(seq);
         }
+        if self.own_len.is_some() && seq < self.next {
+            self.came_late(seq);
+        }
         if self.own_len.is_some() && (self.next..self.steps).contains(&seq) {
             self.newest_own = Some(self.newest_own.map_or(seq, |n| n.max(seq)));
             self.owns.insert(seq, Box::new(o));
@@ -95,6 +106,15 @@ impl RecordAssembler {
     pub fn push_state(&mut self, s: JointState) {
         let seq = s.header.seq;
         self.make_room(seq);
+        // State k serves rows k and k - 1.
+        if seq < self.next {
+            self.came_late(seq);
+        }
+        if let Some(row) = seq.checked_sub(1)
+            && row < self.next
+        {
+            self.came_late(row);
+        }
         // Rows need states up to `steps` (row k uses k + 1).
         if (self.next..=self.steps).contains(&seq) {
             self.newest_state = Some(self.newest_state.map_or(seq, |n| n.max(seq)));
@@ -106,6 +126,9 @@ impl RecordAssembler {
     pub fn push_diag(&mut self, d: ControllerDiagnostics) {
         let seq = d.header.seq;
         self.make_room(seq);
+        if seq < self.next {
+            self.came_late(seq);
+        }
         if (self.next..self.steps).contains(&seq) {
             self.newest_diag = Some(self.newest_diag.map_or(seq, |n| n.max(seq)));
             self.diags.insert(seq, Box::new(d));
@@ -114,7 +137,14 @@ impl RecordAssembler {
 
     /// Rows given up because their data never came.
     pub fn missing(&self) -> u64 {
-        self.missing
+        self.missing - self.late
+    }
+
+    /// Rows given up whose samples came later in the file than the
+    /// reader's bound ([`PENDING_ROWS`] steps behind the other topics):
+    /// they are in the log, but out of order beyond what replay holds.
+    pub fn out_of_order(&self) -> u64 {
+        self.late
     }
 
     /// Rows neither emitted nor given up: at the end of a finished run's
@@ -204,6 +234,7 @@ impl RecordAssembler {
             return;
         }
         self.missing += floor - self.next;
+        self.give_up(self.next, floor);
         self.next = floor;
         self.states = self.states.split_off(&floor);
         self.diags = self.diags.split_off(&floor);
@@ -215,7 +246,39 @@ impl RecordAssembler {
         self.diags.remove(&k);
         self.owns.remove(&k);
         self.missing += 1;
+        self.give_up(k, k + 1);
         self.next += 1;
+    }
+
+    /// Records rows `start..end` as given up, joined to the range before
+    /// when they follow it (rows are given up in order).
+    fn give_up(&mut self, start: u64, end: u64) {
+        if let Some(mut last) = self.given_up.last_entry()
+            && *last.get() == start
+        {
+            *last.get_mut() = end;
+            return;
+        }
+        self.given_up.insert(start, end);
+    }
+
+    /// A sample came for row `k`, already passed: if the row was given up,
+    /// it is counted late instead of lost (once).
+    fn came_late(&mut self, k: u64) {
+        let Some((&start, &end)) = self.given_up.range(..=k).next_back() else {
+            return;
+        };
+        if k >= end {
+            return;
+        }
+        self.given_up.remove(&start);
+        if start < k {
+            self.given_up.insert(start, k);
+        }
+        if k + 1 < end {
+            self.given_up.insert(k + 1, end);
+        }
+        self.late += 1;
     }
 }
 
@@ -329,5 +392,34 @@ mod tests {
         assert_eq!(a.missing(), 0);
         assert_eq!(a.unfinished(), 400);
         assert!(!a.complete());
+    }
+
+    /// Issue 48 item 15 (N11): diagnostics written after every state of a
+    /// run longer than the bound give rows up, but their samples then come:
+    /// those rows are out of order, not lost.
+    #[test]
+    fn samples_past_the_bound_are_out_of_order_not_lost() {
+        let steps = PENDING_ROWS + 600;
+        let mut a = RecordAssembler::new(1, 1e-3, steps);
+        for k in 0..=steps {
+            a.push_state(state(k));
+        }
+        for k in 0..steps {
+            a.push_diag(diag(k));
+        }
+        let read = rows(&mut a);
+        assert_eq!(a.missing(), 0);
+        assert_eq!(a.out_of_order() + read, steps);
+        assert!(a.out_of_order() > 0 && a.complete());
+        // A row truly dropped stays lost beside them.
+        let mut b = RecordAssembler::new(1, 1e-3, steps);
+        for k in (0..=steps).filter(|k| *k != 3) {
+            b.push_state(state(k));
+        }
+        for k in (0..steps).filter(|k| *k != 2 && *k != 3) {
+            b.push_diag(diag(k));
+        }
+        rows(&mut b);
+        assert_eq!(b.missing(), 2);
     }
 }

@@ -180,6 +180,9 @@ pub fn explained_by_floor(floor_late: u64) -> u64 {
 pub struct RunFacts<'a> {
     /// Rows the log lacks (dropped or never logged).
     pub missing_rows: u64,
+    /// Rows whose samples are in the log, but further out of order than
+    /// the reader holds ([`crate::assemble::PENDING_ROWS`] steps).
+    pub out_of_order_rows: u64,
     /// How the run ended, as the logger recorded it (None: never recorded).
     pub run_end: Option<&'a str>,
     /// Why the log was read only in part, if it was.
@@ -222,6 +225,17 @@ pub fn judge(t: &mut TimingSummary, facts: &RunFacts<'_>) {
         invalid.push(format!(
             "{} rows lost (samples dropped or never logged)",
             facts.missing_rows
+        ));
+    }
+    if facts.out_of_order_rows > 0 {
+        // The rows are in the file: saying them lost would send the reader
+        // looking for drops that never happened.
+        invalid.push(format!(
+            "the log is out of order beyond the reader's bound: the samples of {} rows come \
+             more than {} steps after the other topics' in the file, so they are not in \
+             these figures (the rows are in the log; write it in log-time order to read them)",
+            facts.out_of_order_rows,
+            crate::assemble::PENDING_ROWS
         ));
     }
     if let Some(d) = &t.data_path {

@@ -287,3 +287,104 @@ fn compare_refuses_two_rows_of_one_name() {
     let e = crate::util::fails(compare().args(["--controller-cmd", &nac]));
     assert!(e.contains("nac is a built-in law's name"), "{e}");
 }
+
+/// Copies the MCAP log `from` to `to` with every message of `topic`
+/// written after all the others, as a tool that writes one channel at a
+/// time would: the log is whole, only its order changes.
+fn rewrite_with_topic_last(from: &Path, to: &Path, topic: &str) {
+    let bytes = std::fs::read(from).unwrap();
+    let mut w = mcap::WriteOptions::new()
+        .profile("ros2")
+        .create(std::io::BufWriter::new(std::fs::File::create(to).unwrap()))
+        .unwrap();
+    let (mut schemas, mut channels) = (BTreeMap::new(), BTreeMap::new());
+    let mut held = Vec::new();
+    let mut metadata = Vec::new();
+    for record in mcap::read::ChunkFlattener::new(&bytes).unwrap() {
+        match record.unwrap() {
+            Record::Schema { header, data } => {
+                let id = w.add_schema(&header.name, &header.encoding, &data).unwrap();
+                schemas.insert(header.id, id);
+            }
+            Record::Channel(c) => {
+                let id = w
+                    .add_channel(
+                        schemas[&c.schema_id],
+                        &c.topic,
+                        &c.message_encoding,
+                        &c.metadata,
+                    )
+                    .unwrap();
+                channels.insert(c.id, (id, c.topic));
+            }
+            Record::Message { mut header, data } => {
+                let (id, t) = &channels[&header.channel_id];
+                header.channel_id = *id;
+                if t == topic {
+                    held.push((header, data.into_owned()));
+                } else {
+                    w.write_to_known_channel(&header, &data).unwrap();
+                }
+            }
+            // The logger's counts come last, as the logger writes them.
+            Record::Metadata(m) if m.name == "testbed.log_stats" => metadata.push(m),
+            Record::Metadata(m) => w.write_metadata(&m).unwrap(),
+            Record::Attachment { header, data, .. } => w
+                .attach(&mcap::Attachment {
+                    log_time: header.log_time,
+                    create_time: header.create_time,
+                    name: header.name,
+                    media_type: header.media_type,
+                    data,
+                })
+                .unwrap(),
+            _ => {}
+        }
+    }
+    assert!(!held.is_empty(), "no {topic} messages");
+    for (header, data) in held {
+        w.write_to_known_channel(&header, &data).unwrap();
+    }
+    for m in metadata {
+        w.write_metadata(&m).unwrap();
+    }
+    w.finish().unwrap();
+}
+
+/// Item 15 (N11): a whole log whose diagnostics all come after the other
+/// channels (more steps than the reader holds at once) never replays
+/// "rows lost": the rows are in the file, so replay says the log is out
+/// of order beyond its bound, and the row count lost is 0.
+#[test]
+fn a_log_out_of_order_beyond_the_bound_loses_no_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    // More steps than the reader's bound of 16 384 rows.
+    let out = crate::util::ok(
+        testbed()
+            .args([
+                "run",
+                "--mode",
+                "lockstep",
+                "--duration",
+                "17",
+                "--json",
+                "--runs-dir",
+            ])
+            .arg(dir.path()),
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let log = Path::new(v["log"].as_str().unwrap());
+    let late = dir.path().join("diagnostics-last.mcap");
+    rewrite_with_topic_last(log, &late, "/controller/diagnostics");
+    let (code, s, err) = replay(&["--json"], &late);
+    let s = s.unwrap_or_else(|| panic!("no summary: {err}"));
+    let reasons = s["timing"]["reasons"].to_string();
+    assert!(!reasons.contains("rows lost"), "{reasons}");
+    assert_eq!(s["missing_rows"], 0, "{reasons}");
+    assert!(
+        reasons.contains("out of order beyond the reader's bound"),
+        "{reasons}"
+    );
+    // Not every row was read, so the figures are not the whole run's.
+    assert_eq!(code, Some(4), "{err}");
+}
