@@ -46,21 +46,24 @@ impl Gain {
         }
     }
 
-    /// Checks every entry is a finite number > 0 (written so NaN fails).
+    /// Checks every entry is in (0, [`crate::MAX_GAIN`]] (written so NaN
+    /// fails): a gain of 1e308 passed "finite and > 0" and then faulted on
+    /// every step.
     pub(crate) fn check_positive(&self, key: &str) -> Result<(), ControllerError> {
         let bad = |k: String, v: f64| ControllerError::InvalidParameter {
             key: k,
-            value: v.to_string(),
-            need: "a finite number > 0".into(),
+            value: format!("{v:?}"),
+            need: "a number in (0, 1e6]".into(),
         };
+        let ok = |x: &f64| *x > 0.0 && *x <= crate::MAX_GAIN;
         match self {
-            Self::All(x) if !(x.is_finite() && *x > 0.0) => Err(bad(key.to_string(), *x)),
+            Self::All(x) if !ok(x) => Err(bad(key.to_string(), *x)),
             Self::Each(v) if v.is_empty() => Err(ControllerError::InvalidParameter {
                 key: key.to_string(),
                 value: "[]".into(),
                 need: "one number, or one per controlled joint".into(),
             }),
-            Self::Each(v) => match v.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
+            Self::Each(v) => match v.iter().position(|x| !ok(x)) {
                 Some(i) => Err(bad(format!("{key}[{i}]"), v[i])),
                 None => Ok(()),
             },

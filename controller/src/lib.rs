@@ -55,8 +55,8 @@ pub use law_table::{BarrierParts, FeedbackKind, LawDecl, LawKind, LawName};
 pub use machine::{ControllerMachine, ControllerMachineConfig};
 pub use nac::{Controller, ControllerInput, barrier_lyapunov};
 pub use params::{
-    BarrierMode, Check, ControllerParams, Integrator, MAX_MPC_HORIZON, MAX_NEURONS, ParamDoc,
-    RbfLayout, Tuning,
+    BarrierMode, Check, ControllerParams, Integrator, MAX_GAIN, MAX_MPC_HORIZON, MAX_NEURONS,
+    MAX_TC_S, ParamDoc, RbfLayout, Tuning,
 };
 pub use params_reference::reference_markdown;
 pub use ppc::{Ppc, XI_LIMIT};

@@ -131,7 +131,7 @@ parameters! {
     /// left at its default.
     law: LawName = LawName::Nac, ANY_NAME;
     /// Prescribed time T_c at which the constraint is fully on, s.
-    tc: f64 = 2.0, POSITIVE;
+    tc: f64 = 2.0, TIME_CONSTANT;
     /// Position-error gain K1 = diag(K1_i), 1/s: one number or one per
     /// joint (SPEC §7 needs K1_i > 0).
     k1: Gain = Gain::All(15.0), POSITIVE_GAIN;
@@ -202,13 +202,21 @@ parameters! {
     mpc_horizon: usize = 10, HORIZON_STEPS;
     /// `mpc`: the prediction step h, s (the default is ten control periods
     /// at 1 kHz; the QP is still solved every period).
-    mpc_step: f64 = 0.01, POSITIVE;
+    mpc_step: f64 = 0.01, MPC_STEP;
     /// `ctc`, `cbf-ctc`, `mpc`, `ppc`: how K1, K2 become the law's gains:
     /// "as-given", or "matched" to `pd`'s error dynamics. Unwritten at its
     /// default so that existing scenarios keep their identity.
     #[serde(skip_serializing_if = "is_default")]
     tuning: Tuning = Tuning::AsGiven, ANY_NAME;
 }
+
+/// The longest prescribed time T_c, s ([`ControllerParams::tc`]).
+pub const MAX_TC_S: f64 = 1e4;
+
+/// The largest gain K1_i, K2_i: a million times the paper's order of
+/// magnitude is far past any real arm's and still leaves K e and K ė finite
+/// for any error the envelope allows ([`crate::Gain`]).
+pub const MAX_GAIN: f64 = 1e6;
 
 /// The most neurons a network may have: checked before anything is
 /// allocated (the paper uses 10; the per-input layout has this many per
@@ -247,11 +255,12 @@ pub struct Check<T: ?Sized> {
     ok: fn(&T) -> bool,
 }
 
-impl<T: std::fmt::Display + ?Sized> Check<T> {
+impl<T: std::fmt::Debug + ?Sized> Check<T> {
     fn run(&self, key: &str, v: &T) -> Result<(), ControllerError> {
         match (self.ok)(v) {
             true => Ok(()),
-            false => Err(invalid(key, v, self.need)),
+            // Debug: 1e300 as written, not its 301 digits.
+            false => Err(invalid(key, format!("{v:?}"), self.need)),
         }
     }
 }
@@ -265,6 +274,18 @@ const ANY_NAME: AnyName = AnyName {
 const POSITIVE: Check<f64> = Check {
     need: "a finite number > 0",
     ok: |v| v.is_finite() && *v > 0.0,
+};
+/// T_c: up to about three hours. Longer is not a prescribed time but a
+/// constraint never switched on, and γ(t) then underflows every step.
+const TIME_CONSTANT: Check<f64> = Check {
+    need: "a time in (0, 10000] s",
+    ok: |v| *v > 0.0 && *v <= MAX_TC_S,
+};
+/// The `mpc` prediction step: from 1 µs (below, the prediction matrices
+/// lose every digit to rounding) to 10 s (beyond, e^{-K h} underflows).
+const MPC_STEP: Check<f64> = Check {
+    need: "a time from 1e-6 to 10 s",
+    ok: |v| *v >= 1e-6 && *v <= 10.0,
 };
 const NON_NEGATIVE: Check<f64> = Check {
     need: "a finite number ≥ 0",
@@ -280,7 +301,7 @@ const FINITE: Check<f64> = Check {
 };
 /// Gains say which joint's entry is wrong: [`Gain::check_positive`].
 const POSITIVE_GAIN: GainCheck = GainCheck {
-    need: "a finite number > 0, or one per controlled joint, each > 0",
+    need: "a number in (0, 1e6], or one per controlled joint, each in (0, 1e6]",
 };
 const NEURON_COUNT: Check<usize> = Check {
     need: "an integer from 1 to 1000 (MAX_NEURONS)",
@@ -500,5 +521,92 @@ mod tests {
                 "{e}"
             );
         }
+    }
+
+    /// Issue 48 item 10 (N12): values that pass "finite and > 0" but fault
+    /// on every step are refused up front, the error naming the key, the
+    /// value and the range; the edges of each range are accepted.
+    #[test]
+    fn physically_absurd_values_are_refused_with_their_range() {
+        let cases: [(&str, ControllerParams, &str); 6] = [
+            (
+                "controller.tc",
+                ControllerParams {
+                    tc: 1e300,
+                    ..Default::default()
+                },
+                "(0, 10000] s",
+            ),
+            (
+                "controller.mpc_step",
+                ControllerParams {
+                    law: LawName::Mpc,
+                    mpc_step: 1e-300,
+                    ..Default::default()
+                },
+                "from 1e-6 to 10 s",
+            ),
+            (
+                "controller.mpc_step",
+                ControllerParams {
+                    law: LawName::Mpc,
+                    mpc_step: 1e300,
+                    ..Default::default()
+                },
+                "from 1e-6 to 10 s",
+            ),
+            (
+                "controller.k1",
+                ControllerParams {
+                    k1: Gain::All(1e308),
+                    ..Default::default()
+                },
+                "(0, 1e6]",
+            ),
+            (
+                "controller.k2[1]",
+                ControllerParams {
+                    k2: Gain::Each(vec![1.0, 2e6]),
+                    ..Default::default()
+                },
+                "(0, 1e6]",
+            ),
+            (
+                "controller.k1",
+                ControllerParams {
+                    k1: Gain::All(f64::INFINITY),
+                    ..Default::default()
+                },
+                "(0, 1e6]",
+            ),
+        ];
+        for (key, p, range) in cases {
+            let e = p.validate().unwrap_err().to_string();
+            assert!(e.contains(key) && e.contains(range), "{key}: {e}");
+        }
+        let e = ControllerParams {
+            tc: 1e300,
+            ..Default::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("1e300"), "the value is named: {e}");
+        let edges = ControllerParams {
+            law: LawName::Mpc,
+            tc: 1e4,
+            k1: Gain::All(1e6),
+            k2: Gain::Each(vec![1e6, 1e-3]),
+            mpc_step: 1e-6,
+            ..Default::default()
+        };
+        edges.validate().unwrap();
+        ControllerParams {
+            law: LawName::Mpc,
+            mpc_step: 10.0,
+            ..Default::default()
+        }
+        .validate()
+        .unwrap();
     }
 }

@@ -98,7 +98,7 @@ mod tests {
         for key in ControllerParams::KEYS {
             assert!(page.contains(&format!("| `{key}` |")), "{key}");
         }
-        assert!(page.contains("| `k1` | `15.0` | a finite number > 0, or one per controlled joint, each > 0 | all |"), "{page}");
+        assert!(page.contains("| `k1` | `15.0` | a number in (0, 1e6], or one per controlled joint, each in (0, 1e6] | all |"), "{page}");
         assert!(
             page.contains("| `neurons` | `10` | an integer from 1 to 1000"),
             "{page}"
