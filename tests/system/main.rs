@@ -13,6 +13,7 @@ mod live;
 mod liveness;
 mod log_replay;
 mod many_joints;
+mod policy_onnx;
 mod python;
 mod python_in_process;
 mod realtime_integrity;
