@@ -306,3 +306,21 @@ fn a_setting_without_its_partner_is_named() {
     );
     assert!(e.contains("plant.actuator.slew_rate"), "{e}");
 }
+
+/// Issue 48 item 10 (N12): a motor inertia of 1e-300 kg m² passed "> 0"
+/// and then faulted on every step; below 1e-9 kg m² it is refused by key,
+/// value and range, and the edge is taken.
+#[test]
+fn a_motor_inertia_below_any_rotor_is_refused() {
+    let art = EngineName::Articulated;
+    for b in [1e-300, 1e-10] {
+        let e = error_of(art, elastic(100.0, 0.0, b, 0.0));
+        assert!(
+            e.contains("plant.actuator.motor_inertia") && e.contains("1e-9 to 1e9"),
+            "{e}"
+        );
+    }
+    let e = error_of(art, elastic(100.0, 0.0, 1e-300, 0.0));
+    assert!(e.contains("1e-300"), "the value is named: {e}");
+    rig_on(art, elastic(100.0, 0.0, 1e-9, 0.0)).unwrap();
+}

@@ -475,3 +475,55 @@ fn a_contact_scenario_is_checked_before_it_runs() {
     let e = contact.validate().unwrap_err().to_string();
     assert!(e.contains("at most 4"), "{e}");
 }
+
+/// Issue 48 item 10 (D18): a link grasps only what is within reach; an
+/// object 900 m from it is refused by name when the grasp comes, not
+/// carried across the world.
+#[test]
+fn a_grasp_out_of_reach_is_refused() {
+    let mut far = object(0.01, None);
+    far.xyz = [900.0, 0.0, 0.0];
+    let mut r = two_link(
+        ContactConfig {
+            object: vec![far],
+            ..ContactConfig::default()
+        },
+        None,
+    );
+    let e = (0..20)
+        .find_map(|_| r.step(Some(&[0.0, 0.0])).err())
+        .expect("the grasp went ahead")
+        .to_string();
+    assert!(
+        e.contains("plant.contact.object[0]") && e.contains("within 2 m"),
+        "{e}"
+    );
+    assert!(!r.effects().has(Effects::PAYLOAD));
+}
+
+/// Issue 48 item 10 (N12): an object of 1e-300 kg passed "> 0" and then
+/// faulted on every step; below 1e-9 kg it is refused by key, value and
+/// range, and the edge is taken.
+#[test]
+fn an_object_lighter_than_a_microgram_is_refused() {
+    let mut o = object(100.0, None);
+    for mass in [1e-300, 1e-10] {
+        o.mass = mass;
+        let c = ContactConfig {
+            object: vec![o.clone()],
+            ..ContactConfig::default()
+        };
+        let e = c.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("plant.contact.object[0].mass") && e.contains("[1e-9, 10000] kg"),
+            "{e}"
+        );
+    }
+    o.mass = 1e-9;
+    ContactConfig {
+        object: vec![o],
+        ..ContactConfig::default()
+    }
+    .validate()
+    .unwrap();
+}

@@ -52,6 +52,10 @@ pub struct Harmonic {
     pub phase: f64,
 }
 
+/// The lightest motor inertia taken, kg m²: a hundred times below a
+/// millimetre-scale micromotor's rotor.
+pub const MIN_MOTOR_INERTIA: f64 = 1e-9;
+
 /// The largest cogging order taken: a period of 1 µrad.
 const MAX_ORDER: f64 = 1e6;
 
@@ -87,6 +91,13 @@ impl ActuatorConfig {
         for (key, v) in self.per_joint() {
             v.check(&format!("plant.actuator.{key}"))?;
         }
+        // A rotor lighter than any motor has makes the spring's mode too
+        // fast for any step: 1e-300 kg m² faulted on every step.
+        self.motor_inertia.check_with(
+            "plant.actuator.motor_inertia",
+            |x| x == 0.0 || (MIN_MOTOR_INERTIA..=super::per_joint::MAX_MAGNITUDE).contains(&x),
+            "0 (off) or a number from 1e-9 to 1e9, kg m²",
+        )?;
         for (i, h) in self.cogging.iter().enumerate() {
             let key = format!("plant.actuator.cogging[{i}]");
             if !(h.order > 0.0 && h.order <= MAX_ORDER) {

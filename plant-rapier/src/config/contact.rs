@@ -178,6 +178,9 @@ impl ContactConfig {
     }
 }
 
+/// The lightest object taken, kg (a microgram).
+pub const MIN_OBJECT_MASS_KG: f64 = 1e-9;
+
 /// More obstacles than a workspace needs is a mistake, not a scene.
 const MAX_OBSTACLES: usize = 1000;
 
@@ -230,8 +233,14 @@ impl ContactObject {
     fn validate(&self, i: usize) -> Result<(), PlantError> {
         let key = |k: &str| format!("plant.contact.object[{i}].{k}");
         self.geometry(i)?;
-        if !(self.mass.is_finite() && self.mass > 0.0 && self.mass <= 1e4) {
-            return Err(invalid(&key("mass"), self.mass, "a mass in (0, 10000] kg"));
+        // A microgram at least: 1e-300 kg passed "> 0" and then faulted on
+        // every step.
+        if !(self.mass >= MIN_OBJECT_MASS_KG && self.mass <= 1e4) {
+            return Err(invalid(
+                &key("mass"),
+                short(self.mass),
+                "a mass in [1e-9, 10000] kg",
+            ));
         }
         place(&self.xyz, &self.rpy, &key)?;
         if !(self.grasp_at_s.is_finite() && self.grasp_at_s >= 0.0 && self.grasp_at_s <= 1e6) {

@@ -214,9 +214,10 @@ pub struct ActuationConfig {
     pub drop_probability: f64,
 }
 
-/// A number as a message shows it: 1e308, not its 309 digits.
+/// A number as a message shows it: 1e308, not its 309 digits (nor 1e-300
+/// as 300 zeros).
 pub(super) fn short(x: f64) -> String {
-    if x.is_finite() && x.abs() >= 1e15 {
+    if x.is_finite() && (x.abs() >= 1e15 || (x != 0.0 && x.abs() < 1e-6)) {
         format!("{x:e}")
     } else {
         x.to_string()

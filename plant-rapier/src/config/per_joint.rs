@@ -76,7 +76,12 @@ impl PerJoint {
         )
     }
 
-    fn check_with(&self, key: &str, ok: fn(f64) -> bool, need: &str) -> Result<(), PlantError> {
+    pub(super) fn check_with(
+        &self,
+        key: &str,
+        ok: fn(f64) -> bool,
+        need: &str,
+    ) -> Result<(), PlantError> {
         match self {
             Self::All(x) if !ok(*x) => Err(invalid(key, short(*x), need)),
             Self::Each(v) => match v.iter().position(|x| !ok(*x)) {

@@ -16,6 +16,11 @@ use crate::{ContactConfig, PlantError};
 const ARM: Group = Group::GROUP_1;
 const OBSTACLES: Group = Group::GROUP_2;
 const OBJECTS: Group = Group::GROUP_3;
+/// How far from the grasping link's frame an object's surface may be when
+/// the link grasps it, m: the longest link of a shipped arm is under
+/// 0.5 m, so this takes anything a link can reach and nothing across the
+/// workspace.
+pub const MAX_GRASP_DISTANCE_M: f64 = 2.0;
 /// What a free object meets.
 const OBJECT_MEETS: Group = ARM.union(OBSTACLES).union(OBJECTS);
 
@@ -182,8 +187,25 @@ impl Contacts {
 
     /// Object `i` joins its link where it now is: its collider (and so its
     /// mass and inertia) rides on the link's body; its own body rests.
+    /// An object farther than [`MAX_GRASP_DISTANCE_M`] from the link's
+    /// frame is refused: a gripper holds what it touches, and a grasp from
+    /// 900 m away once carried the object across the world.
     pub(super) fn grasp(&self, i: usize, world: &mut PhysicsWorld) -> Result<(), PlantError> {
         let (h, at, link) = self.where_held(i, world)?;
+        let gap = world.colliders.get(h.collider).map_or(0.0, |c| {
+            c.shape()
+                .distance_to_point(&at, link.position().translation, true)
+        });
+        // NaN (a broken shape) is refused too.
+        if gap.is_nan() || gap > MAX_GRASP_DISTANCE_M {
+            return Err(PlantError::InvalidConfig {
+                key: format!("plant.contact.object[{i}]"),
+                value: format!("{gap:.3e} m from its link's frame when grasped"),
+                need: format!(
+                    "within {MAX_GRASP_DISTANCE_M} m of the grasping link's frame at grasp_at_s"
+                ),
+            });
+        }
         let relative = link.position().inverse() * at;
         let PhysicsWorld {
             colliders, bodies, ..
