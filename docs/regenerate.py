@@ -475,8 +475,11 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--check", action="store_true", help="exit 1 if a generated page is stale")
     p.add_argument("pages", nargs="*", metavar="PAGE", help=f"only these pages (of {', '.join(PAGES)})")
+    p.add_argument("--skip", action="append", default=[], metavar="PAGE",
+                   help="leave this page out (repeatable; the test suite skips robustness.md, "
+                        "about 10 minutes of runs)")
     args = p.parse_args()
-    unknown = [n for n in args.pages if n not in PAGES]
+    unknown = [n for n in args.pages + args.skip if n not in PAGES]
     if unknown:
         p.error(f"no page {', '.join(unknown)}: the pages are {', '.join(PAGES)}")
     OUT.mkdir(exist_ok=True)
@@ -484,7 +487,7 @@ def main() -> int:
     WRITE_FIGURES = not args.check
     stale = []
     for name, make in PAGES.items():
-        if args.pages and name not in args.pages:
+        if (args.pages and name not in args.pages) or name in args.skip:
             continue
         text = make()
         path = OUT / name
