@@ -85,3 +85,89 @@ fn a_non_finite_output_is_an_error_naming_the_component() {
         e => panic!("expected NotFinite, got {e:?}"),
     }
 }
+
+/// The run's config for a pd base law on two joints at 1 kHz.
+fn pd_config() -> controller::node::ControllerNodeConfig {
+    controller::node::ControllerNodeConfig {
+        params: controller::ControllerParams {
+            law: controller::LawName::Pd,
+            ..Default::default()
+        },
+        dof: 2,
+        period_ns: 1_000_000,
+        reference_period_ns: 0,
+        model: None,
+        own_params: Default::default(),
+        own_diagnostics: String::new(),
+    }
+}
+
+/// State k of a made-up motion and a reference with k_c = 0.5.
+fn sample(k: u64) -> (wire::JointState, wire::ReferenceSample) {
+    let mut s = wire::JointState::default();
+    s.header.seq = k;
+    s.header.t_ns = k * 1_000_000;
+    let mut r = wire::ReferenceSample::default();
+    r.header.t_ns = s.header.t_ns;
+    for i in 0..2 {
+        s.q_measured[i] = 0.01 * k as f64 + i as f64;
+        s.qd_measured[i] = 0.3 - 0.02 * k as f64;
+        s.q[i] = s.q_measured[i];
+        s.qd[i] = s.qd_measured[i];
+        r.q_d[i] = 0.5 * i as f64;
+        r.kc[i] = 0.5;
+    }
+    (s, r)
+}
+
+#[test]
+fn the_action_is_taken_every_decimation_periods_held_and_added_to_the_base_law() {
+    let policy = Policy::load(&fixture("linear.onnx")).unwrap();
+    let r = policy.record().clone();
+    let mut law = policy::PolicyLaw::new(policy.clone(), &pd_config()).unwrap();
+    let mut base = pd_config().machine().unwrap();
+    let (mut obs, mut action, mut held) = (vec![0.0; 15], [0.0; 2], [0.0; 2]);
+    let mut changes = 0;
+    for k in 0..45u64 {
+        let (s, reference) = sample(k);
+        let (cmd, diag, err) = law.step(&s, Some(&reference));
+        assert!(err.is_none());
+        if k % 20 == 0 {
+            // The environment's observation and action map, by hand.
+            gym_env::observe(
+                &s,
+                &reference,
+                k,
+                r.steps,
+                true,
+                &r.velocity_scale,
+                &mut obs,
+            );
+            policy.act(&obs, &mut action).unwrap();
+            let before = held;
+            gym_env::action_torque(&action, r.span(), &r.torque_scale, &mut held);
+            changes += usize::from(before != held);
+        }
+        let (want, _) = base.step(&s, Some(&reference));
+        for i in 0..2 {
+            assert_eq!(
+                cmd.tau[i].to_bits(),
+                (want.tau[i] + held[i]).to_bits(),
+                "k {k}, joint {i}"
+            );
+        }
+        assert_eq!(diag.tau[..2], cmd.tau[..2]);
+    }
+    assert_eq!(changes, 3, "a new action at k = 0, 20 and 40 only");
+}
+
+#[test]
+fn without_a_reference_the_torque_is_zero_with_the_fault() {
+    let policy = Policy::load(&fixture("linear.onnx")).unwrap();
+    let mut law = policy::PolicyLaw::new(policy, &pd_config()).unwrap();
+    let (s, _) = sample(0);
+    let (cmd, _, err) = law.step(&s, None);
+    assert!(err.is_none());
+    assert_eq!(cmd.tau, [0.0; wire::MAX_DOF]);
+    assert_eq!(cmd.fault, wire::Fault::NoReference.code());
+}
