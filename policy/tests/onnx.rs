@@ -149,10 +149,10 @@ fn the_action_is_taken_every_decimation_periods_held_and_added_to_the_base_law()
             changes += usize::from(before != held);
         }
         let (want, _) = base.step(&s, Some(&reference));
-        for i in 0..2 {
+        for (i, h) in held.iter().enumerate() {
             assert_eq!(
                 cmd.tau[i].to_bits(),
-                (want.tau[i] + held[i]).to_bits(),
+                (want.tau[i] + h).to_bits(),
                 "k {k}, joint {i}"
             );
         }
