@@ -26,6 +26,44 @@ pub struct Samples {
     pub values: Vec<Vec<f64>>,
 }
 
+/// The closest two sample times may be, s: a microsecond. Times 1e-300
+/// apart passed "increasing" and made the spline's slopes overflow on
+/// every step.
+pub const MIN_TIME_STEP_S: f64 = 1e-6;
+
+/// The largest |t| taken, s (eleven days).
+pub const MAX_TIME_S: f64 = 1e6;
+
+/// The largest |value| taken (rad or m for a reference, the envelope's
+/// width for an envelope): 1e3 is past any joint's travel, where 1e200
+/// passed "finite" and then overflowed the controller's squares.
+pub const MAX_VALUE: f64 = 1e3;
+
+/// Why `v`, a time, is out of bounds after `last` (None: it is not).
+fn time_out_of_bounds(v: f64, last: Option<f64>) -> Option<String> {
+    if !(-MAX_TIME_S..=MAX_TIME_S).contains(&v) {
+        return Some(format!(
+            "time {v:e} is out of range: times must be from -1e6 to 1e6 s"
+        ));
+    }
+    match last {
+        Some(last) if v <= last => Some(format!(
+            "time {v} does not come after the previous row's {last}: times must increase"
+        )),
+        Some(last) if v - last < MIN_TIME_STEP_S => Some(format!(
+            "time {v:e} comes {:e} s after the previous row's {last:e}: times must be at least 1e-6 s apart",
+            v - last
+        )),
+        _ => None,
+    }
+}
+
+/// Why `v`, a value, is out of bounds (None: it is not).
+fn value_out_of_bounds(v: f64) -> Option<String> {
+    (!(-MAX_VALUE..=MAX_VALUE).contains(&v))
+        .then(|| format!("{v:e} is out of range: values must be from -1000 to 1000"))
+}
+
 fn csv_error(
     source: &str,
     row: usize,
@@ -136,21 +174,14 @@ impl Samples {
                 ));
             }
             if c == 0 {
-                if let Some(&last) = self.t.last()
-                    && v <= last
-                {
-                    return Err(csv_error(
-                        &self.source,
-                        row,
-                        1,
-                        name,
-                        format!(
-                            "time {v} does not come after the previous row's {last}: times must increase"
-                        ),
-                    ));
+                if let Some(why) = time_out_of_bounds(v, self.t.last().copied()) {
+                    return Err(csv_error(&self.source, row, 1, name, why));
                 }
                 self.t.push(v);
             } else {
+                if let Some(why) = value_out_of_bounds(v) {
+                    return Err(csv_error(&self.source, row, c + 1, name, why));
+                }
                 self.values[c - 1].push(v);
             }
         }
@@ -182,6 +213,20 @@ impl Samples {
             .any(|v| !v.is_finite())
         {
             return Err(invalid("a value is not finite".into()));
+        }
+        for (k, v) in self.t.iter().enumerate() {
+            let last = k.checked_sub(1).map(|j| self.t[j]);
+            if let Some(why) = time_out_of_bounds(*v, last) {
+                return Err(invalid(format!("time {k}: {why}")));
+            }
+        }
+        if let Some(why) = self
+            .values
+            .iter()
+            .flatten()
+            .find_map(|v| value_out_of_bounds(*v))
+        {
+            return Err(invalid(why));
         }
         Ok(())
     }
@@ -322,5 +367,44 @@ mod tests {
         assert!(e("time,a\n0,0\n").contains("the header must be `t`"));
         assert!(e("t,a\n0,NaN\n1,0\n").contains("row 2, column 2 ('a'): NaN is not finite"));
         assert!(e("t,a\n0,0\n").contains("at least two rows"));
+    }
+
+    /// Issue 48 item 10 (N12): times 1e-300 apart and values of 1e200 or
+    /// 1e300 passed "finite and increasing" and then faulted on every
+    /// step; they are refused by row, column and range, in a file and
+    /// given inline, and the edges are taken.
+    #[test]
+    fn samples_beyond_physical_bounds_are_refused() {
+        let e = |text: &str| Samples::from_csv(text, "f.csv").unwrap_err().to_string();
+        let close = e("t,a\n0,0\n1e-300,1\n");
+        assert!(
+            close.contains("row 3, column 1 ('t')") && close.contains("at least 1e-6 s"),
+            "{close}"
+        );
+        for v in ["1e200", "1e300", "-1001"] {
+            let big = e(&format!("t,a\n0,0\n1,{v}\n"));
+            assert!(
+                big.contains("row 3, column 2 ('a')") && big.contains("from -1000 to 1000"),
+                "{big}"
+            );
+        }
+        let late = e("t,a\n0,0\n1e300,1\n");
+        assert!(late.contains("from -1e6 to 1e6 s"), "{late}");
+        Samples::from_csv("t,a\n0,-1000\n1e-6,1000\n", "f.csv").unwrap();
+        let inline = |t: Vec<f64>, v: Vec<f64>| Samples {
+            t,
+            values: vec![v],
+            ..Samples::from_csv("t,a\n0,0\n1,0\n", "f.csv").unwrap()
+        };
+        for bad in [
+            inline(vec![0.0, 1e-300], vec![0.0, 1.0]),
+            inline(vec![0.0, 1.0], vec![0.0, 1e300]),
+        ] {
+            let e = bad.validate("reference.samples").unwrap_err().to_string();
+            assert!(e.contains("reference.samples"), "{e}");
+        }
+        inline(vec![0.0, 1e-6], vec![0.0, 1e3])
+            .validate("reference.samples")
+            .unwrap();
     }
 }

@@ -19,6 +19,9 @@ pub struct Waypoint {
     pub dwell_s: f64,
 }
 
+/// The largest |q| of a waypoint, rad or m: past any joint's travel.
+pub const MAX_POSITION: f64 = 1e3;
+
 /// Checks `points`: finite, one position per joint, each move with time to
 /// happen. Returns the number of joints.
 pub(crate) fn validate(points: &[Waypoint]) -> Result<usize, TrajectoryError> {
@@ -52,6 +55,23 @@ pub(crate) fn validate(points: &[Waypoint]) -> Result<usize, TrajectoryError> {
                 });
             }
         }
+        // Finite is not enough: q = 1e300 passed and overflowed every step.
+        if let Some(v) = p.q.iter().find(|v| v.abs() > MAX_POSITION) {
+            return Err(invalid(
+                k,
+                "q",
+                format!("{v:e} is out of range: positions must be from -1000 to 1000 (rad or m)"),
+            ));
+        }
+        for (name, v) in [("t", p.t), ("dwell_s", p.dwell_s)] {
+            if v.abs() > crate::samples::MAX_TIME_S {
+                return Err(invalid(
+                    k,
+                    name,
+                    format!("{v:e} is out of range: times must be from -1e6 to 1e6 s"),
+                ));
+            }
+        }
         if p.dwell_s < 0.0 {
             return Err(invalid(k, "dwell_s", format!("{} is negative", p.dwell_s)));
         }
@@ -64,6 +84,18 @@ pub(crate) fn validate(points: &[Waypoint]) -> Result<usize, TrajectoryError> {
                     format!(
                         "{} is not after the previous waypoint's departure at {leave} s (its t plus dwell_s): a move needs time",
                         p.t
+                    ),
+                ));
+            }
+            // A 1 ns move's quintic has accelerations of 1e18 rad/s².
+            if p.t - leave < crate::samples::MIN_TIME_STEP_S {
+                return Err(invalid(
+                    k,
+                    "t",
+                    format!(
+                        "{} is {:e} s after the previous waypoint's departure at {leave} s: a move needs at least 1e-6 s",
+                        p.t,
+                        p.t - leave
                     ),
                 ));
             }
@@ -139,5 +171,34 @@ mod tests {
             e.to_string().contains("2 positions, but waypoint 0 has 1"),
             "{e}"
         );
+    }
+
+    /// Issue 48 item 10 (N12): a waypoint at q = 1e300, or a move of 1 ns,
+    /// passed "finite, after the previous one" and then faulted on every
+    /// step; they are refused by key, value and range, and the edges are
+    /// taken.
+    #[test]
+    fn waypoints_beyond_physical_bounds_are_refused() {
+        let e = validate(&[wp(0.0, 0.0, 0.0), wp(1.0, 1e300, 0.0)])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("reference.waypoints[1].q")
+                && e.contains("1e300")
+                && e.contains("from -1000 to 1000"),
+            "{e}"
+        );
+        let e = validate(&[wp(0.0, 0.0, 1.0), wp(1.0 + 1e-9, 1.0, 0.0)])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("reference.waypoints[1].t") && e.contains("at least 1e-6 s"),
+            "{e}"
+        );
+        let e = validate(&[wp(0.0, 0.0, 0.0), wp(1e300, 1.0, 0.0)])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("from -1e6 to 1e6 s"), "{e}");
+        validate(&[wp(0.0, -1e3, 0.0), wp(1e-6, 1e3, 0.0)]).unwrap();
     }
 }
