@@ -5,6 +5,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::ControllerError;
 
+/// The largest gain K1_i, K2_i: a million times the paper's order of
+/// magnitude is far past any real arm's and still leaves K e and K ė finite
+/// for any error the envelope allows. Declared beside [`Gain`], which checks
+/// it, so that the parameters' module imports this one and not the reverse.
+pub const MAX_GAIN: f64 = 1e6;
+
 /// K = diag(K_i): one number for every joint, or one per joint.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(
@@ -46,7 +52,7 @@ impl Gain {
         }
     }
 
-    /// Checks every entry is in (0, [`crate::MAX_GAIN`]] (written so NaN
+    /// Checks every entry is in (0, [`MAX_GAIN`]] (written so NaN
     /// fails): a gain of 1e308 passed "finite and > 0" and then faulted on
     /// every step.
     pub(crate) fn check_positive(&self, key: &str) -> Result<(), ControllerError> {
@@ -55,7 +61,7 @@ impl Gain {
             value: format!("{v:?}"),
             need: "a number in (0, 1e6]".into(),
         };
-        let ok = |x: &f64| *x > 0.0 && *x <= crate::MAX_GAIN;
+        let ok = |x: &f64| *x > 0.0 && *x <= MAX_GAIN;
         match self {
             Self::All(x) if !ok(x) => Err(bad(key.to_string(), *x)),
             Self::Each(v) if v.is_empty() => Err(ControllerError::InvalidParameter {

@@ -213,10 +213,7 @@ parameters! {
 /// The longest prescribed time T_c, s ([`ControllerParams::tc`]).
 pub const MAX_TC_S: f64 = 1e4;
 
-/// The largest gain K1_i, K2_i: a million times the paper's order of
-/// magnitude is far past any real arm's and still leaves K e and K ė finite
-/// for any error the envelope allows ([`crate::Gain`]).
-pub const MAX_GAIN: f64 = 1e6;
+pub use crate::gain::MAX_GAIN;
 
 /// The most neurons a network may have: checked before anything is
 /// allocated (the paper uses 10; the per-input layout has this many per
