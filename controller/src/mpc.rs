@@ -94,7 +94,11 @@ pub(crate) enum MpcSetupError {
     Riccati,
     /// clarabel refused the problem.
     #[error("the QP solver refused the problem: {0}")]
-    Solver(String),
+    Solver(#[from] clarabel::solver::SolverError),
+    /// clarabel refused the settings (a setting out of its range: every
+    /// step would otherwise solve with defaults the law was not tested with).
+    #[error("the QP solver refused its settings: {0}")]
+    Settings(#[from] clarabel::solver::DefaultSettingsBuilderError),
 }
 
 impl ErrorMpc {
@@ -215,8 +219,7 @@ impl JointQp {
             SupportedConeT::ZeroConeT(layout.equality_rows()),
             SupportedConeT::NonnegativeConeT(a.m - layout.equality_rows()),
         ];
-        let solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings())
-            .map_err(|e| MpcSetupError::Solver(e.to_string()))?;
+        let solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings()?)?;
         let [ke, kv] = lqr_gain(&terminal, theta);
         Ok(Self {
             solver,
@@ -265,7 +268,7 @@ impl JointQp {
     }
 }
 
-fn settings() -> DefaultSettings<f64> {
+fn settings() -> Result<DefaultSettings<f64>, clarabel::solver::DefaultSettingsBuilderError> {
     // Presolve and dropped zeros are off so that `update_b` is allowed.
     // The QP is small and well scaled (see `Weights`): iterative
     // refinement would halve the solve rate and change nothing the law
@@ -277,7 +280,6 @@ fn settings() -> DefaultSettings<f64> {
         .iterative_refinement_enable(false)
         .max_iter(50)
         .build()
-        .unwrap_or_default()
 }
 
 /// Where each variable and row of one joint's QP lies. The variables are
