@@ -76,16 +76,6 @@ impl Gain {
             Self::All(_) => Ok(()),
         }
     }
-
-    /// Indices of the joints whose K_i is at or below `bound`.
-    pub fn at_or_below(&self, bound: f64, n: usize) -> Vec<usize> {
-        (0..n)
-            .filter(|&i| match self {
-                Self::All(x) => *x <= bound,
-                Self::Each(v) => v.get(i).is_some_and(|x| *x <= bound),
-            })
-            .collect()
-    }
 }
 
 impl std::fmt::Display for Gain {

@@ -244,11 +244,6 @@ impl LawName {
         )
     }
 
-    /// Whether the law is the paper's or one of its ablations.
-    pub fn is_nac(self) -> bool {
-        matches!(self.kind(), LawKind::Barrier(p) if !p.classic_barrier)
-    }
-
     /// Whether `key` (of `[controller]`) is a parameter of this law.
     pub fn takes(self, key: &str) -> bool {
         COMMON.contains(&key) || self.decl().keys.contains(&key)

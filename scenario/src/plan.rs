@@ -100,21 +100,10 @@ impl Plan {
         self.period_ns as f64 / 1e9
     }
 
-    /// Sim time of step `k` in nanoseconds.
-    pub fn t_ns(&self, k: u64) -> u64 {
-        k * self.period_ns
-    }
-
     /// How far ahead of its time the real-time trajectory publishes each
     /// sample, ns (a whole number of reference periods, rounded up).
     pub fn reference_horizon_ns(&self) -> u64 {
         self.scenario.reference.horizon_ns(self.reference_period_ns)
-    }
-
-    /// Time of the newest reference sample at or before `t_ns`: the one a
-    /// controller at `t_ns` uses.
-    pub fn reference_t_ns(&self, t_ns: u64) -> u64 {
-        t_ns / self.reference_period_ns * self.reference_period_ns
     }
 }
 

@@ -290,12 +290,6 @@ impl Plant {
         Ok((m, h))
     }
 
-    /// Whether any joint has friction.
-    pub fn has_friction(&self) -> bool {
-        let f = &self.friction;
-        f.viscous.iter().chain(&f.coulomb).any(|x| *x != 0.0)
-    }
-
     /// The friction torque each joint feels at its current velocity
     /// (the torque the friction model adds, so opposite to q̇).
     pub fn friction_torque(&self) -> Vec<f64> {
