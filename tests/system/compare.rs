@@ -671,5 +671,8 @@ fn a_law_set_reaches_its_law_only() {
         "--law-set",
         "mpc:controller.mpc_step=-1",
     ]));
-    assert!(err.contains("controller.mpc_step = -1 is invalid"), "{err}");
+    assert!(
+        err.contains("mpc, seed 0") && err.contains("controller.mpc_step = -1"),
+        "{err}"
+    );
 }
