@@ -81,3 +81,54 @@ pub fn channels() -> Vec<ChannelSpec> {
     ]);
     all
 }
+
+/// Where the Python log reader keeps the schemas this build writes.
+pub const PYTHON_SCHEMAS_PATH: &str = "python/testbed_controller/log_schemas.py";
+
+/// The Python module that tells `testbed_controller.log` which schemas a
+/// log of this build holds: topic → [schema name, `ros2msg` text] for every
+/// channel. The reader refuses a log whose schemas differ before it decodes
+/// anything, as this crate's reader reads only its own messages: a schema
+/// of 5 M lines, one that says uint64 for uint32, an empty one or one
+/// nested a thousand deep would otherwise be decoded into garbage, or not
+/// in minutes.
+pub fn python_schemas_module() -> String {
+    let map: std::collections::BTreeMap<&str, (String, String)> = channels()
+        .into_iter()
+        .map(|c| (c.topic, (c.schema_name, c.schema)))
+        .collect();
+    // JSON's strings and arrays are Python literals too.
+    let body = serde_json::to_string_pretty(&map).unwrap_or_default();
+    format!(
+        "\"\"\"The `ros2msg` schemas a log of this build of the testbed holds, per topic:\n\
+         [schema name, schema text]. Generated from the Rust logger's channels\n\
+         (`logger::python_schemas_module`); `cargo test -p logger --lib python_schemas`\n\
+         checks it is current, `TESTBED_WRITE_DOCS=1` rewrites it.\"\"\"\n\n\
+         SCHEMA_ENCODING = {SCHEMA_ENCODING:?}\n\
+         MESSAGE_ENCODING = {MESSAGE_ENCODING:?}\n\n\
+         SCHEMAS = {body}\n"
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    use super::*;
+
+    /// The committed Python module equals what this build writes (write it
+    /// with `TESTBED_WRITE_DOCS=1`).
+    #[test]
+    fn committed_python_schemas_are_current() {
+        let path = format!("{}/../{PYTHON_SCHEMAS_PATH}", env!("CARGO_MANIFEST_DIR"));
+        let module = python_schemas_module();
+        if std::env::var_os("TESTBED_WRITE_DOCS").is_some() {
+            std::fs::write(&path, &module).unwrap();
+        }
+        let shipped = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            shipped == module,
+            "{path} is stale: TESTBED_WRITE_DOCS=1 cargo test -p logger --lib python_schemas"
+        );
+        assert!(module.contains("\"/joint_state\": [\n    \"testbed_msgs/msg/JointState\""));
+    }
+}

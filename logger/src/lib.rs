@@ -49,7 +49,7 @@ mod writer;
 
 pub use channels::{
     ChannelSpec, JOINT_COMMANDS_TOPIC, JOINT_STATES_TOPIC, MESSAGE_ENCODING, PROFILE,
-    SCHEMA_ENCODING, channels,
+    PYTHON_SCHEMAS_PATH, SCHEMA_ENCODING, channels, python_schemas_module,
 };
 pub use compression::{LogCompression, UnknownCompression};
 pub use decode::{Decode, decode_logged};
