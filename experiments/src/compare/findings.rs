@@ -321,6 +321,15 @@ fn outside(c: &Comparison, nac: &LawRow) -> Finding {
     }
 }
 
+/// A finding with no test behind it.
+fn done(claim: &str, verdict: Verdict, evidence: String) -> Draft {
+    Draft::Done(Finding {
+        claim: claim.to_string(),
+        verdict,
+        evidence,
+    })
+}
+
 /// The row `nac` is tested against, or the final finding when there is
 /// nothing to test: `other` did not run, or no `nac` run reached T_c.
 fn opponent<'a>(
@@ -329,21 +338,16 @@ fn opponent<'a>(
     other: LawName,
     claim: &str,
 ) -> Result<&'a LawRow, Draft> {
-    let done = |verdict, evidence| {
-        Draft::Done(Finding {
-            claim: claim.to_string(),
-            verdict,
-            evidence,
-        })
-    };
     let Some(o) = row(c, other) else {
         return Err(done(
+            claim,
             Verdict::NotTested,
             format!("{other} is not in the comparison"),
         ));
     };
     if nac.not_judged == nac.runs.len() as u64 {
         return Err(done(
+            claim,
             Verdict::NotJudged,
             format!("every run ended before T_c = {} s", tc(nac)),
         ));
@@ -358,13 +362,6 @@ fn separates(c: &Comparison, nac: &LawRow, other: LawName, claim: &str, runs: us
     let o = match opponent(c, nac, other, &claim) {
         Ok(o) => o,
         Err(done) => return done,
-    };
-    let done = |verdict, evidence| {
-        Draft::Done(Finding {
-            claim: claim.clone(),
-            verdict,
-            evidence,
-        })
     };
     let pairs = || nac.runs.iter().zip(&o.runs).take(runs);
     let only = |a: Envelope, b: Envelope| {
@@ -392,6 +389,7 @@ fn separates(c: &Comparison, nac: &LawRow, other: LawName, claim: &str, runs: us
     );
     if a_only + b_only == 0 {
         return done(
+            &claim,
             Verdict::NotTested,
             format!("{evidence}; no seed separates them"),
         );
@@ -423,16 +421,10 @@ fn better(
         Ok(o) => o,
         Err(done) => return done,
     };
-    let done = |verdict, evidence| {
-        Draft::Done(Finding {
-            claim: claim.clone(),
-            verdict,
-            evidence,
-        })
-    };
     let (a, b) = (values(nac, metric, runs), values(o, metric, runs));
     if a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()) {
         return done(
+            &claim,
             Verdict::NotTested,
             format!(
                 "identical, not tested: nac and {other} gave the same {metric} bit for bit on every seed (median {})",
