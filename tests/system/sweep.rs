@@ -199,7 +199,7 @@ fn sweep_errors_name_the_file_and_key_and_run_nothing() {
         ),
         (
             "[[axis]]\nkey = \"controller.beta\"\nvalues = [-1.0]\n",
-            "controller.beta = -1 is invalid",
+            "controller.beta = -1.0 is invalid",
         ),
         (
             "[[axis]]\nkey = \"controller.k1\"\nrange = { start = 1.0, stop = 2.0, num = 0 }\n",
