@@ -39,6 +39,9 @@ pub struct ResetOptions {
 /// One arm's episodes.
 pub struct ArmEnv {
     plan: Plan,
+    /// The scenario before any draw or reset option: what every reset
+    /// starts from, so that one reset's options do not outlive it.
+    undrawn: scenario::Scenario,
     opts: EnvOptions,
     scale: Vec<f64>,
     velocity: Vec<f64>,
@@ -66,6 +69,7 @@ impl ArmEnv {
         let seed = plan.scenario.seed;
         let (stepper, base) = episode(&plan, &opts)?;
         Ok(Self {
+            undrawn: plan.undrawn.clone(),
             plan,
             opts,
             scale,
@@ -94,7 +98,7 @@ impl ArmEnv {
         opts: &ResetOptions,
         obs: &mut [f64],
     ) -> Result<(), EnvError> {
-        let mut s = self.plan.undrawn.clone();
+        let mut s = self.undrawn.clone();
         s.seed = seed;
         for (name, given, into) in [
             ("initial_q", &opts.initial_q, &mut s.initial.q),

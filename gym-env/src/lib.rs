@@ -28,7 +28,8 @@
 //! ```
 //!
 //! # Limitations
-//! - The vector form steps its arms one after another, on one thread.
+//! - The vector form steps each arm on one thread (arms in parallel on a
+//!   pool, [`ArmEnvs::with_threads`]); one arm's step is never split.
 //! - The picture is a projection of the link frames' origins onto one
 //!   plane: links are drawn as segments between joints, not as meshes.
 
@@ -45,4 +46,4 @@ pub use options::{
 };
 pub use policy_io::{action_torque, observe};
 pub use render::{Picture, Projection};
-pub use vector::{ArmEnvs, MAX_ENVS, SeedStream};
+pub use vector::{ArmEnvs, Autoreset, MAX_ENVS, MAX_THREADS, SeedStream, default_threads};

@@ -117,6 +117,9 @@ pub enum EnvError {
     /// The base law cannot be built.
     #[error("base law: {0}")]
     Controller(#[from] controller::ControllerError),
+    /// The vector form's threads cannot be started.
+    #[error("num_threads: cannot start the threads: {0}")]
+    Threads(#[from] rayon::ThreadPoolBuildError),
 }
 
 impl EnvError {

@@ -4,7 +4,7 @@
 
 use scenario::Plan;
 
-use crate::arm::{ArmEnv, Outcome};
+use crate::arm::{ArmEnv, Outcome, ResetOptions};
 use crate::options::{EnvError, EnvOptions};
 
 /// A stream of episode seeds (SplitMix64): what a reset without a seed
@@ -32,17 +32,69 @@ impl SeedStream {
 /// plant, reference and buffers: tens of kB).
 pub const MAX_ENVS: usize = 1 << 16;
 
-/// Many arms of one scenario, stepped in one call.
+/// Many arms of one scenario, stepped in one call, on a pool of threads
+/// (one arm is never split: each steps on one thread, so the results do
+/// not depend on the thread count).
 pub struct ArmEnvs {
     envs: Vec<ArmEnv>,
     seeds: Vec<SeedStream>,
     ended: Vec<bool>,
     obs_dim: usize,
+    n: usize,
+    /// None: the arms step one after another on the caller's thread.
+    pool: Option<rayon::ThreadPool>,
+    /// Rows for the outcomes and final observations a call does not ask
+    /// for (a reset; a NEXT_STEP step), kept to allocate once.
+    spare_out: Vec<Outcome>,
+    spare_obs: Vec<f64>,
+}
+
+/// One arm's part of a call: its environment, seed stream, ended flag,
+/// observation row, outcome and final-observation row.
+struct Arm<'a> {
+    index: usize,
+    env: &'a mut ArmEnv,
+    seeds: &'a mut SeedStream,
+    ended: &'a mut bool,
+    obs: &'a mut [f64],
+    out: &'a mut Outcome,
+    final_obs: &'a mut [f64],
+}
+
+/// What happens to an arm whose episode ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Autoreset {
+    /// Gymnasium's NEXT_STEP: the arm resets on the next step (which
+    /// ignores its action and returns the new episode's first observation).
+    NextStep,
+    /// Stable-Baselines3's: the arm resets in the step that ended it; its
+    /// observation is the new episode's first, and the last one of the
+    /// ended episode goes to the caller's `final_obs`.
+    SameStep,
+}
+
+/// The threads a vector steps on by default: one per CPU this process
+/// may use.
+pub fn default_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
 }
 
 impl ArmEnvs {
-    /// `count` copies of the environment of `plan`.
+    /// `count` copies of the environment of `plan`, stepped on
+    /// [`default_threads`] threads.
     pub fn new(plan: Plan, opts: EnvOptions, count: usize) -> Result<Self, EnvError> {
+        Self::with_threads(plan, opts, count, default_threads())
+    }
+
+    /// [`ArmEnvs::new`] on `threads` threads (1: on the caller's thread,
+    /// no pool; more than the arms gives no more speed, so the pool is
+    /// capped at the arm count).
+    pub fn with_threads(
+        plan: Plan,
+        opts: EnvOptions,
+        count: usize,
+        threads: usize,
+    ) -> Result<Self, EnvError> {
         if !(1..=MAX_ENVS).contains(&count) {
             return Err(EnvError::option(
                 "num_envs",
@@ -50,18 +102,41 @@ impl ArmEnvs {
                 format!("must be from 1 to {MAX_ENVS}"),
             ));
         }
+        if !(1..=MAX_THREADS).contains(&threads) {
+            return Err(EnvError::option(
+                "num_threads",
+                threads,
+                format!("must be from 1 to {MAX_THREADS}"),
+            ));
+        }
         let first = ArmEnv::new(plan, opts)?;
         let obs_dim = first.obs_dim();
+        let n = first.dof();
         let mut envs = Vec::with_capacity(count);
         for _ in 1..count {
             envs.push(ArmEnv::new(first.plan().clone(), first.options().clone())?);
         }
         envs.insert(0, first);
+        let threads = threads.min(count);
+        let pool = if threads > 1 {
+            Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .thread_name(|i| format!("gym-env-{i}"))
+                    .build()?,
+            )
+        } else {
+            None
+        };
         Ok(Self {
             seeds: (0..count).map(|i| SeedStream::new(i as u64)).collect(),
             ended: vec![false; count],
+            spare_out: vec![Outcome::default(); count],
+            spare_obs: vec![0.0; count * obs_dim],
             envs,
             obs_dim,
+            n,
+            pool,
         })
     }
 
@@ -80,29 +155,111 @@ impl ArmEnvs {
         self.obs_dim
     }
 
+    /// The threads the arms step on.
+    pub fn threads(&self) -> usize {
+        self.pool
+            .as_ref()
+            .map_or(1, rayon::ThreadPool::current_num_threads)
+    }
+
+    /// Runs `f` on every arm, on the pool if there is one; the first
+    /// error (by arm order) is returned. `out` and `final_obs`: None for
+    /// the spare rows.
+    fn each<F>(
+        &mut self,
+        obs: &mut [f64],
+        out: Option<&mut [Outcome]>,
+        final_obs: Option<&mut [f64]>,
+        f: F,
+    ) -> Result<(), EnvError>
+    where
+        F: Fn(Arm<'_>) -> Result<(), EnvError> + Sync,
+    {
+        let d = self.obs_dim;
+        let out = out.unwrap_or(&mut self.spare_out);
+        let fin = final_obs.unwrap_or(&mut self.spare_obs);
+        let (envs, seeds, ended) = (&mut self.envs, &mut self.seeds, &mut self.ended);
+        let arm = |(index, (((((env, seeds), ended), obs), out), final_obs))| Arm {
+            index,
+            env,
+            seeds,
+            ended,
+            obs,
+            out,
+            final_obs,
+        };
+        match &self.pool {
+            None => envs
+                .iter_mut()
+                .zip(seeds.iter_mut())
+                .zip(ended.iter_mut())
+                .zip(obs.chunks_mut(d))
+                .zip(out.iter_mut())
+                .zip(fin.chunks_mut(d))
+                .enumerate()
+                .try_for_each(|x| f(arm(x))),
+            Some(pool) => pool.install(|| {
+                use rayon::prelude::*;
+                // Whole arms to each task: rayon splits the range in
+                // halves down to single arms, and idle threads steal.
+                let results: Vec<Result<(), EnvError>> = envs
+                    .par_iter_mut()
+                    .zip(seeds.par_iter_mut())
+                    .zip(ended.par_iter_mut())
+                    .zip(obs.par_chunks_mut(d))
+                    .zip(out.par_iter_mut())
+                    .zip(fin.par_chunks_mut(d))
+                    .enumerate()
+                    .map(|x| f(arm(x)))
+                    .collect();
+                results.into_iter().collect()
+            }),
+        }
+    }
+
     /// Resets every environment: environment i with `seed + i` (refused
     /// past 2⁶⁴ − 1 rather than wrapped), and its later episodes with
     /// seeds drawn from a stream that starts there.
     pub fn reset(&mut self, seed: u64, obs: &mut [f64]) -> Result<(), EnvError> {
-        let d = self.obs_dim;
-        let count = self.envs.len() as u64;
-        if seed.checked_add(count - 1).is_none() {
+        self.reset_with(seed, &[ResetOptions::default()], obs)
+    }
+
+    /// [`ArmEnvs::reset`] with each arm's start changed by `opts`: one
+    /// entry for every arm, or one per arm. Only this episode: the arms'
+    /// later episodes (their autoresets) start as the scenario says.
+    pub fn reset_with(
+        &mut self,
+        seed: u64,
+        opts: &[ResetOptions],
+        obs: &mut [f64],
+    ) -> Result<(), EnvError> {
+        let count = self.envs.len();
+        if seed.checked_add(count as u64 - 1).is_none() {
             return Err(EnvError::option(
                 "seed",
                 seed,
                 format!(
                     "arm i gets seed + i: it must be at most {}",
-                    u64::MAX - (count - 1)
+                    u64::MAX - (count as u64 - 1)
                 ),
             ));
         }
-        for (i, env) in self.envs.iter_mut().enumerate() {
-            let s = seed + i as u64;
-            self.seeds[i] = SeedStream::new(s);
-            env.reset(s, &mut obs[i * d..(i + 1) * d])?;
-            self.ended[i] = false;
+        if opts.len() != 1 && opts.len() != count {
+            return Err(EnvError::option(
+                "options",
+                format!("{} entries", opts.len()),
+                format!("one for every arm, or one per arm ({count})"),
+            ));
         }
-        Ok(())
+        self.check_len(obs.len(), self.obs_dim, "observations")?;
+        self.each(obs, None, None, |a| {
+            let s = seed + a.index as u64;
+            *a.seeds = SeedStream::new(s);
+            a.env
+                .reset_with(s, &opts[a.index.min(opts.len() - 1)], a.obs)?;
+            *a.ended = false;
+            Ok(())
+        })
     }
 
     /// One step of every environment with its row of `actions` (n per
@@ -115,19 +272,65 @@ impl ArmEnvs {
         obs: &mut [f64],
         out: &mut [Outcome],
     ) -> Result<(), EnvError> {
-        let d = self.obs_dim;
-        for (i, env) in self.envs.iter_mut().enumerate() {
-            let n = env.dof();
-            let o = &mut obs[i * d..(i + 1) * d];
-            if self.ended[i] {
-                env.reset(self.seeds[i].next_seed(), o)?;
-                out[i] = Outcome::default();
-                self.ended[i] = false;
-            } else {
-                out[i] = env.step(&actions[i * n..(i + 1) * n], o);
-                self.ended[i] = out[i].terminated || out[i].truncated;
-            }
+        self.step_with(Autoreset::NextStep, actions, obs, None, out)
+    }
+
+    /// One step of every environment, ended episodes restarting as
+    /// `mode` says. With [`Autoreset::SameStep`], `final_obs` (one row per
+    /// arm, as `obs`; None: not kept) receives the last observation of each arm whose
+    /// episode ended in this step (other rows are left as they were), and
+    /// `out` keeps that step's outcome; the arm's next episode's seed is
+    /// the same one [`Autoreset::NextStep`] would draw.
+    pub fn step_with(
+        &mut self,
+        mode: Autoreset,
+        actions: &[f64],
+        obs: &mut [f64],
+        final_obs: Option<&mut [f64]>,
+        out: &mut [Outcome],
+    ) -> Result<(), EnvError> {
+        let (d, n) = (self.obs_dim, self.n);
+        self.check_len(actions.len(), n, "actions")?;
+        self.check_len(obs.len(), d, "observations")?;
+        self.check_len(out.len(), 1, "outcomes")?;
+        if let Some(f) = &final_obs {
+            self.check_len(f.len(), d, "final observations")?;
         }
-        Ok(())
+        self.each(obs, Some(out), final_obs, |a| {
+            if *a.ended {
+                a.env.reset(a.seeds.next_seed(), a.obs)?;
+                *a.out = Outcome::default();
+                *a.ended = false;
+                return Ok(());
+            }
+            *a.out = a.env.step(&actions[a.index * n..(a.index + 1) * n], a.obs);
+            if a.out.terminated || a.out.truncated {
+                match mode {
+                    Autoreset::SameStep => {
+                        a.final_obs.copy_from_slice(a.obs);
+                        a.env.reset(a.seeds.next_seed(), a.obs)?;
+                    }
+                    Autoreset::NextStep => *a.ended = true,
+                }
+            }
+            Ok(())
+        })
+    }
+
+    /// A buffer of `len` values must hold `per` for every arm.
+    fn check_len(&self, len: usize, per: usize, what: &str) -> Result<(), EnvError> {
+        let count = self.envs.len();
+        if len == count * per {
+            Ok(())
+        } else {
+            Err(EnvError::option(
+                what,
+                format!("{len} values"),
+                format!("must be {per} per arm for {count} arms"),
+            ))
+        }
     }
 }
+
+/// The most threads a vector steps on.
+pub const MAX_THREADS: usize = 1024;

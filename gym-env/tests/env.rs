@@ -351,8 +351,13 @@ fn reset_options_set_the_start_and_are_checked_by_name() {
         initial_q: Some(vec![0.25; n]),
         initial_qd: None,
     };
+    let plain = env.plan().scenario.initial.q.clone();
     env.reset_with(5, &start, &mut obs).expect("reset");
     assert_eq!(&env.state().q[..n], &vec![0.25; n][..]);
+    // The options hold for that episode only: a plain reset starts where
+    // the scenario says.
+    env.reset(5, &mut obs).expect("reset");
+    assert_eq!(&env.state().q[..n], &plain[..]);
     let bad = gym_env::ResetOptions {
         initial_q: None,
         initial_qd: Some(vec![0.0; n + 1]),

@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use gym_env::{ActionMode, ArmEnv, ArmEnvs, EnvOptions, Outcome, ResetOptions};
+use gym_env::{ActionMode, ArmEnv, ArmEnvs, Autoreset, EnvOptions, Outcome, ResetOptions};
 use numpy::{
     PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods,
 };
@@ -152,6 +152,65 @@ fn reset_options(n: usize, options: Option<&Bound<'_, PyDict>>) -> PyResult<Rese
         }
     }
     Ok(out)
+}
+
+/// The vector form's `reset` `options`: as the single env's, each value n
+/// numbers for every arm or (num_envs, n) numbers, a row per arm.
+fn vec_reset_options(
+    n: usize,
+    count: usize,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Vec<ResetOptions>> {
+    let Some(options) = options else {
+        return Ok(vec![ResetOptions::default()]);
+    };
+    let mut out = vec![ResetOptions::default(); count];
+    for (k, v) in options.iter() {
+        let key: String = take("options key", &k, "a string")?;
+        // A row per arm when the value is two-dimensional (an array of
+        // two dimensions, or a list of sequences); else one for all.
+        let rows: Option<Vec<Bound<'_, PyAny>>> = if v.is_none() {
+            None
+        } else if let Ok(shape) = v.getattr("shape").and_then(|s| s.extract::<Vec<usize>>()) {
+            (shape.len() == 2)
+                .then(|| v.try_iter().and_then(|it| it.collect()))
+                .transpose()?
+        } else {
+            v.extract::<Vec<Bound<'_, PyAny>>>()
+                .ok()
+                .filter(|items| items.first().is_some_and(|x| x.extract::<f64>().is_err()))
+        };
+        let one = PyDict::new(options.py());
+        let Some(rows) = rows else {
+            one.set_item(&key, &v)?;
+            let o = reset_options(n, Some(&one))?;
+            for arm in &mut out {
+                merge(arm, &o);
+            }
+            continue;
+        };
+        if rows.len() != count {
+            return Err(PyValueError::new_err(format!(
+                "reset: options['{key}']: {} rows; expected {n} numbers for every arm or {count} rows of {n}, one per arm",
+                rows.len()
+            )));
+        }
+        for (arm, row) in out.iter_mut().zip(&rows) {
+            one.set_item(&key, row)?;
+            merge(arm, &reset_options(n, Some(&one))?);
+        }
+    }
+    Ok(out)
+}
+
+/// `from`'s given values into `into`.
+fn merge(into: &mut ResetOptions, from: &ResetOptions) {
+    if from.initial_q.is_some() {
+        into.initial_q.clone_from(&from.initial_q);
+    }
+    if from.initial_qd.is_some() {
+        into.initial_qd.clone_from(&from.initial_qd);
+    }
 }
 
 /// A picture as an (height, width, 3) uint8 array.
@@ -381,22 +440,43 @@ pub struct VecEnvCore {
     /// The actions, copied out of the caller's array before the GIL is
     /// released (another thread may write that array meanwhile).
     actions: Vec<f64>,
+    /// The last observations of episodes that ended (same-step autoreset).
+    final_obs: Vec<f64>,
 }
 
 #[pymethods]
 impl VecEnvCore {
     #[new]
-    #[pyo3(signature = (num_envs, scenario=None, **kwargs))]
+    #[pyo3(signature = (num_envs, scenario=None, num_threads=None, **kwargs))]
     fn new(
         num_envs: usize,
         scenario: Option<PathBuf>,
+        num_threads: Option<&Bound<'_, PyAny>>,
         kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        let threads = match num_threads.filter(|v| !v.is_none()) {
+            None => gym_env::default_threads(),
+            Some(v) if v.is_instance_of::<PyBool>() => {
+                return Err(PyTypeError::new_err(
+                    "num_threads: expected a whole number, got bool",
+                ));
+            }
+            Some(v) => {
+                let t: i64 = take("num_threads", v, "a whole number of threads or None")?;
+                usize::try_from(t).map_err(|_| {
+                    PyValueError::new_err(format!(
+                        "num_threads = {t}: must be from 1 to {}",
+                        gym_env::MAX_THREADS
+                    ))
+                })?
+            }
+        };
         let (plan, opts) = load("VecEnvCore", scenario, kwargs)?;
-        let envs = ArmEnvs::new(plan, opts, num_envs).map_err(err)?;
+        let envs = ArmEnvs::with_threads(plan, opts, num_envs, threads).map_err(err)?;
         let n = envs.envs()[0].dof();
         Ok(Self {
             obs: vec![0.0; num_envs * envs.obs_dim()],
+            final_obs: vec![0.0; num_envs * envs.obs_dim()],
             out: vec![Outcome::default(); num_envs],
             actions: vec![0.0; num_envs * n],
             envs,
@@ -404,14 +484,26 @@ impl VecEnvCore {
         })
     }
 
-    /// Resets environment i with `seed + i`; returns the observations.
-    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        self.envs.reset(seed, &mut self.obs).map_err(err)?;
+    /// Resets environment i with `seed + i` (`options`: `initial_q`,
+    /// `initial_qd`, each n numbers for every arm or (num_envs, n), one
+    /// row per arm); returns the observations.
+    #[pyo3(signature = (seed, options=None))]
+    fn reset<'py>(
+        &mut self,
+        py: Python<'py>,
+        seed: u64,
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let opts = vec_reset_options(self.n, self.out.len(), options)?;
+        let (envs, obs) = (&mut self.envs, &mut self.obs);
+        py.detach(|| envs.reset_with(seed, &opts, obs))
+            .map_err(err)?;
         self.observations(py)
     }
 
     /// One step of every arm: `(obs, rewards, terminated, truncated,
-    /// costs)`, arrays of one row per arm.
+    /// costs)`, arrays of one row per arm; an arm whose episode ended
+    /// resets on the next step (Gymnasium's NEXT_STEP).
     #[allow(clippy::type_complexity)] // Reason: the tuple is Gymnasium's step return.
     fn step<'py>(
         &mut self,
@@ -424,40 +516,33 @@ impl VecEnvCore {
         Bound<'py, PyArray1<bool>>,
         Bound<'py, PyArray1<f64>>,
     )> {
-        let count = self.out.len();
-        let a: PyReadonlyArray2<'py, f64> = actions
-            .cast::<PyArray2<f64>>()
-            .map_err(|_| {
-                PyTypeError::new_err(format!(
-                    "actions: expected a float64 array of shape ({count}, {})",
-                    self.n
-                ))
-            })?
-            .readonly();
-        if a.shape() != [count, self.n] {
-            return Err(PyValueError::new_err(format!(
-                "actions: shape {:?}; expected ({count}, {}): one row per arm, one column per joint",
-                a.shape(),
-                self.n
-            )));
-        }
-        // By index, row after row, whatever the memory order (a Fortran-
-        // ordered array's memory is column after column).
-        for (dst, src) in self.actions.iter_mut().zip(a.as_array().iter()) {
-            *dst = *src;
-        }
-        check_finite(&self.actions, Some(self.n))?;
-        let (envs, obs, out, a) = (&mut self.envs, &mut self.obs, &mut self.out, &self.actions);
-        py.detach(|| envs.step(a, obs, out)).map_err(err)?;
-        let pick = |f: fn(&Outcome) -> f64| -> Vec<f64> { self.out.iter().map(f).collect() };
-        let flag = |f: fn(&Outcome) -> bool| -> Vec<bool> { self.out.iter().map(f).collect() };
-        Ok((
-            self.observations(py)?,
-            PyArray1::from_vec(py, pick(|o| o.reward)),
-            PyArray1::from_vec(py, flag(|o| o.terminated)),
-            PyArray1::from_vec(py, flag(|o| o.truncated)),
-            PyArray1::from_vec(py, pick(|o| o.cost)),
-        ))
+        self.step_in(py, actions, Autoreset::NextStep)?;
+        self.outcomes(py)
+    }
+
+    /// One step of every arm, an arm whose episode ended resetting in the
+    /// same step (Stable-Baselines3's convention): `(obs, rewards,
+    /// terminated, truncated, costs, final_obs)`, `final_obs` the ended
+    /// episodes' last observations (rows of arms that did not end: as
+    /// they were).
+    #[allow(clippy::type_complexity)] // Reason: the tuple is the step return and the final rows.
+    fn step_same<'py>(
+        &mut self,
+        py: Python<'py>,
+        actions: &Bound<'py, PyAny>,
+    ) -> PyResult<(
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray2<f64>>,
+    )> {
+        self.step_in(py, actions, Autoreset::SameStep)?;
+        let (obs, r, term, trunc, cost) = self.outcomes(py)?;
+        let fin = PyArray1::from_slice(py, &self.final_obs)
+            .reshape([self.out.len(), self.envs.obs_dim()])?;
+        Ok((obs, r, term, trunc, cost, fin))
     }
 
     /// A picture of arm `index`: an (height, width, 3) uint8 array.
@@ -524,9 +609,90 @@ impl VecEnvCore {
     fn seeds(&self) -> Vec<u64> {
         self.envs.envs().iter().map(ArmEnv::seed).collect()
     }
+
+    /// The threads the arms step on.
+    #[getter]
+    fn num_threads(&self) -> usize {
+        self.envs.threads()
+    }
+
+    /// The scenario's T_c, s.
+    #[getter]
+    fn tc(&self) -> f64 {
+        self.envs.envs()[0].plan().scenario.controller.tc
+    }
+
+    /// Velocity per unit of observation, per joint.
+    #[getter]
+    fn velocity_scale<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.envs.envs()[0].velocity_scale())
+    }
 }
 
 impl VecEnvCore {
+    /// Reads `actions` and steps every arm with the GIL released.
+    fn step_in(
+        &mut self,
+        py: Python<'_>,
+        actions: &Bound<'_, PyAny>,
+        mode: Autoreset,
+    ) -> PyResult<()> {
+        let count = self.out.len();
+        let a: PyReadonlyArray2<'_, f64> = actions
+            .cast::<PyArray2<f64>>()
+            .map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "actions: expected a float64 array of shape ({count}, {})",
+                    self.n
+                ))
+            })?
+            .readonly();
+        if a.shape() != [count, self.n] {
+            return Err(PyValueError::new_err(format!(
+                "actions: shape {:?}; expected ({count}, {}): one row per arm, one column per joint",
+                a.shape(),
+                self.n
+            )));
+        }
+        // By index, row after row, whatever the memory order (a Fortran-
+        // ordered array's memory is column after column).
+        for (dst, src) in self.actions.iter_mut().zip(a.as_array().iter()) {
+            *dst = *src;
+        }
+        check_finite(&self.actions, Some(self.n))?;
+        let (envs, obs, fin, out, a) = (
+            &mut self.envs,
+            &mut self.obs,
+            &mut self.final_obs,
+            &mut self.out,
+            &self.actions,
+        );
+        py.detach(|| envs.step_with(mode, a, obs, Some(fin), out))
+            .map_err(err)
+    }
+
+    #[allow(clippy::type_complexity)] // Reason: the tuple is Gymnasium's step return.
+    fn outcomes<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyArray1<f64>>,
+    )> {
+        let pick = |f: fn(&Outcome) -> f64| -> Vec<f64> { self.out.iter().map(f).collect() };
+        let flag = |f: fn(&Outcome) -> bool| -> Vec<bool> { self.out.iter().map(f).collect() };
+        Ok((
+            self.observations(py)?,
+            PyArray1::from_vec(py, pick(|o| o.reward)),
+            PyArray1::from_vec(py, flag(|o| o.terminated)),
+            PyArray1::from_vec(py, flag(|o| o.truncated)),
+            PyArray1::from_vec(py, pick(|o| o.cost)),
+        ))
+    }
+
     fn observations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         PyArray1::from_slice(py, &self.obs).reshape([self.out.len(), self.envs.obs_dim()])
     }

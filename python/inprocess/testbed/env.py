@@ -129,8 +129,12 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
     7n + 1), rewards, terminated and truncated of shape (num_envs,), and
     `info["cost"]`. An arm whose episode ended resets on the next step
     (Gymnasium's NEXT_STEP autoreset: that step ignores its action and
-    returns its first observation, reward 0). `reset(seed=s)` gives arm i
-    the seed s + i. `render()` gives one picture per arm.
+    returns its first observation, reward 0). `reset(seed=s, options=…)`
+    gives arm i the seed s + i; `options` as the single env's (`initial_q`,
+    `initial_qd`: n numbers for every arm, or (num_envs, n), a row per
+    arm), for that reset only. `render()` gives one picture per arm.
+    `num_threads` (default: every CPU) is how many threads step the arms;
+    the results are the same bits whatever it is.
     """
 
     metadata = {"autoreset_mode": gymnasium.vector.AutoresetMode.NEXT_STEP,
@@ -152,9 +156,8 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         return self._core
 
     def reset(self, *, seed=None, options=None):
-        if options:
-            raise ValueError(f"reset: options {sorted(options)} are not taken by the vector form; "
-                             "pass seed= only")
+        if options is not None and not isinstance(options, dict):
+            raise TypeError(f"reset: options must be a dict, got {type(options).__name__}")
         if seed is not None and not isinstance(seed, (int, np.integer)):
             seeds = [operator.index(s) for s in seed]
             if not seeds or seeds != [seeds[0] + i for i in range(self.num_envs)]:
@@ -163,7 +166,7 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         super().reset(seed=seed)
         if seed is None:
             seed = _seed_from(self.np_random)
-        obs = self._core.reset(int(seed))
+        obs = self._core.reset(int(seed), options or None)
         return obs, {}
 
     def step(self, actions):
