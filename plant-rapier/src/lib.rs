@@ -51,7 +51,9 @@ pub use config::{
 pub use effects::Effects;
 pub use engine::EngineName;
 pub use machine::{PlantMachine, PlantMachineConfig};
-pub use plant::{ContactReading, Plant, check_contact};
+pub use plant::{
+    ContactReading, MAX_SUBSTEPS_PER_SECOND, PeriodCost, Plant, StiffCause, check_contact,
+};
 pub use rig::Rig;
 
 /// Why an arm cannot be built or stepped. Each variant names what is wrong.
@@ -104,6 +106,25 @@ pub enum PlantError {
         value: String,
         /// What it must be.
         need: String,
+    },
+    /// A scenario whose stiffness needs more integrator substeps than the
+    /// testbed runs.
+    #[error(
+        "{keys}: {why}, which needs {substeps:.0} integrator substeps per {period_s} s period ({per_second:.2e} a simulated second: about {wall:.0} s of wall time per simulated second at a microsecond a substep); the testbed takes at most {max:.0e} a simulated second: lower the stiffness or damping, or raise motor_inertia",
+        max = crate::MAX_SUBSTEPS_PER_SECOND,
+        wall = .per_second * 1e-6
+    )]
+    TooStiff {
+        /// The scenario keys that make it stiff.
+        keys: &'static str,
+        /// The rate and the bound a substep keeps.
+        why: String,
+        /// Substeps a period needs.
+        substeps: f64,
+        /// The control period, s.
+        period_s: f64,
+        /// Substeps a simulated second needs.
+        per_second: f64,
     },
     /// Rapier did something this crate did not expect.
     #[error("physics engine: {0}")]

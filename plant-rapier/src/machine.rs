@@ -81,6 +81,8 @@ impl PlantMachine {
             &scaled
         };
         let mut rig = Rig::new(model, config, seed, period_ns)?;
+        // Refused before the first step, not hours into it.
+        rig.plant().period_cost(period_ns as f64 / 1e9)?;
         rig.set_state(q0, qd0)?;
         let n = rig.dof();
         Ok(Self {
@@ -100,6 +102,28 @@ impl PlantMachine {
     /// Number of controlled joints.
     pub fn dof(&self) -> usize {
         self.n
+    }
+
+    /// What a period costs the engine ([`crate::Plant::period_cost`]).
+    pub fn period_cost(&self) -> Result<crate::PeriodCost, PlantError> {
+        self.rig.plant().period_cost(self.period_ns as f64 / 1e9)
+    }
+
+    /// A warning, to say before the run, when the substeps the engine adds
+    /// for stiff springs or damping make the plant alone slower than real
+    /// time: the estimated factor, from substeps timed on a copy of the
+    /// arm (a few hundred, well under a millisecond's worth).
+    pub fn speed_warning(&self) -> Result<Option<String>, PlantError> {
+        let cost = self.period_cost()?;
+        if cost.cause.is_none() {
+            return Ok(None);
+        }
+        let dt = self.period_ns as f64 / 1e9;
+        Ok(self
+            .rig
+            .plant()
+            .time_substeps(dt, 256)
+            .and_then(|s| cost.warning(s)))
     }
 
     /// Control period, ns.

@@ -324,3 +324,76 @@ fn a_motor_inertia_below_any_rotor_is_refused() {
     assert!(e.contains("1e-300"), "the value is named: {e}");
     rig_on(art, elastic(100.0, 0.0, 1e-9, 0.0)).unwrap();
 }
+
+fn machine(actuator: ActuatorConfig) -> Result<plant_rapier::PlantMachine, PlantError> {
+    machine_of(ROTOR, actuator)
+}
+
+fn machine_of(
+    urdf: &str,
+    actuator: ActuatorConfig,
+) -> Result<plant_rapier::PlantMachine, PlantError> {
+    let model = ArmModel::from_urdf_str(urdf).unwrap();
+    let n = model.dof();
+    plant_rapier::PlantMachineConfig {
+        model,
+        plant: PlantConfig {
+            actuator,
+            ..PlantConfig::default()
+        },
+        seed: 0,
+        period_ns: PERIOD_NS,
+        steps: 10,
+        initial_q: vec![0.0; n],
+        initial_qd: vec![0.0; n],
+    }
+    .machine()
+}
+
+/// Issue 48 item 7 (N3): K = 1e9 N m/rad on B = 1e-6 kg m², both within
+/// their documented ranges, needs 2.2e5 substeps per millisecond (the
+/// two-link arm ran at 0.0026× real time, silently). Refused before the
+/// first step, naming the keys, the substeps and the bound; a rigid joint
+/// costs the scenario's own substeps, a stiff spring under the bound more,
+/// with its cause.
+#[test]
+fn a_spring_too_stiff_to_integrate_is_refused_before_the_run() {
+    let e = machine(elastic(1e9, 0.0, 1e-6, 0.0)).unwrap_err();
+    assert!(matches!(e, PlantError::TooStiff { .. }), "{e:?}");
+    let text = e.to_string();
+    for want in [
+        "plant.actuator.stiffness",
+        "motor_inertia",
+        "223608 integrator substeps per 0.001 s period",
+        "at most 1e7 a simulated second",
+    ] {
+        assert!(text.contains(want), "{want:?} missing from: {text}");
+    }
+    let rigid = machine(ActuatorConfig::default()).unwrap();
+    let cost = rigid.period_cost().unwrap();
+    assert_eq!((cost.substeps, cost.asked, cost.cause), (1, 1, None));
+    assert_eq!(rigid.speed_warning().unwrap(), None);
+    let stiff = machine(elastic(1e4, 0.5, 1e-3, 0.0)).unwrap();
+    let cost = stiff.period_cost().unwrap();
+    assert!(cost.substeps > 1 && cost.cause.is_some(), "{cost:?}");
+}
+
+/// Under the bound but slower than real time: 8e6 substeps a simulated
+/// second on the two-link arm, whose substep takes about 1.3 µs in a
+/// release build (so about 0.1× real time, ten times under the line): the
+/// warning estimates the factor from substeps timed here and names the
+/// keys.
+#[test]
+fn a_plant_slower_than_real_time_is_warned() {
+    let m = machine_of(plant_rapier::TWO_LINK_URDF, elastic(1.28e6, 0.0, 1e-6, 0.0)).unwrap();
+    let cost = m.period_cost().unwrap();
+    assert!((8000..8100).contains(&cost.substeps), "{cost:?}");
+    let w = m.speed_warning().unwrap().expect("a warning");
+    for want in [
+        "plant.actuator.stiffness",
+        &format!("{} substeps per 0.001 s period", cost.substeps),
+        "× real time",
+    ] {
+        assert!(w.contains(want), "{want:?} missing from: {w}");
+    }
+}

@@ -491,7 +491,7 @@ pub fn plan(
             need: format!("at least one control period ({} s)", period_ns as f64 / 1e9),
         });
     }
-    Ok(Plan {
+    let mut plan = Plan {
         scenario,
         undrawn,
         source,
@@ -502,7 +502,34 @@ pub fn plan(
         reference_period_ns,
         steps,
         changes,
-    })
+    };
+    if let Some(warning) = stiffness_warning(&plan)? {
+        plan.changes.push(warning);
+    }
+    Ok(plan)
+}
+
+/// Where stiff springs or friction make the plant take more substeps than
+/// the scenario asks (the articulated engine only): refused past the
+/// engine's bound, and said before the run when the plant alone would be
+/// slower than real time. Other faults of building the plant are left to
+/// the run, which reports them as it always has.
+fn stiffness_warning(plan: &Plan) -> Result<Option<String>, ScenarioError> {
+    let p = &plan.scenario.plant;
+    let stiff =
+        p.actuator.elastic() || !p.friction.viscous.is_zero() || !p.friction.coulomb.is_zero();
+    if p.engine != plant_rapier::EngineName::Articulated || !stiff {
+        return Ok(None);
+    }
+    let err = |cause| ScenarioError::Plant {
+        file: plan.source.clone(),
+        cause,
+    };
+    match plan.plant_config().machine() {
+        Ok(machine) => machine.speed_warning().map_err(err),
+        Err(cause @ plant_rapier::PlantError::TooStiff { .. }) => Err(err(cause)),
+        Err(_) => Ok(None),
+    }
 }
 
 #[cfg(test)]
@@ -611,6 +638,46 @@ mod tests {
         assert!(
             e.contains("--set plant.nonsense=3: unknown field `nonsense`") && !e.contains("line "),
             "{e}"
+        );
+    }
+
+    /// #48 item 7 (N3): a spring too stiff to integrate in time is refused
+    /// when the scenario is loaded, before any node starts, naming the
+    /// keys; one under the bound but slower than real time is said among
+    /// the notes printed before the run.
+    #[test]
+    fn a_plant_too_stiff_for_its_period_is_refused_or_said() {
+        let e = load(
+            None,
+            &overrides(
+                None,
+                &[
+                    "plant.actuator.stiffness=1e9",
+                    "plant.actuator.motor_inertia=1e-6",
+                ],
+            ),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("plant.actuator.stiffness") && e.contains("at most 1e7 a simulated second"),
+            "{e}"
+        );
+        let plan = load(
+            None,
+            &overrides(
+                None,
+                &[
+                    "plant.actuator.stiffness=1.28e6",
+                    "plant.actuator.motor_inertia=1e-6",
+                ],
+            ),
+        )
+        .unwrap();
+        assert!(
+            plan.changes.iter().any(|c| c.contains("× real time")),
+            "{:?}",
+            plan.changes
         );
     }
 }

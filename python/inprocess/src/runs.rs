@@ -15,6 +15,10 @@ use experiments::compare::{CompareOptions, DEFAULT_LAWS};
 
 use crate::convert::{ScenarioArgs, err, json_to_py};
 
+/// How often a run in process looks for Ctrl-C, in wall time: a reply
+/// within a blink, at a few clock reads a step.
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
 /// Every row of a run, one growing column per field.
 struct Columns {
     n: usize,
@@ -114,16 +118,20 @@ pub fn sim<'py>(
             .with_gravity(&plan.robot.model);
             let mut costs = launcher::sim::StepCosts::default();
             let start = Instant::now();
+            let mut looked = start;
             launcher::sim::run_measured(&plan, Some(&mut costs), |r| {
-                // Ctrl-C reaches Python only between steps: look every 4096.
-                if columns.t.len() % 4096 == 4095
-                    && let Err(e) = Python::attach(|py| py.check_signals())
-                {
-                    interrupted = Some(e);
-                    return Err(std::io::Error::new(
-                        std::io::ErrorKind::Interrupted,
-                        "interrupted",
-                    ));
+                // Ctrl-C reaches Python only between steps: look every
+                // SIGNAL_POLL of wall time. (Every 4096 steps was over a
+                // minute where a stiff plant made a step 15 ms.)
+                if looked.elapsed() >= SIGNAL_POLL {
+                    looked = Instant::now();
+                    if let Err(e) = Python::attach(|py| py.check_signals()) {
+                        interrupted = Some(e);
+                        return Err(std::io::Error::new(
+                            std::io::ErrorKind::Interrupted,
+                            "interrupted",
+                        ));
+                    }
                 }
                 summary.add(r);
                 columns.add(r);

@@ -94,6 +94,8 @@ pub(crate) struct Articulated {
     qd: Vec<f64>,
     /// The drive's own states (series-elastic motors' angles and speeds).
     x: Vec<f64>,
+    /// Substeps the last step took.
+    substeps_taken: u32,
     scratch: Scratch,
 }
 
@@ -101,6 +103,24 @@ pub(crate) struct Articulated {
 /// by: RK4's phase error is then ~(0.2)⁵/120 ≈ 3e-6 rad per substep and
 /// its amplitude error ~(0.2)⁶/144 ≈ 4e-7, far below any physical damping.
 const MAX_PHASE_STEP: f64 = 0.2;
+
+/// The most substeps a period takes: the count is capped here, and a
+/// scenario that needs more is refused before it runs.
+pub(crate) const MAX_SUBSTEPS: f64 = 1e6;
+
+/// What a period of the articulated engine needs, uncapped.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SubstepNeed {
+    /// Substeps the explicit damping (friction slope, spring damping over
+    /// motor inertia) needs.
+    pub(crate) damped: f64,
+    /// Substeps the fastest elastic oscillation needs.
+    pub(crate) oscillating: f64,
+    /// The damping bound, 1/s.
+    pub(crate) damping_rate: f64,
+    /// The oscillation bound, rad/s.
+    pub(crate) oscillation_rate: f64,
+}
 
 /// Buffers for one evaluation and the RK4 stages, allocated once.
 #[derive(Debug, Clone)]
@@ -200,6 +220,7 @@ impl Articulated {
             q: vec![0.0; n],
             qd: vec![0.0; n],
             x: vec![0.0; springs.states],
+            substeps_taken: 0,
             scratch: Scratch {
                 qf: vec![0.0; nf],
                 qdf: vec![0.0; nf],
@@ -285,10 +306,21 @@ impl Articulated {
     /// The substeps a period of `dt` takes when the scenario asks for
     /// `substeps`: more only where stiff scenario friction needs them.
     pub(crate) fn substeps_for(&self, dt: f64, substeps: u32) -> u32 {
-        // The friction slope acts through the explicit stages.
-        let damped = (dt * self.damping_rate).ceil();
-        let oscillating = (dt * self.oscillation_rate / MAX_PHASE_STEP).ceil();
-        substeps.max(damped.max(oscillating).min(1e6) as u32)
+        let need = self.substeps_needed(dt);
+        substeps.max(need.damped.max(need.oscillating).min(MAX_SUBSTEPS) as u32)
+    }
+
+    /// The substeps a period of `dt` needs for accuracy, uncapped (so a
+    /// scenario past [`MAX_SUBSTEPS`] can be refused rather than run
+    /// inaccurately), and the rates they come from.
+    pub(crate) fn substeps_needed(&self, dt: f64) -> SubstepNeed {
+        SubstepNeed {
+            // The friction slope acts through the explicit stages.
+            damped: (dt * self.damping_rate).ceil(),
+            oscillating: (dt * self.oscillation_rate / MAX_PHASE_STEP).ceil(),
+            damping_rate: self.damping_rate,
+            oscillation_rate: self.oscillation_rate,
+        }
     }
 
     /// Advances by `dt` in `substeps` steps (RK4, or ETDRK4 with URDF
@@ -301,7 +333,14 @@ impl Articulated {
     ) -> Result<(), PlantError> {
         let substeps = self.substeps_for(dt, substeps);
         let h = dt / f64::from(substeps);
+        self.substeps_taken = 0;
         for k in 0..substeps {
+            // A blown-up state stays blown up: the rest of the period's
+            // substeps (up to a million) would only carry NaN along.
+            if !self.finite() {
+                self.blown_up();
+                break;
+            }
             let s0 = f64::from(k) * h;
             match self.exponential.take() {
                 Some(mut x) => {
@@ -311,8 +350,24 @@ impl Articulated {
                 None => self.rk4(drive, s0, h, false),
             }
             self.constrain(h);
+            self.substeps_taken += 1;
         }
         Ok(())
+    }
+
+    /// Whether q, q̇ and the drive's states are all finite.
+    fn finite(&self) -> bool {
+        self.q
+            .iter()
+            .chain(&self.qd)
+            .chain(&self.x)
+            .all(|v| v.is_finite())
+    }
+
+    /// Substeps the last [`Self::step`] took (fewer than its count once
+    /// the state went non-finite).
+    pub(crate) fn substeps_taken(&self) -> u32 {
+        self.substeps_taken
     }
 
     /// Marks the state non-finite, as a blown-up run is reported.
@@ -499,4 +554,52 @@ fn mass_structure(tree: &Tree, follow: &[Follow], n: usize) -> Cholesky {
         coupled.iter_mut().for_each(|c| *c = true);
     }
     Cholesky::with_structure(order, |i, j| coupled[i * n + j])
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// A torque past any the state can hold: q̈ overflows within a substep.
+    struct Overflow;
+
+    impl Drive for Overflow {
+        fn torque(&self, _: &Stage, out: &mut [f64], _: &mut [f64]) {
+            out.iter_mut().for_each(|t| *t = f64::MAX);
+        }
+    }
+
+    fn two_link() -> Articulated {
+        let model = ArmModel::from_urdf_str(arm_model::TWO_LINK_URDF).unwrap();
+        let setup = Setup {
+            gravity: [0.0, 0.0, -9.81],
+            armature: &[0.0, 0.0],
+            urdf_dynamics: true,
+            extra_damping: &[0.0, 0.0],
+            springs: Springs {
+                stiffness: &[0.0, 0.0],
+                damping: &[0.0, 0.0],
+                per_motor_inertia: (0.0, 0.0),
+                states: 0,
+            },
+        };
+        Articulated::new(&model, &setup).unwrap()
+    }
+
+    /// Issue 48 item 7: a state that went non-finite took every remaining
+    /// substep of its period (up to a million) carrying NaN. Substepping
+    /// stops at once: a period that starts blown up takes none, one that
+    /// blows up takes the substeps up to it, and the state reads NaN.
+    #[test]
+    fn substepping_stops_once_the_state_is_not_finite() {
+        let mut arm = two_link();
+        arm.set_state(&[f64::NAN, 0.0], &[0.0, 0.0]);
+        arm.step(&Overflow, 1e-3, 1000).unwrap();
+        assert_eq!(arm.substeps_taken(), 0);
+        let mut arm = two_link();
+        arm.step(&Overflow, 1e-3, 1000).unwrap();
+        assert!(arm.substeps_taken() <= 2, "{}", arm.substeps_taken());
+        assert!(arm.state().0.iter().all(|q| q.is_nan()));
+    }
 }
