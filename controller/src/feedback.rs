@@ -7,8 +7,9 @@ use arm_model::ArmModel;
 use arm_model::dynamics::Dynamics;
 
 use crate::law_table::FeedbackKind;
-use crate::mpc::{ErrorMpc, MpcInput, Weights};
+use crate::mpc::{ErrorMpc, MpcInput, MpcShape, Weights};
 use crate::nac::{begin_plain_step, end_plain_step};
+use crate::torque_box::TorqueBox;
 use crate::{ControllerError, ControllerInput, ControllerParams, Diagnostics, Tuning};
 
 /// `pd`, `smc`, `pd-gravity`, `ctc`, `cbf-ctc` or `mpc` for n joints.
@@ -27,12 +28,16 @@ pub struct Feedback {
     v: Vec<f64>,
     /// `smc`'s switching gain k_s and boundary layer φ.
     smc: (f64, f64),
-    /// `cbf-ctc`: T_c (the filter acts from then on) and the rate λ.
-    cbf: (f64, f64),
-    /// `mpc`: T_c, the horizon N and step h; its QP, built at the first
-    /// step from `ctc_gains`.
-    mpc: (f64, usize, f64),
+    /// `cbf-ctc`: T_c (the filter acts from then on), the rate λ and the
+    /// robust margin δ.
+    cbf: (f64, f64, f64),
+    /// `mpc`: how its QP is posed; the QP, built at the first step from
+    /// `ctc_gains`.
+    mpc: MpcShape,
     qp: Option<Box<ErrorMpc>>,
+    /// `cbf-ctc`, `mpc`: the torque bounds as a box on u (`torque_bounds`
+    /// and every joint with an effort limit).
+    torque_box: Option<TorqueBox>,
     /// Scratch for `mpc`: e and ė.
     e: Vec<f64>,
     ed: Vec<f64>,
@@ -50,7 +55,7 @@ impl Feedback {
         let law = params.law;
         let model = match (law.model_based(), model) {
             (false, _) => None,
-            (true, Some(m)) if m.dof() == dof => Some(Dynamics::new(m, params.model_scale)),
+            (true, Some(m)) if m.dof() == dof => Some(m),
             (true, Some(m)) => {
                 return Err(ControllerError::InvalidParameter {
                     key: "controller.law".into(),
@@ -60,6 +65,11 @@ impl Feedback {
             }
             (true, None) => return Err(ControllerError::NeedsModel(law)),
         };
+        let torque_box = match (kind, params.torque_bounds) {
+            (FeedbackKind::CbfCtc | FeedbackKind::Mpc, true) => model.and_then(TorqueBox::new),
+            _ => None,
+        };
+        let model = model.map(|m| Dynamics::new(m, params.model_scale));
         let k1 = params.k1.resolve("controller.k1", dof)?;
         let k2 = params.k2.resolve("controller.k2", dof)?;
         let ctc_gains = match params.tuning {
@@ -78,9 +88,16 @@ impl Feedback {
             model,
             v: vec![0.0; dof],
             smc: (params.smc_gain, params.smc_boundary),
-            cbf: (params.tc, params.cbf_rate),
-            mpc: (params.tc, params.mpc_horizon, params.mpc_step),
+            cbf: (params.tc, params.cbf_rate, params.cbf_margin),
+            mpc: MpcShape {
+                horizon: params.mpc_horizon,
+                h: params.mpc_step,
+                tc: params.tc,
+                bounded: torque_box.is_some(),
+                disturbance: params.mpc_disturbance,
+            },
             qp: None,
+            torque_box,
             e: vec![0.0; dof],
             ed: vec![0.0; dof],
         })
@@ -133,6 +150,9 @@ impl Feedback {
                 }
             }
         }
+        if let (Some(b), Some(m)) = (self.torque_box.as_mut(), self.model.as_mut()) {
+            b.update(m, input.q, input.qd, input.qdd_d);
+        }
         if self.kind == FeedbackKind::CbfCtc && input.t >= self.cbf.0 {
             // The filter clipping is the law's guard acting: a breach step.
             out.barrier_breached = self.cbf_filter(input);
@@ -150,14 +170,18 @@ impl Feedback {
 
     /// The CBF–QP safety filter (BASELINES §3) on `ctc`'s commanded
     /// accelerations: with u_i = v_i − q̈_d,i = ë_i and h_i = k_c,i² − e_i²,
-    /// min Σ (u_i − u_nom,i)² subject to ḧ_i + 2λ ḣ_i + λ² h_i ≥ 0, i.e.
-    /// 2 e_i u_i ≤ b_i = 2k̇_c,i² − 2ė_i² + 2λ ḣ_i + λ² h_i (k̈_c taken as 0:
-    /// the reference sample carries k_c and k̇_c only). The QP separates per
-    /// joint, so its solution is the nominal u clipped at b_i / (2 e_i); at
-    /// e_i = 0 the constraint does not involve u_i and u_i stays nominal.
-    /// Returns whether it clipped any joint.
+    /// min Σ (u_i − u_nom,i)² subject to ḧ_i + 2λ ḣ_i + λ² h_i ≥ 0 for the
+    /// worst error-acceleration disturbance |d_i| ≤ δ, i.e.
+    /// 2 e_i u_i + 2|e_i| δ ≤ b_i = 2k̇_c,i² − 2ė_i² + 2λ ḣ_i + λ² h_i (k̈_c
+    /// taken as 0: the reference sample carries k_c and k̇_c only), and,
+    /// with torque bounds, |u_i| ≤ a_i. The QP separates per joint: each
+    /// joint's u is the nominal one projected onto an interval (see
+    /// [`cbf_interval`]). Returns whether the CBF row bound or could not be
+    /// met within the input bound on any joint (clipping by the torque box
+    /// alone is no breach).
     fn cbf_filter(&mut self, input: &ControllerInput<'_>) -> bool {
-        let lambda = self.cbf.1;
+        let (_, lambda, margin) = self.cbf;
+        let a = self.torque_box.as_ref().map(TorqueBox::half_widths);
         let mut clipped = false;
         for i in 0..self.n {
             let e = input.q[i] - input.q_d[i];
@@ -165,16 +189,12 @@ impl Feedback {
             let (k, kd) = (input.kc[i], input.kc_dot[i]);
             let h = k * k - e * e;
             let hd = 2.0 * k * kd - 2.0 * e * ed;
-            let b = 2.0 * kd * kd - 2.0 * ed * ed + 2.0 * lambda * hd + lambda * lambda * h;
+            let b = 2.0 * kd * kd - 2.0 * ed * ed + 2.0 * lambda * hd + lambda * lambda * h
+                - 2.0 * e.abs() * margin;
             let u_nom = self.v[i] - input.qdd_d[i];
-            let u = if e > 0.0 {
-                u_nom.min(b / (2.0 * e))
-            } else if e < 0.0 {
-                u_nom.max(b / (2.0 * e))
-            } else {
-                u_nom
-            };
-            clipped |= u != u_nom;
+            let bound = a.map_or(f64::INFINITY, |a| a[i]);
+            let (u, binds) = cbf_interval(e, b, bound, u_nom);
+            clipped |= binds;
             self.v[i] = input.qdd_d[i] + u;
         }
         clipped
@@ -193,8 +213,7 @@ impl Feedback {
                 .zip(kd)
                 .map(|(&p, &d)| Weights::matching(p, d))
                 .collect();
-            let (tc, horizon, h) = self.mpc;
-            self.qp = Some(Box::new(ErrorMpc::new(&weights, horizon, h, tc).ok()?));
+            self.qp = Some(Box::new(ErrorMpc::new(&weights, self.mpc).ok()?));
         }
         let qp = self.qp.as_mut()?;
         let (u, breached) = qp.solve(&MpcInput {
@@ -203,6 +222,7 @@ impl Feedback {
             ed: &self.ed,
             kc: input.kc,
             kc_dot: input.kc_dot,
+            u_max: self.torque_box.as_ref().map(TorqueBox::half_widths),
         });
         for ((v, a), u) in self.v.iter_mut().zip(input.qdd_d).zip(u) {
             *v = a + u;
@@ -263,6 +283,30 @@ impl Feedback {
     }
 }
 
+/// One joint of the CBF–QP: the u nearest `u_nom` with 2 e u ≤ b and
+/// |u| ≤ a, and whether the CBF row bound (u_nom broke it). The feasible
+/// set is an interval; if it is empty (the row asks for more than the
+/// bound allows) u is the bound's end that comes nearest to the row, the
+/// most the motors can do. At e = 0 the row does not involve u.
+pub(crate) fn cbf_interval(e: f64, b: f64, a: f64, u_nom: f64) -> (f64, bool) {
+    // The row as a bound on u: above it for e > 0, below it for e < 0.
+    let row = b / (2.0 * e);
+    let (lo, hi, binds) = if e > 0.0 {
+        (-a, row.min(a), u_nom > row)
+    } else if e < 0.0 {
+        (row.max(-a), a, u_nom < row)
+    } else {
+        (-a, a, false)
+    };
+    match lo <= hi {
+        // max then min, not clamp: clamp panics on a NaN bound.
+        true => (u_nom.max(lo).min(hi), binds),
+        // Empty: the row's side of the box.
+        false if e > 0.0 => (-a, true),
+        false => (a, true),
+    }
+}
+
 /// 1 / (M(q)⁻¹)_ii per joint; M's columns from inverse dynamics at rest
 /// (M e_k = τ(q, 0, e_k) − G(q)). A singular M falls back to M_ii.
 pub fn effective_inertia(d: &mut Dynamics, q: &[f64]) -> Vec<f64> {
@@ -288,3 +332,7 @@ pub fn effective_inertia(d: &mut Dynamics, q: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 #[path = "feedback_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "robust_tests.rs"]
+mod robust_tests;

@@ -211,12 +211,25 @@ impl LawName {
             LawName::CbfCtc => LawDecl {
                 name: "cbf-ctc",
                 kind: LawKind::Feedback(FeedbackKind::CbfCtc),
-                keys: &["model_scale", "tuning", "cbf_rate"],
+                keys: &[
+                    "model_scale",
+                    "tuning",
+                    "cbf_rate",
+                    "cbf_margin",
+                    "torque_bounds",
+                ],
             },
             LawName::Mpc => LawDecl {
                 name: "mpc",
                 kind: LawKind::Feedback(FeedbackKind::Mpc),
-                keys: &["model_scale", "tuning", "mpc_horizon", "mpc_step"],
+                keys: &[
+                    "model_scale",
+                    "tuning",
+                    "mpc_horizon",
+                    "mpc_step",
+                    "mpc_disturbance",
+                    "torque_bounds",
+                ],
             },
         }
     }

@@ -46,6 +46,7 @@ mod params_reference;
 mod ppc;
 mod rbf;
 mod shifting;
+mod torque_box;
 mod weight_update;
 
 pub use dispatch::Law;

@@ -2,7 +2,9 @@
 //! the error dynamics that computed torque leaves, ë_i = u_i per joint,
 //! with |e_i| ≤ k_c,i over the horizon from T_c on, solved by `clarabel`
 //! every control step. [`crate::feedback::Feedback`] turns its first input
-//! into a torque through the law's model, as `ctc` does.
+//! into a torque through the law's model, as `ctc` does. Optionally the
+//! inputs are bounded (the torque box of `torque_box.rs`) and the rows are
+//! tightened against a disturbance bound w on ë = u + d (tube MPC, [`Tube`]).
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -25,6 +27,20 @@ pub(crate) struct MpcInput<'a> {
     pub kc: &'a [f64],
     /// k̇_c.
     pub kc_dot: &'a [f64],
+    /// The bound |u_i| ≤ a_i of this step, if the QP has input rows.
+    pub u_max: Option<&'a [f64]>,
+}
+
+/// How the QP is posed: its horizon N, step h, the time T_c from which
+/// the envelope holds, whether it has input rows, and the disturbance
+/// bound w it is tightened against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct MpcShape {
+    pub horizon: usize,
+    pub h: f64,
+    pub tc: f64,
+    pub bounded: bool,
+    pub disturbance: f64,
 }
 
 /// The QP of n joints: the error dynamics do not couple the joints, so it
@@ -33,9 +49,7 @@ pub(crate) struct MpcInput<'a> {
 #[derive(Debug)]
 pub(crate) struct ErrorMpc {
     joints: Vec<JointQp>,
-    horizon: usize,
-    h: f64,
-    tc: f64,
+    shape: MpcShape,
     /// The inputs of the last step.
     u: Vec<f64>,
     /// How many QPs the solver has solved (the others were settled by the
@@ -52,6 +66,66 @@ struct JointQp {
     omega: f64,
     /// The unconstrained optimum's gain: u = −(k_e e + k_v ė).
     lqr: [f64; 2],
+    /// What the disturbance bound takes off each row.
+    tube: Tube,
+    /// Whether the QP has input rows.
+    bounded: bool,
+}
+
+/// Constraint tightening against |d| ≤ w on ë = u + d, in the form of
+/// Chisci, Rossiter & Zappa (Automatica 37(7), 2001), the tube of Mayne,
+/// Seron & Raković (Automatica 41(2), 2005) with its centre started at the
+/// measured state: the real error is the nominal prediction plus
+/// ε_{j+1} = (A − BK) ε_j + δ_j, ε_0 = 0, under the ancillary feedback
+/// u = v − K ε (K the LQR gain below), where one step's δ is within
+/// (w h²/2, w h) per component whatever d does inside the step. So
+/// |ε_e,j| ≤ α_j = Σ_{i<j} |row_e (A − BK)^i| δ̄ and |K ε_j| ≤ β_j =
+/// Σ_{i<j} |K (A − BK)^i| δ̄, and the nominal rows become |e_j| ≤ k_j − α_j
+/// and |v_j| ≤ a − β_j (each at least 0). With w = 0 both are 0: the
+/// nominal MPC.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Tube {
+    /// α_j, j = 0 … N.
+    pub e: Vec<f64>,
+    /// β_j, j = 0 … N − 1.
+    pub u: Vec<f64>,
+}
+
+impl Tube {
+    /// The tightening for the physical gain u = −(k_e e + k_v ė), step h.
+    pub(crate) fn new(lqr: [f64; 2], h: f64, horizon: usize, w: f64) -> Self {
+        let [ke, kv] = lqr;
+        let ak = [
+            [1.0 - 0.5 * h * h * ke, h - 0.5 * h * h * kv],
+            [-h * ke, 1.0 - h * kv],
+        ];
+        let delta = [0.5 * h * h * w, h * w];
+        let mut p: [[f64; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
+        let mut tube = Self {
+            e: vec![0.0; horizon + 1],
+            u: vec![0.0; horizon],
+        };
+        for i in 0..horizon {
+            let de = p[0][0].abs() * delta[0] + p[0][1].abs() * delta[1];
+            let kp = [ke * p[0][0] + kv * p[1][0], ke * p[0][1] + kv * p[1][1]];
+            let du = kp[0].abs() * delta[0] + kp[1].abs() * delta[1];
+            tube.e[i + 1] = tube.e[i] + de;
+            if i + 1 < horizon {
+                tube.u[i + 1] = tube.u[i] + du;
+            }
+            p = [
+                [
+                    ak[0][0] * p[0][0] + ak[0][1] * p[1][0],
+                    ak[0][0] * p[0][1] + ak[0][1] * p[1][1],
+                ],
+                [
+                    ak[1][0] * p[0][0] + ak[1][1] * p[1][0],
+                    ak[1][0] * p[0][1] + ak[1][1] * p[1][1],
+                ],
+            ];
+        }
+        tube
+    }
 }
 
 impl std::fmt::Debug for JointQp {
@@ -102,23 +176,15 @@ pub(crate) enum MpcSetupError {
 }
 
 impl ErrorMpc {
-    /// The QP for `weights.len()` joints over `horizon` steps of `h` s,
-    /// with the envelope enforced at predicted times ≥ `tc`.
-    pub(crate) fn new(
-        weights: &[Weights],
-        horizon: usize,
-        h: f64,
-        tc: f64,
-    ) -> Result<Self, MpcSetupError> {
+    /// The QP for `weights.len()` joints posed as `shape` says.
+    pub(crate) fn new(weights: &[Weights], shape: MpcShape) -> Result<Self, MpcSetupError> {
         let joints = weights
             .iter()
-            .map(|w| JointQp::new(w, horizon, h))
+            .map(|w| JointQp::new(w, &shape))
             .collect::<Result<_, _>>()?;
         Ok(Self {
             joints,
-            horizon,
-            h,
-            tc,
+            shape,
             u: vec![0.0; weights.len()],
             solves: 0,
         })
@@ -126,28 +192,31 @@ impl ErrorMpc {
 
     /// This step's first input of each joint, and whether the envelope
     /// could not be held (a solve that failed: then that joint's u is the
-    /// unconstrained optimum; with u unbounded the QP is always feasible,
-    /// e₁ alone can be put anywhere). A joint whose
-    /// unconstrained optimum keeps every predicted error inside the
-    /// envelope has no active constraint: that optimum is the QP's
-    /// solution, and the solver is not called.
+    /// unconstrained optimum, clipped to the input bound; with u unbounded
+    /// and w = 0 the QP is always feasible, e₁ alone can be put anywhere,
+    /// but bounded inputs or a tightened envelope can make it infeasible).
+    /// A joint whose unconstrained optimum keeps every predicted error and
+    /// input inside its rows has no active constraint: that optimum is
+    /// the QP's solution, and the solver is not called.
     pub(crate) fn solve(&mut self, x: &MpcInput<'_>) -> (&[f64], bool) {
         let mut breached = false;
+        let horizon = self.shape.horizon;
         for i in 0..self.joints.len() {
             let bounds = self.bounds(x, i);
             let joint = &mut self.joints[i];
             let x0 = [x.e[i], x.ed[i]];
             let [ke, kv] = joint.lqr;
             let unconstrained = -(ke * x0[0] + kv * x0[1]);
-            if joint.rollout_inside(x0, self.horizon, &bounds) {
+            if joint.rollout_inside(x0, horizon, &bounds) {
                 self.u[i] = unconstrained;
                 continue;
             }
             self.solves += 1;
-            match joint.solve(x0, self.horizon, &bounds) {
+            match joint.solve(x0, horizon, &bounds) {
                 Some(u) => self.u[i] = u,
                 None => {
-                    self.u[i] = unconstrained;
+                    let a = joint.input_bound(&bounds, 0).unwrap_or(f64::INFINITY);
+                    self.u[i] = unconstrained.clamp(-a, a);
                     breached = true;
                 }
             }
@@ -172,17 +241,24 @@ impl ErrorMpc {
     #[cfg(test)]
     pub(crate) fn solve_joint(&mut self, i: usize, x: &MpcInput<'_>) -> Option<f64> {
         let bounds = self.bounds(x, i);
-        self.joints[i].solve([x.e[i], x.ed[i]], self.horizon, &bounds)
+        self.joints[i].solve([x.e[i], x.ed[i]], self.shape.horizon, &bounds)
     }
 
-    /// Joint `i`'s envelope over the horizon.
+    /// Joint `i`'s tightening (tests).
+    #[cfg(test)]
+    pub(crate) fn tube(&self, i: usize) -> &Tube {
+        &self.joints[i].tube
+    }
+
+    /// Joint `i`'s envelope and input bound over the horizon.
     fn bounds(&self, x: &MpcInput<'_>, i: usize) -> Bounds {
         Bounds {
             t: x.t,
-            tc: self.tc,
-            h: self.h,
+            tc: self.shape.tc,
+            h: self.shape.h,
             kc: x.kc[i],
             rate: x.kc_dot[i] / x.kc[i],
+            u_max: x.u_max.and_then(|a| a.get(i).copied()),
         }
     }
 }
@@ -197,6 +273,8 @@ struct Bounds {
     kc: f64,
     /// k̇_c / k_c.
     rate: f64,
+    /// The input bound a of this step, if any.
+    u_max: Option<f64>,
 }
 
 impl Bounds {
@@ -207,10 +285,14 @@ impl Bounds {
 }
 
 impl JointQp {
-    fn new(w: &Weights, horizon: usize, h: f64) -> Result<Self, MpcSetupError> {
+    fn new(w: &Weights, shape: &MpcShape) -> Result<Self, MpcSetupError> {
+        let (horizon, h) = (shape.horizon, shape.h);
         let theta = w.omega * h;
         let terminal = riccati(w.q_v, theta).ok_or(MpcSetupError::Riccati)?;
-        let layout = Layout { horizon };
+        let layout = Layout {
+            horizon,
+            bounded: shape.bounded,
+        };
         let p = layout.cost(w.q_v, &terminal, theta);
         let q = vec![0.0; layout.vars()];
         let a = layout.constraints(theta);
@@ -221,24 +303,45 @@ impl JointQp {
         ];
         let solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings()?)?;
         let [ke, kv] = lqr_gain(&terminal, theta);
+        let lqr = [w.omega * w.omega * ke, w.omega * kv];
         Ok(Self {
             solver,
             b,
             omega: w.omega,
-            lqr: [w.omega * w.omega * ke, w.omega * kv],
+            lqr,
+            tube: Tube::new(lqr, h, horizon, shape.disturbance),
+            bounded: shape.bounded,
         })
     }
 
-    /// Whether x_{j+1} = (A − BK) x_j from `x0` keeps |e_j| ≤ k_j at every
-    /// bounded step j.
+    /// The envelope row at step j, tightened: k_j − α_j (at least 0), or
+    /// None before T_c.
+    fn envelope(&self, bounds: &Bounds, j: usize) -> Option<f64> {
+        bounds.at(j).map(|k| (k - self.tube.e[j]).max(0.0))
+    }
+
+    /// The input row at step k, tightened: a − β_k (at least 0), or None
+    /// without input rows.
+    fn input_bound(&self, bounds: &Bounds, k: usize) -> Option<f64> {
+        match self.bounded {
+            true => bounds.u_max.map(|a| (a - self.tube.u[k]).max(0.0)),
+            false => None,
+        }
+    }
+
+    /// Whether x_{j+1} = (A − BK) x_j from `x0` keeps every predicted
+    /// error and input inside its (tightened) row.
     fn rollout_inside(&self, x0: [f64; 2], horizon: usize, bounds: &Bounds) -> bool {
         let h = bounds.h;
         let [ke, kv] = self.lqr;
         let [mut e, mut ed] = x0;
         for j in 1..=horizon {
             let u = -(ke * e + kv * ed);
+            if self.input_bound(bounds, j - 1).is_some_and(|a| u.abs() > a) {
+                return false;
+            }
             (e, ed) = (e + h * ed + 0.5 * h * h * u, ed + h * u);
-            if bounds.at(j).is_some_and(|k| e.abs() > k) {
+            if self.envelope(bounds, j).is_some_and(|k| e.abs() > k) {
                 return false;
             }
         }
@@ -247,15 +350,26 @@ impl JointQp {
 
     /// The solver's u₀, or None if it did not solve.
     fn solve(&mut self, x0: [f64; 2], horizon: usize, bounds: &Bounds) -> Option<f64> {
-        let layout = Layout { horizon };
+        let layout = Layout {
+            horizon,
+            bounded: self.bounded,
+        };
         let (e_row, v_row) = (layout.equality_row(1, 0), layout.equality_row(1, 1));
         let v0 = x0[1] / self.omega;
         self.b[e_row] = x0[0] + self.omega * bounds.h * v0;
         self.b[v_row] = v0;
         for j in 1..=horizon {
             let (upper, lower) = layout.envelope_rows(j);
-            let k = bounds.at(j).unwrap_or(OFF_BOUND);
+            let k = self.envelope(bounds, j).unwrap_or(OFF_BOUND);
             (self.b[upper], self.b[lower]) = (k, k);
+        }
+        let scale = self.omega * self.omega;
+        for k in 0..horizon {
+            if let Some((upper, lower)) = layout.input_rows(k) {
+                // w = u / ω².
+                let a = self.input_bound(bounds, k).map_or(OFF_BOUND, |a| a / scale);
+                (self.b[upper], self.b[lower]) = (a, a);
+            }
         }
         self.solver.update_b(&self.b).ok()?;
         self.solver.solve();
@@ -278,16 +392,21 @@ fn settings() -> Result<DefaultSettings<f64>, clarabel::solver::DefaultSettingsB
         .presolve_enable(false)
         .input_sparse_dropzeros(false)
         .iterative_refinement_enable(false)
+        .tol_gap_abs(1e-12)
+        .tol_gap_rel(1e-12)
+        .tol_feas(1e-12)
         .max_iter(50)
         .build()
 }
 
 /// Where each variable and row of one joint's QP lies. The variables are
 /// x₁ … x_N (e_j, v_j interleaved) and w₀ … w_{N−1}; the rows are the 2N
-/// dynamics equalities, then e_j ≤ k_j and −e_j ≤ k_j for j = 1 … N.
+/// dynamics equalities, then e_j ≤ k_j and −e_j ≤ k_j for j = 1 … N, then
+/// (if bounded) w_k ≤ a_k and −w_k ≤ a_k for k = 0 … N − 1.
 #[derive(Clone, Copy)]
 struct Layout {
     horizon: usize,
+    bounded: bool,
 }
 
 impl Layout {
@@ -310,8 +429,13 @@ impl Layout {
         let r = self.equality_rows() + 2 * (j - 1);
         (r, r + 1)
     }
+    fn input_rows(self, k: usize) -> Option<(usize, usize)> {
+        let r = self.equality_rows() + 2 * self.horizon + 2 * k;
+        self.bounded.then_some((r, r + 1))
+    }
     fn rows(self) -> usize {
-        self.equality_rows() + 2 * self.horizon
+        let inputs = if self.bounded { 2 * self.horizon } else { 0 };
+        self.equality_rows() + 2 * self.horizon + inputs
     }
 
     /// b before the first step: dynamics rows 0 (the first two are set
@@ -358,6 +482,10 @@ impl Layout {
             let (upper, lower) = self.envelope_rows(j);
             t.push(upper, self.state(j, 0), 1.0);
             t.push(lower, self.state(j, 0), -1.0);
+            if let Some((upper, lower)) = self.input_rows(j - 1) {
+                t.push(upper, self.input(j - 1), 1.0);
+                t.push(lower, self.input(j - 1), -1.0);
+            }
         }
         t.into_csc(self.rows(), self.vars())
     }

@@ -194,6 +194,15 @@ parameters! {
     /// `cbf-ctc`: the filter's rate λ, 1/s: h = k_c² − e² obeys
     /// ḧ + 2λ ḣ + λ² h ≥ 0, a double pole at −λ.
     cbf_rate: f64 = 20.0, POSITIVE;
+    /// `cbf-ctc`: the robust margin δ, rad/s²: the bound on an unmodelled
+    /// error acceleration |ë − u| ≤ δ the filter holds the envelope against
+    /// (the condition is met for the worst such disturbance; 0: nominal).
+    cbf_margin: f64 = 0.0, NON_NEGATIVE;
+    /// `cbf-ctc`, `mpc`: bound the torque by the URDF's effort limits
+    /// (when every controlled joint has one), through the law's model:
+    /// the error acceleration u is kept in a per-joint box whose every
+    /// point gives |τ_i| ≤ effort_i at this step's M(q) (BASELINES §3).
+    torque_bounds: bool = true, BOOLEAN;
     /// `mpc`: prediction steps N (at most [`MAX_MPC_HORIZON`]). The default,
     /// with `mpc_step`'s, looks 0.1 s ahead for the envelope, 1.5 time
     /// constants of the default gains' error dynamics; beyond it the
@@ -203,6 +212,11 @@ parameters! {
     /// `mpc`: the prediction step h, s (the default is ten control periods
     /// at 1 kHz; the QP is still solved every period).
     mpc_step: f64 = 0.01, MPC_STEP;
+    /// `mpc`: the disturbance bound w, rad/s², on the error dynamics
+    /// ë = u + d, |d| ≤ w: the envelope and torque rows are tightened over
+    /// the horizon by what such a d can do under the ancillary LQR
+    /// feedback (tube MPC); 0: the nominal MPC.
+    mpc_disturbance: f64 = 0.0, NON_NEGATIVE;
     /// `ctc`, `cbf-ctc`, `mpc`, `ppc`: how K1, K2 become the law's gains:
     /// "as-given", or "matched" to `pd`'s error dynamics. Unwritten at its
     /// default so that existing scenarios keep their identity.
@@ -267,6 +281,10 @@ impl<T: std::fmt::Debug + ?Sized> Check<T> {
 /// Any value serde accepts: a name, checked as it is read.
 const ANY_NAME: AnyName = AnyName {
     need: "a name (see what it is)",
+};
+/// A switch: serde has read it as true or false.
+const BOOLEAN: AnyName = AnyName {
+    need: "true or false",
 };
 const POSITIVE: Check<f64> = Check {
     need: "a finite number > 0",
