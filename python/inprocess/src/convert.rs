@@ -181,7 +181,8 @@ fn to_toml(key: &str, v: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::Valu
 
 /// What every function that runs a scenario takes, as `testbed sim` does:
 /// `scenario` (a file or a shipped name; None: the paper's, or the
-/// default of `robot`), `robot`, `set`, `duration`, `law`.
+/// default of `robot`), `robot` (a URDF or a shipped robot's name), `set`,
+/// `duration`, `law`.
 pub struct ScenarioArgs<'a, 'py> {
     pub scenario: Option<PathBuf>,
     pub robot: Option<PathBuf>,
@@ -200,14 +201,21 @@ impl ScenarioArgs<'_, '_> {
                     .map_err(|e| PyValueError::new_err(format!("law: {e}")))
             })
             .transpose()?;
+        let robot = self
+            .robot
+            .as_deref()
+            .map(crate::shipped::robot)
+            .transpose()
+            .map_err(err)?;
         let overrides = scenario::Overrides {
             duration_s: self.duration,
             rate_hz: None,
-            robot: self.robot.clone(),
+            robot,
             law,
             set: overrides_set(self.set)?,
         };
-        scenario::load_named(self.scenario.as_deref(), &overrides).map_err(err)
+        let scenario = self.scenario.as_deref().map(crate::shipped::scenario);
+        scenario::load_named(scenario.as_deref(), &overrides).map_err(err)
     }
 }
 

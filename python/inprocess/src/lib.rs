@@ -15,6 +15,7 @@ mod env;
 mod laws;
 mod robot;
 mod runs;
+mod shipped;
 
 use pyo3::prelude::*;
 
@@ -29,6 +30,20 @@ pyo3::create_exception!(
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("TestbedError", m.py().get_type::<TestbedError>())?;
+    // The package `testbed` is being imported (this module is its
+    // `_native`): its folder holds the shipped scenarios and robots.
+    if let Ok(dir) = m
+        .py()
+        .import("sys")
+        .and_then(|sys| sys.getattr("modules"))
+        .and_then(|mods| mods.get_item("testbed"))
+        .and_then(|pkg| pkg.getattr("__path__"))
+        .and_then(|path| path.get_item(0))
+        .and_then(|dir| dir.extract::<std::path::PathBuf>())
+    {
+        shipped::set_package_dir(dir);
+    }
+    m.add("ROBOTS", shipped::robots())?;
     m.add("MAX_DOF", wire::MAX_DOF)?;
     m.add(
         "LAWS",

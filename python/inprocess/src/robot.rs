@@ -29,7 +29,8 @@ pub struct Robot {
 
 #[pymethods]
 impl Robot {
-    /// Loads `urdf` (None: the built-in two-link arm) with the joints in
+    /// Loads `urdf` (a file or a shipped robot's name, `"iiwa14"`; None:
+    /// the built-in two-link arm) with the joints in
     /// `lock` ({name: position}) held still.
     #[new]
     #[pyo3(signature = (urdf=None, *, lock=None))]
@@ -40,6 +41,11 @@ impl Robot {
                 locks.insert(k.extract()?, v.extract()?);
             }
         }
+        let urdf = urdf
+            .as_deref()
+            .map(crate::shipped::robot)
+            .transpose()
+            .map_err(err)?;
         let source = match &urdf {
             Some(p) => scenario::RobotSource::from_file(p, &locks),
             None => scenario::RobotSource::builtin().relocked(&locks),

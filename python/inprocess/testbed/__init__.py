@@ -2,7 +2,7 @@
 
     import testbed
     rows, summary = testbed.sim("paper")               # as `testbed sim --scenario paper`
-    robot = testbed.Robot("robots/iiwa14.urdf")        # joints, limits, M(q), C(q, q̇)q̇, G(q)
+    robot = testbed.Robot("iiwa14")                    # a shipped robot (or a URDF): M(q), C(q, q̇)q̇, G(q)
     law = testbed.Law("nac")                           # a built-in law, stepped by hand
     table = testbed.compare("ur5_randomised", seeds=5) # `testbed compare --json`
     env = gymnasium.make("testbed/ArmTracking-v0")     # the Gymnasium environment
@@ -13,6 +13,7 @@ docs/python.md has the whole interface.
 from ._native import (  # noqa: F401  (the public interface)
     LAWS,
     MAX_DOF,
+    ROBOTS,
     SCENARIOS,
     EnvCore,
     Law,
