@@ -361,8 +361,12 @@ impl Scenario {
                 file: file.to_string(),
                 cause,
             })?;
-        // With the envelope from the limits, the robot is needed to check it (see `plan`).
-        let checked = if self.envelope.from_limits {
+        // With the envelope from the limits, the robot is needed to check it
+        // (see `plan`); and a trajectory file's columns are matched to the
+        // joints by name there, before reference and envelope are compared
+        // (a missing joint is named, not counted).
+        let from_file = self.reference.samples.is_some() || self.envelope.samples.is_some();
+        let checked = if self.envelope.from_limits || from_file {
             self.reference.validate()
         } else {
             Reference::new(&self.reference, &self.envelope).map(|_| ())

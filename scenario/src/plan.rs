@@ -399,6 +399,24 @@ pub fn plan(
                 .join(", "),
         });
     }
+    // A trajectory file's columns are the arm's joints by name, in the
+    // arm's order from here on (the log keeps them so).
+    let mut scenario = scenario;
+    let joints = robot.model.joint_names();
+    for s in [
+        &mut scenario.reference.samples,
+        &mut scenario.envelope.samples,
+    ]
+    .into_iter()
+    .flatten()
+    {
+        *s = s
+            .by_joint_names(&joints)
+            .map_err(|cause| ScenarioError::Trajectory {
+                file: source.clone(),
+                cause,
+            })?;
+    }
     let mismatch = |key: &str, got: usize| ScenarioError::Invalid {
         file: source.clone(),
         key: key.to_string(),
@@ -679,5 +697,36 @@ mod tests {
             "{:?}",
             plan.changes
         );
+    }
+
+    /// #48 item 11 (D11): a trajectory file's columns are the joints by
+    /// name: `t,joint2,joint1` drives joint1 with its own column (it drove
+    /// it with joint2's), and the iiwa's names on the two-link arm are
+    /// refused naming the file, row, column and the arm's joints, as is a
+    /// file missing a joint (not counted against the envelope).
+    #[test]
+    fn a_trajectory_file_is_matched_to_the_joints_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let with = |csv: &str| {
+            let path = dir.path().join("traj.csv");
+            std::fs::write(&path, csv).unwrap();
+            let set = format!("reference.file={:?}", path.display().to_string());
+            load(None, &overrides(None, &[set.as_str()]))
+        };
+        let plan = with("t,joint2,joint1\n0,0.2,0.1\n1,0.4,0.3\n").unwrap();
+        let s = plan.scenario.reference.samples.as_ref().unwrap();
+        assert_eq!(s.columns, ["joint1", "joint2"]);
+        assert_eq!(s.values, [vec![0.1, 0.3], vec![0.2, 0.4]]);
+        assert_eq!(plan.reference.sample(0.0).q_d, [0.1, 0.2]);
+        let e = with("t,iiwa_joint_1,iiwa_joint_2\n0,0,0\n1,0,0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("traj.csv: row 1, column 2 ('iiwa_joint_1')")
+                && e.contains("joint1, joint2"),
+            "{e}"
+        );
+        let e = with("t,joint2\n0,0\n1,0\n").unwrap_err().to_string();
+        assert!(e.contains("no column for joint joint1"), "{e}");
     }
 }

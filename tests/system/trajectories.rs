@@ -69,11 +69,12 @@ fn scenario_with(dir: &Path, csv: &str) -> std::path::PathBuf {
 #[test]
 fn a_bad_trajectory_file_is_named_with_its_row_and_column() {
     let dir = tempfile::tempdir().unwrap();
-    let header = "t,a,b,c,d,e,f,g\n";
+    // The columns are the iiwa's joints, by name.
+    let header = "t,iiwa_joint_1,iiwa_joint_2,iiwa_joint_3,iiwa_joint_4,iiwa_joint_5,iiwa_joint_6,iiwa_joint_7\n";
     for (rows, want) in [
         (
             "0,0,0,0,0,0,0,0\n1,0,0,x,0,0,0,0\n",
-            "traj.csv: row 3, column 4 ('c'): \"x\" is not a number",
+            "traj.csv: row 3, column 4 ('iiwa_joint_3'): \"x\" is not a number",
         ),
         (
             "0,0,0,0,0,0,0,0\n0,0,0,0,0,0,0,0\n",
@@ -81,15 +82,15 @@ fn a_bad_trajectory_file_is_named_with_its_row_and_column() {
         ),
         (
             "0,0,0,0,0,0,0,0\n1,0,0,0,0,0,0,inf\n",
-            "row 3, column 8 ('g'): inf is not finite",
+            "row 3, column 8 ('iiwa_joint_7'): inf is not finite",
         ),
         (
             "0,0,0,0,0,0,0\n1,0,0,0,0,0,0\n",
-            "reference.joints has 6 entries but envelope.joints has 7",
+            "traj.csv: row 1, column 8 ('iiwa_joint_7'): no column for joint iiwa_joint_7",
         ),
     ] {
-        let header = if want.contains("has 6 entries") {
-            "t,a,b,c,d,e,f\n"
+        let header = if want.contains("no column") {
+            "t,iiwa_joint_1,iiwa_joint_2,iiwa_joint_3,iiwa_joint_4,iiwa_joint_5,iiwa_joint_6\n"
         } else {
             header
         };
@@ -111,7 +112,9 @@ fn a_bad_trajectory_file_is_named_with_its_row_and_column() {
 #[test]
 fn a_log_of_a_file_driven_run_verifies_without_the_file() {
     let dir = tempfile::tempdir().unwrap();
-    let mut csv = String::from("t,a,b,c,d,e,f,g\n");
+    let mut csv = String::from(
+        "t,iiwa_joint_1,iiwa_joint_2,iiwa_joint_3,iiwa_joint_4,iiwa_joint_5,iiwa_joint_6,iiwa_joint_7\n",
+    );
     for k in 0..=20 {
         let t = k as f64 * 0.1;
         let v = 0.2 * (t * 1.5).sin();

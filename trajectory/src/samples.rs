@@ -13,7 +13,7 @@ use crate::TrajectoryError;
 pub const MAX_ROWS: usize = 1_000_000;
 
 /// Samples of one signal per column at times `t`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Samples {
     /// Where they came from, for messages.
@@ -24,6 +24,18 @@ pub struct Samples {
     pub t: Vec<f64>,
     /// Per column, one value per time.
     pub values: Vec<Vec<f64>>,
+    /// The header's row in its file, from 1, for messages (None: the
+    /// samples were given inline or read back from a log).
+    #[serde(skip)]
+    pub header_row: Option<usize>,
+}
+
+/// Equal samples are equal wherever their header stood.
+impl PartialEq for Samples {
+    fn eq(&self, other: &Self) -> bool {
+        (&self.source, &self.columns, &self.t, &self.values)
+            == (&other.source, &other.columns, &other.t, &other.values)
+    }
 }
 
 /// The closest two sample times may be, s: a microsecond. Times 1e-300
@@ -113,6 +125,7 @@ impl Samples {
             columns: names[1..].to_vec(),
             t: Vec::new(),
             values: vec![Vec::new(); names.len() - 1],
+            header_row: Some(h_row + 1),
         };
         for (row, line) in lines {
             if out.t.len() >= MAX_ROWS {
@@ -136,6 +149,65 @@ impl Samples {
             ));
         }
         Ok(out)
+    }
+
+    /// The samples with one column per joint of `joints`, in the arm's
+    /// order, each found by its name in the header: a column is never
+    /// taken for a joint by its place (`t,joint2,joint1` drove joint1 with
+    /// joint2's motion). A name that is no joint of the arm, a name given
+    /// twice and a joint with no column are refused, naming the file, the
+    /// header's row and the column (or the joints missing).
+    pub fn by_joint_names(&self, joints: &[String]) -> Result<Self, TrajectoryError> {
+        let row = self.header_row.unwrap_or(1);
+        let at = |c: usize, reason: String| {
+            csv_error(&self.source, row, c + 2, &self.columns[c], reason)
+        };
+        let mut order: Vec<Option<usize>> = vec![None; joints.len()];
+        for (c, name) in self.columns.iter().enumerate() {
+            let Some(j) = joints.iter().position(|n| n == name) else {
+                return Err(at(
+                    c,
+                    format!(
+                        "no joint of the arm is named so: the header names each column by its joint ({})",
+                        joints.join(", ")
+                    ),
+                ));
+            };
+            if let Some(first) = order[j] {
+                return Err(at(
+                    c,
+                    format!("joint '{name}' has a column already (column {})", first + 2),
+                ));
+            }
+            order[j] = Some(c);
+        }
+        let missing: Vec<&str> = joints
+            .iter()
+            .zip(&order)
+            .filter(|(_, c)| c.is_none())
+            .map(|(n, _)| n.as_str())
+            .collect();
+        if !missing.is_empty() {
+            return Err(csv_error(
+                &self.source,
+                row,
+                self.columns.len() + 2,
+                missing[0],
+                format!(
+                    "no column for joint{} {}: the header needs `t` then one column per joint, by name",
+                    if missing.len() == 1 { "" } else { "s" },
+                    missing.join(", ")
+                ),
+            ));
+        }
+        let order: Vec<usize> = order.into_iter().flatten().collect();
+        Ok(Self {
+            source: self.source.clone(),
+            columns: joints.to_vec(),
+            t: self.t.clone(),
+            values: order.iter().map(|&c| self.values[c].clone()).collect(),
+            header_row: self.header_row,
+        })
     }
 
     fn push_row(
@@ -350,6 +422,45 @@ mod tests {
             assert!((sp.eval(0, t)[1] - fd1).abs() < 1e-6, "t = {t}");
             assert!((sp.eval(0, t)[2] - fd2).abs() < 1e-4, "t = {t}");
         }
+    }
+
+    /// Issue 48 item 11 (D11): columns were taken by their place, so
+    /// `t,joint2,joint1` drove joint1 with joint2's motion and another
+    /// arm's names ran unremarked. Each column is found by its name; an
+    /// unknown name, a name twice and a joint with no column are refused
+    /// naming the file, the header's row and the column.
+    #[test]
+    fn columns_are_the_joints_by_name() {
+        let joints = ["joint1".to_string(), "joint2".to_string()];
+        let read = |text: &str| Samples::from_csv(text, "f.csv").unwrap();
+        let s = read(
+            "t,joint2,joint1
+0,2,1
+1,20,10
+",
+        );
+        let s = s.by_joint_names(&joints).unwrap();
+        assert_eq!(s.columns, joints);
+        assert_eq!(s.values, [vec![1.0, 10.0], vec![2.0, 20.0]]);
+        let e = |text: &str| read(text).by_joint_names(&joints).unwrap_err().to_string();
+        let other = e("# from the iiwa\nt,iiwa_joint_1,iiwa_joint_2\n0,0,0\n1,0,0\n");
+        assert!(
+            other.starts_with("f.csv: row 2, column 2 ('iiwa_joint_1'): no joint of the arm")
+                && other.contains("(joint1, joint2)"),
+            "{other}"
+        );
+        let twice = e("t,joint1,joint1\n0,0,0\n1,0,0\n");
+        assert!(
+            twice.starts_with(
+                "f.csv: row 1, column 3 ('joint1'): joint 'joint1' has a column already (column 2)"
+            ),
+            "{twice}"
+        );
+        let missing = e("t,joint2\n0,0\n1,0\n");
+        assert!(
+            missing.starts_with("f.csv: row 1, column 3 ('joint1'): no column for joint joint1"),
+            "{missing}"
+        );
     }
 
     #[test]
