@@ -333,6 +333,12 @@ impl Scenario {
                 "a rate from 1 to 100000 Hz",
             ));
         }
+        if let (Some(r), Some(need)) = (
+            self.reference.rate_hz,
+            self.reference.rate_fault(self.rate_hz),
+        ) {
+            return Err(invalid("reference.rate_hz", r, &need));
+        }
         if let Some(need) = self.reference.horizon_fault(self.rate_hz) {
             return Err(invalid(
                 "reference.horizon_s",
@@ -418,6 +424,30 @@ mod tests {
         Scenario::from_toml_str(text, "bad.toml")
             .unwrap_err()
             .to_string()
+    }
+
+    /// #48 item 12 (D12): `[reference] rate_hz = 50000` against a 1 kHz
+    /// loop flooded a real-time run until the logger starved and was blamed
+    /// ("not heard from"). A reference faster than the control rate is
+    /// refused before anything starts, naming both rates; the control rate
+    /// itself and slower are taken.
+    #[test]
+    fn a_reference_faster_than_the_control_rate_is_refused() {
+        let e = err("[reference]\nrate_hz = 50000.0\n");
+        assert!(
+            e.starts_with("bad.toml")
+                && e.contains("reference.rate_hz = 50000 is invalid")
+                && e.contains("at most the control rate, rate_hz = 1000 Hz"),
+            "{e}"
+        );
+        let e = err("rate_hz = 500.0\n[reference]\nrate_hz = 1000.0\n");
+        assert!(e.contains("rate_hz = 500 Hz"), "{e}");
+        for ok in [
+            "[reference]\nrate_hz = 1000.0\n",
+            "[reference]\nrate_hz = 250.0\n",
+        ] {
+            Scenario::from_toml_str(ok, "ok.toml").unwrap();
+        }
     }
 
     #[test]

@@ -149,7 +149,8 @@ pub struct ReferenceConfig {
     pub samples: Option<Samples>,
     /// Rate at which the trajectory publishes samples, Hz (default: unset,
     /// the control rate). The controller uses the newest sample not later
-    /// than the state, so a slower reference is held between samples.
+    /// than the state, so a slower reference is held between samples; a
+    /// faster one is refused ([`ReferenceConfig::rate_fault`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rate_hz: Option<f64>,
     /// In real time, how far ahead of its time each sample is published, s
@@ -175,6 +176,21 @@ fn default_horizon() -> f64 {
 }
 
 impl ReferenceConfig {
+    /// What `rate_hz` must be beside a control rate of `control_rate_hz`
+    /// (None: it is fine). At most the control rate: the controller takes
+    /// one sample a step, the newest at or before the state, so faster
+    /// samples are never used; in real time they only crowd the machine
+    /// (50 kHz against 1 kHz starved the logger, which was then blamed as
+    /// not heard from).
+    pub fn rate_fault(&self, control_rate_hz: f64) -> Option<String> {
+        let r = self.rate_hz?;
+        (r > control_rate_hz).then(|| {
+            format!(
+                "at most the control rate, rate_hz = {control_rate_hz} Hz: the controller takes one reference sample a control step, so a faster reference only sends samples no step uses (and in real time crowds out the other nodes)"
+            )
+        })
+    }
+
     /// What `horizon_s` must be when the reference is published at its own
     /// `rate_hz` or, unset, at `control_rate_hz`; None when it is.
     pub fn horizon_fault(&self, control_rate_hz: f64) -> Option<String> {
