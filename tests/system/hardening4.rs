@@ -179,6 +179,39 @@ fn a_helper_in_its_own_session_ends_with_the_run() {
     );
 }
 
+/// #48 item 6 (D17): a helper that also clears its environment
+/// (`setsid env -i`) carried no run name and outlived the run; and one
+/// orphaned at once (a subshell that exits) had no parent below the nodes.
+/// The launcher is its descendants' subreaper and ends the run's tree:
+/// neither outlives the run.
+#[test]
+fn a_helper_with_a_cleared_environment_ends_with_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let id = std::process::id();
+    let kept = format!("{}.{}", 300 + id % 600, 10 + id % 89);
+    let orphan = format!("{}.{}", 301 + id % 600, 10 + id % 89);
+    let (status, err) = crate::util::run_with_controller_script(
+        dir.path(),
+        &format!("setsid env -i sleep {kept} &\n(setsid env -i sleep {orphan} &)"),
+    );
+    let mut left = String::new();
+    for marker in [&kept, &orphan] {
+        let helpers = std::process::Command::new("pgrep")
+            .args(["-f", &format!("^sleep {marker}$")])
+            .output()
+            .unwrap();
+        let found = String::from_utf8_lossy(&helpers.stdout).to_string();
+        for pid in found.split_whitespace() {
+            let _ = std::process::Command::new("kill")
+                .args(["-9", pid])
+                .status();
+        }
+        left += &found;
+    }
+    assert!(status.success(), "{err}");
+    assert!(left.trim().is_empty(), "a helper outlived the run: {left}");
+}
+
 /// Row 1: a byte changed in a record outside the chunks (the run's
 /// metadata, a channel) makes the log invalid: the data section's
 /// checksum covers them.

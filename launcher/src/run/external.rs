@@ -204,6 +204,9 @@ fn describe(command: &[String]) -> Result<Option<String>, RunError> {
         std::process::id(),
         std::thread::current().id()
     );
+    // Its process tree, adopted here, ends with it (a helper that cleared
+    // its environment carries no tag).
+    let mut tree = super::strays::RunTree::default();
     let mut child = Command::new(program)
         .args(words)
         .arg("--describe")
@@ -216,8 +219,11 @@ fn describe(command: &[String]) -> Result<Option<String>, RunError> {
         .map_err(|e| refused(command, format!("cannot start it: {e}")))?;
     // Whatever it started goes with it (a helper would hold the pipe open).
     let group = nix::unistd::Pid::from_raw(child.id() as i32);
-    let end_group = || {
+    let nodes = [group.as_raw()];
+    let end_group = |tree: &mut super::strays::RunTree| {
+        tree.note(&nodes, true);
         let _ = nix::sys::signal::killpg(group, nix::sys::signal::Signal::SIGKILL);
+        tree.end(&nodes);
         super::strays::end_strays(&tag);
     };
     let mut out = String::new();
@@ -237,8 +243,9 @@ fn describe(command: &[String]) -> Result<Option<String>, RunError> {
         {
             break status;
         }
+        tree.note(&nodes, false);
         if start.elapsed() > DESCRIBE_WAIT {
-            end_group();
+            end_group(&mut tree);
             let _ = child.wait();
             return Err(refused(
                 command,
@@ -250,7 +257,7 @@ fn describe(command: &[String]) -> Result<Option<String>, RunError> {
         }
         std::thread::sleep(Duration::from_millis(10));
     };
-    end_group();
+    end_group(&mut tree);
     // The pipe closes with the group; a reader still blocked is left behind.
     let waited = Instant::now();
     while !reader.is_finished() && waited.elapsed() < Duration::from_secs(1) {

@@ -167,12 +167,16 @@ fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
     stop.code = end.code();
     let _ = control.send(stop);
     let forced = children.stop(STOP_GRACE);
+    // What the nodes started, wherever it moved (its own session, a
+    // cleared environment): adopted by this process, killed and reaped.
+    children.end_descendants();
     let result = result.map_err(|e| e.with_stderr_of(&mut children));
     let logger_exit = children.exit_of(NodeKind::Logger);
     // Close every port of this process, then remove what is left of the
     // run's domain (including what a killed node left behind).
     drop((status, control, bus));
-    // What the nodes started and left behind (a helper in its own session).
+    // And whatever still carries the run's name (adopted by another
+    // subreaper, say).
     strays::end_strays(prefix.as_str());
     let _ = prefix.remove_domain_if_unused();
     prefix.remove_leftover_files(true);

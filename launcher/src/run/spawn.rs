@@ -287,9 +287,9 @@ pub fn describe(status: ExitStatus) -> String {
     }
 }
 
-/// All node processes of a run.
+/// All node processes of a run, and the run's process tree below them.
 #[derive(Default)]
-pub struct Children(Vec<Child>);
+pub struct Children(Vec<Child>, super::strays::RunTree);
 
 impl Children {
     /// Adds a spawned child.
@@ -306,6 +306,25 @@ impl Children {
             }
         }
         None
+    }
+
+    /// Notes what the nodes have started so far (at most every 50 ms),
+    /// so that it ends with the run wherever it moves
+    /// ([`super::strays::RunTree`]).
+    pub fn watch(&mut self) {
+        let nodes = self.node_pids();
+        self.1.note(&nodes, false);
+    }
+
+    /// Kills and reaps what is left of the nodes' process tree once they
+    /// are gone; how many were killed.
+    pub fn end_descendants(&mut self) -> usize {
+        let nodes = self.node_pids();
+        self.1.end(&nodes)
+    }
+
+    fn node_pids(&self) -> Vec<i32> {
+        self.0.iter().map(|c| c.pid() as i32).collect()
     }
 
     /// Each child's process id.
@@ -342,6 +361,9 @@ impl Children {
     /// then SIGTERM, another `grace`, then SIGKILL. Returns the children
     /// that needed a signal.
     pub fn stop(&mut self, grace: Duration) -> Vec<(NodeKind, &'static str)> {
+        // The last look while the nodes' helpers are still below them.
+        let nodes = self.node_pids();
+        self.1.note(&nodes, true);
         let mut forced = Vec::new();
         if !self.wait_all(grace) {
             for c in &mut self.0 {
@@ -384,6 +406,7 @@ impl Children {
 
 impl Drop for Children {
     fn drop(&mut self) {
+        let nodes = self.node_pids();
         for c in &mut self.0 {
             if c.poll().is_none() {
                 c.signal_group(Signal::SIGKILL);
@@ -392,6 +415,7 @@ impl Drop for Children {
             let _ = c.process.wait();
             c.join_forwarder();
         }
+        self.1.end(&nodes);
     }
 }
 

@@ -155,6 +155,7 @@ fn tick(bus: &Bus) -> Result<(), RunError> {
 
 /// Any child that exits before the run is over has failed.
 fn check_children(children: &mut Children) -> Result<(), RunError> {
+    children.watch();
     match children.first_exited() {
         Some((kind, status, stderr)) => Err(RunError::NodeFailed {
             node: kind.name(),

@@ -34,6 +34,11 @@ const LEGACY_V1: &str = "foxglove.websocket.v1";
 const MAX_HEAD: usize = 16 * 1024;
 /// How long a client may take to send its whole handshake.
 const HANDSHAKE_WAIT: Duration = Duration::from_secs(10);
+/// The window in which at most `max_clients` new sessions start: the
+/// limit on clients at once alone let reconnect loops through (30 loops
+/// against a limit of 2 made 990 server sessions and 60 MB in 17 s, never
+/// more than 2 at once). A viewer that reloads now and then never meets it.
+const SESSION_WINDOW: Duration = Duration::from_secs(1);
 
 /// The relay, running.
 pub(super) struct Front {
@@ -123,6 +128,7 @@ fn wake_address(addr: SocketAddr) -> SocketAddr {
 
 fn accept_loop(listener: &TcpListener, inner: SocketAddr, shared: &Arc<Shared>) {
     let mut next = 0u64;
+    let (mut window, mut started) = (Instant::now(), 0usize);
     for conn in listener.incoming() {
         if shared.stop.load(Ordering::SeqCst) {
             return;
@@ -132,9 +138,18 @@ fn accept_loop(listener: &TcpListener, inner: SocketAddr, shared: &Arc<Shared>) 
         let Ok(client) = conn else { continue };
         if shared.open().len() >= shared.max_clients {
             shared.refused.fetch_add(1, Ordering::Relaxed);
-            refuse(client, shared.max_clients);
+            refuse(client, &at_once(shared.max_clients));
             continue;
         }
+        if window.elapsed() >= SESSION_WINDOW {
+            (window, started) = (Instant::now(), 0);
+        }
+        if started >= shared.max_clients {
+            shared.refused.fetch_add(1, Ordering::Relaxed);
+            refuse(client, &too_often(shared.max_clients));
+            continue;
+        }
+        started += 1;
         next += 1;
         let Ok(kept) = client.try_clone() else {
             continue;
@@ -155,12 +170,24 @@ fn accept_loop(listener: &TcpListener, inner: SocketAddr, shared: &Arc<Shared>) 
     }
 }
 
-/// Answers a client past the limit with a reason it can show.
-fn refuse(mut client: TcpStream, max: usize) {
-    let body = format!(
+/// Why a client past the limit on clients at once is refused.
+fn at_once(max: usize) -> String {
+    format!(
         "this run's live view serves at most {max} clients at once \
          (testbed run --live-clients N)\n"
-    );
+    )
+}
+
+/// Why a client past the limit on new sessions is refused.
+fn too_often(max: usize) -> String {
+    format!(
+        "this run's live view starts at most {max} sessions a second \
+         (testbed run --live-clients N); connect again in a second\n"
+    )
+}
+
+/// Answers a refused client with a reason it can show.
+fn refuse(mut client: TcpStream, body: &str) {
     let answer = format!(
         "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain\r\n\
          Connection: close\r\nContent-Length: {}\r\n\r\n{body}",
@@ -327,6 +354,49 @@ mod tests {
         );
         // Watchdog, not a timing claim: it did not wait for ever.
         assert!(start.elapsed() < Duration::from_secs(30));
+    }
+
+    /// #48 item 6 (D9): the limit on clients at once let reconnect loops
+    /// through (30 loops against a limit of 2: 990 sessions in 17 s). A
+    /// stand-in server answers each handshake and closes, so each session
+    /// ends at once and a slot is always free: 300 connections one after
+    /// another start at most `max_clients` sessions a second; the rest are
+    /// refused with the reason.
+    #[test]
+    fn reconnect_loops_start_at_most_max_clients_sessions_a_second() {
+        let inner = TcpListener::bind("127.0.0.1:0").unwrap();
+        let inner_addr = inner.local_addr().unwrap();
+        std::thread::spawn(move || {
+            for c in inner.incoming() {
+                let Ok(mut c) = c else { continue };
+                let _ = read_head(&mut c, Instant::now() + Duration::from_secs(5));
+                let _ = c.write_all(b"HTTP/1.1 101 Switching Protocols\r\n\r\n");
+            }
+        });
+        let front = Front::start("127.0.0.1:0".parse().unwrap(), inner_addr, 2).unwrap();
+        let start = Instant::now();
+        let mut reasons = HashSet::new();
+        for _ in 0..300 {
+            let mut c = TcpStream::connect(front.address()).unwrap();
+            c.write_all(OFFER.as_bytes()).unwrap();
+            // A watchdog: each connection ends when the relay closes it.
+            c.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
+            let mut answer = String::new();
+            let _ = c.read_to_string(&mut answer);
+            reasons.insert(answer.lines().next().unwrap_or_default().to_string());
+        }
+        let seconds = start.elapsed().as_secs_f64().ceil() as u64;
+        let (refused, accepted) = front.counts();
+        front.stop();
+        assert!(
+            accepted <= 2 * (seconds + 1),
+            "{accepted} sessions in {seconds} s (limit 2 a second)"
+        );
+        assert_eq!(refused + accepted, 300);
+        assert!(
+            reasons.contains("HTTP/1.1 503 Service Unavailable"),
+            "{reasons:?}"
+        );
     }
 
     const OFFER: &str =
