@@ -2,6 +2,9 @@
 //! the step after its episode ended (Gymnasium's "next step" autoreset),
 //! with a stream of seeds so that a seeded vector repeats exactly.
 
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+
 use scenario::Plan;
 
 use crate::arm::{ArmEnv, Outcome, ResetOptions};
@@ -43,6 +46,9 @@ pub struct ArmEnvs {
     n: usize,
     /// None: the arms step one after another on the caller's thread.
     pool: Option<rayon::ThreadPool>,
+    /// Counts the calls that use the pool: a lingering worker (below)
+    /// stops when it changes.
+    calls: Arc<AtomicU64>,
     /// Rows for the outcomes and final observations a call does not ask
     /// for (a reset; a NEXT_STEP step), kept to allocate once.
     spare_out: Vec<Outcome>,
@@ -118,10 +124,11 @@ impl ArmEnvs {
         }
         envs.insert(0, first);
         let threads = threads.min(count);
+        // The calling thread is one of the threads: the pool has the others.
         let pool = if threads > 1 {
             Some(
                 rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
+                    .num_threads(threads - 1)
                     .thread_name(|i| format!("gym-env-{i}"))
                     .build()?,
             )
@@ -137,6 +144,7 @@ impl ArmEnvs {
             obs_dim,
             n,
             pool,
+            calls: Arc::new(AtomicU64::new(0)),
         })
     }
 
@@ -159,7 +167,7 @@ impl ArmEnvs {
     pub fn threads(&self) -> usize {
         self.pool
             .as_ref()
-            .map_or(1, rayon::ThreadPool::current_num_threads)
+            .map_or(1, |p| p.current_num_threads() + 1)
     }
 
     /// Runs `f` on every arm, on the pool if there is one; the first
@@ -173,7 +181,7 @@ impl ArmEnvs {
         f: F,
     ) -> Result<(), EnvError>
     where
-        F: Fn(Arm<'_>) -> Result<(), EnvError> + Sync,
+        F: Fn(&mut Arm<'_>) -> Result<(), EnvError> + Sync,
     {
         let d = self.obs_dim;
         let out = out.unwrap_or(&mut self.spare_out);
@@ -188,32 +196,93 @@ impl ArmEnvs {
             out,
             final_obs,
         };
-        match &self.pool {
-            None => envs
-                .iter_mut()
-                .zip(seeds.iter_mut())
-                .zip(ended.iter_mut())
-                .zip(obs.chunks_mut(d))
-                .zip(out.iter_mut())
-                .zip(fin.chunks_mut(d))
-                .enumerate()
-                .try_for_each(|x| f(arm(x))),
-            Some(pool) => pool.install(|| {
-                use rayon::prelude::*;
-                // Whole arms to each task: rayon splits the range in
-                // halves down to single arms, and idle threads steal.
-                let results: Vec<Result<(), EnvError>> = envs
-                    .par_iter_mut()
-                    .zip(seeds.par_iter_mut())
-                    .zip(ended.par_iter_mut())
-                    .zip(obs.par_chunks_mut(d))
-                    .zip(out.par_iter_mut())
-                    .zip(fin.par_chunks_mut(d))
-                    .enumerate()
-                    .map(|x| f(arm(x)))
-                    .collect();
-                results.into_iter().collect()
-            }),
+        let arms = envs
+            .iter_mut()
+            .zip(seeds.iter_mut())
+            .zip(ended.iter_mut())
+            .zip(obs.chunks_mut(d))
+            .zip(out.iter_mut())
+            .zip(fin.chunks_mut(d))
+            .enumerate()
+            .map(arm);
+        let Some(pool) = &self.pool else {
+            return arms.into_iter().try_for_each(|mut a| f(&mut a));
+        };
+        // Each arm behind a lock only one thread ever takes (an arm index
+        // is handed out once): safe sharing of the rows, uncontended.
+        let arms: Vec<Mutex<Arm<'_>>> = arms.map(Mutex::new).collect();
+        let done = AtomicUsize::new(0);
+        let first_error: Mutex<Option<(usize, EnvError)>> = Mutex::new(None);
+        let threads = pool.current_num_threads() + 1;
+        let blocks = Blocks::new(arms.len(), threads);
+        let step = |i: usize| {
+            let Some(a) = arms.get(i) else { return };
+            let mut a = a.lock().unwrap_or_else(PoisonError::into_inner);
+            if let Err(e) = f(&mut a) {
+                let mut slot = first_error.lock().unwrap_or_else(PoisonError::into_inner);
+                if slot.as_ref().is_none_or(|(j, _)| i < *j) {
+                    *slot = Some((i, e));
+                }
+            }
+            done.fetch_add(1, Ordering::Release);
+        };
+        // Thread k steps block k of neighbouring arms from its front, then
+        // takes arms from the back of the others' blocks (a thread the OS
+        // holds back gets fewer). Whole blocks, not alternate arms:
+        // neighbouring arms' memory shares cache lines, and two threads
+        // stepping alternate arms fought over them (64 two-link arms were
+        // no faster on two threads than on one).
+        let work = |k: usize| {
+            while let Some(i) = blocks.front(k) {
+                step(i);
+            }
+            for j in (1..threads).map(|o| (k + o) % threads) {
+                while let Some(i) = blocks.back(j) {
+                    step(i);
+                }
+            }
+        };
+        // Ends the workers' lingering after the last call: they take this
+        // call's arms at once, awake.
+        let call = self.calls.fetch_add(1, Ordering::AcqRel) + 1;
+        // The calling thread steps arms too, while the pool's threads
+        // wake up (which, in a virtual machine, can take as long as
+        // stepping a few arms).
+        pool.in_place_scope(|scope| {
+            for k in 1..threads {
+                let work = &work;
+                scope.spawn(move |_| work(k));
+            }
+            work(0);
+            // The last arms may still be stepping on the pool: wait for
+            // them spinning, up to a bound, rather than sleeping on the
+            // scope's latch, whose wake-up costs more than a short step.
+            let start = std::time::Instant::now();
+            while done.load(Ordering::Acquire) < arms.len() && start.elapsed() < SPIN_WAIT {
+                std::hint::spin_loop();
+            }
+        });
+        // A worker that sleeps between calls is woken by the next one, which
+        // costs (in a virtual machine) tens of microseconds, a good part
+        // of a call of 64 two-link arms at one plant period. So each
+        // worker stays awake for a while after a call, spinning until the
+        // next one starts or LINGER passes: a caller that steps in a
+        // loop finds it awake.
+        for _ in 0..pool.current_num_threads() {
+            let calls = Arc::clone(&self.calls);
+            pool.spawn(move || {
+                let start = std::time::Instant::now();
+                while calls.load(Ordering::Acquire) == call && start.elapsed() < LINGER {
+                    std::hint::spin_loop();
+                }
+            });
+        }
+        match first_error
+            .into_inner()
+            .unwrap_or_else(PoisonError::into_inner)
+        {
+            Some((_, e)) => Err(e),
+            None => Ok(()),
         }
     }
 
@@ -334,3 +403,66 @@ impl ArmEnvs {
 
 /// The most threads a vector steps on.
 pub const MAX_THREADS: usize = 1024;
+
+/// How long the calling thread spins for the pool's last arms before it
+/// sleeps until they are done.
+const SPIN_WAIT: std::time::Duration = std::time::Duration::from_micros(200);
+
+/// How long the pool's threads stay awake after a call for the next one.
+const LINGER: std::time::Duration = std::time::Duration::from_micros(500);
+
+/// The arms cut into one block of neighbours per thread, each taken from
+/// its front by its own thread and from its back by the others: per block
+/// the next front and the end, packed in one atomic word.
+struct Blocks(Vec<AtomicU64>);
+
+impl Blocks {
+    fn new(count: usize, threads: usize) -> Self {
+        let per = count.div_ceil(threads);
+        Self(
+            (0..threads)
+                .map(|k| {
+                    let (front, end) = ((k * per).min(count), ((k + 1) * per).min(count));
+                    AtomicU64::new(pack(front, end))
+                })
+                .collect(),
+        )
+    }
+
+    /// The next arm from block `k`'s front, if any is left.
+    fn front(&self, k: usize) -> Option<usize> {
+        self.take(k, |front, end| {
+            (front < end).then(|| (front, pack(front + 1, end)))
+        })
+    }
+
+    /// The last arm left in block `k`, if any.
+    fn back(&self, k: usize) -> Option<usize> {
+        self.take(k, |front, end| {
+            (front < end).then(|| (end - 1, pack(front, end - 1)))
+        })
+    }
+
+    fn take(&self, k: usize, pick: impl Fn(usize, usize) -> Option<(usize, u64)>) -> Option<usize> {
+        let block = self.0.get(k)?;
+        let mut now = block.load(Ordering::Acquire);
+        loop {
+            let (front, end) = unpack(now);
+            let (arm, next) = pick(front, end)?;
+            match block.compare_exchange_weak(now, next, Ordering::AcqRel, Ordering::Acquire) {
+                Ok(_) => return Some(arm),
+                Err(seen) => now = seen,
+            }
+        }
+    }
+}
+
+/// A block's next front and end in one word (each below 2³², as the
+/// arms are at most [`MAX_ENVS`]).
+fn pack(front: usize, end: usize) -> u64 {
+    ((front as u64) << 32) | end as u64
+}
+
+fn unpack(v: u64) -> (usize, usize) {
+    ((v >> 32) as usize, (v & 0xFFFF_FFFF) as usize)
+}
