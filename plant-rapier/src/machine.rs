@@ -112,18 +112,21 @@ impl PlantMachine {
     /// A warning, to say before the run, when the substeps the engine adds
     /// for stiff springs or damping make the plant alone slower than real
     /// time: the estimated factor, from substeps timed on a copy of the
-    /// arm (a few hundred, well under a millisecond's worth).
+    /// arm (the fastest of five looks at 128, well under a millisecond's
+    /// worth).
     pub fn speed_warning(&self) -> Result<Option<String>, PlantError> {
         let cost = self.period_cost()?;
         if cost.cause.is_none() {
             return Ok(None);
         }
         let dt = self.period_ns as f64 / 1e9;
-        Ok(self
-            .rig
-            .plant()
-            .time_substeps(dt, 256)
-            .and_then(|s| cost.warning(s)))
+        // The fastest of a few looks: another process's time slice is the
+        // machine's load, not the plant's cost (one look on a loaded
+        // machine once warned of a scenario that keeps up 14 times over).
+        let fastest = (0..5)
+            .filter_map(|_| self.rig.plant().time_substeps(dt, 128))
+            .reduce(f64::min);
+        Ok(fastest.and_then(|s| cost.warning(s)))
     }
 
     /// Control period, ns.
