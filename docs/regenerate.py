@@ -414,6 +414,87 @@ def robustness_page() -> str:
     return "\n".join(lines)
 
 
+# The learnt residual (#51 item 7): a shipped ONNX policy as a row of
+# compare, at the gains it was trained at, on held-out seeds and under the
+# stresses where the paper's law claims its edge.
+POLICY = "policies/ppo_residual_pd_quarter.onnx"
+LEARNT_SEEDS, LEARNT_FIRST_SEED, LEARNT_DURATION = 20, 10000, "4"
+QUARTER = ["controller.k1=3.75", "controller.k2=3.75"]
+LEARNT_LAWS = ["nac", "pd", "pd-gravity"]
+LEARNT_STRESS = [
+    ("as trained (held-out seeds)", []),
+    ("payload 2 kg at the tip of link 2", PAYLOAD + ["plant.payload.mass=2"]),
+    ("model error: plant masses × 1.5", fixed("mass_scale", 1.5)),
+    ("envelope width × 0.3", env_sets(0.3)),
+]
+
+
+def policy_node() -> str:
+    exe = os.environ.get("TESTBED_POLICY") or str(ROOT / "target/release/testbed-policy")
+    if not Path(exe).exists():
+        sys.exit(f"regenerate: no {exe}: build it (cargo build --release --bin testbed-policy) "
+                 "or set TESTBED_POLICY")
+    return f"{shlex.quote(exe)} {POLICY}"
+
+
+def learnt_args(sets: list[str], laws: list[str], with_policy: bool) -> list[str]:
+    args = ["compare", "--scenario", "paper_randomised", "--seeds", str(LEARNT_SEEDS),
+            "--duration", LEARNT_DURATION, "--laws", ",".join(laws), "--set", f"seed={LEARNT_FIRST_SEED}"]
+    for line in sets:
+        args += ["--set", line]
+    if with_policy:
+        args += ["--controller-cmd", f"ppo={policy_node()}"]
+    return args
+
+
+def kept_iae(c: dict, name: str) -> str:
+    row = next(r for r in c["laws"] if r["name"] == name)
+    return f"{row['kept_envelope']}/{len(row['runs'])} · {g(row['median']['iae'], 3)}"
+
+
+def learnt_page() -> str:
+    lines = header(
+        "A learnt residual beside the laws",
+        f"testbed compare --scenario paper_randomised --seeds {LEARNT_SEEDS} --duration {LEARNT_DURATION} "
+        f"--laws {','.join(LEARNT_LAWS)} --set seed={LEARNT_FIRST_SEED} --set {' --set '.join(QUARTER)} "
+        f"[--set STRESS] --controller-cmd ppo=\"target/release/testbed-policy {POLICY}\" --json",
+    )
+    lines += [
+        f"`ppo` is [`{POLICY}`](../../{POLICY}): PPO's residual on `pd` at a quarter of its gains",
+        "(K1 = K2 = 3.75), trained by `python/examples/train_sb3.py --seed 0` on the Gymnasium",
+        "environment's defaults and exported by `python/examples/export_sb3_onnx.py`",
+        f"([{POLICY.split('/')[0]}/README.md](../../{POLICY.split('/')[0]}/README.md)). It runs as the Rust",
+        "controller node `testbed-policy` (tract), in lockstep, one process per seed, like any",
+        f"external law. Seeds {LEARNT_FIRST_SEED}–{LEARNT_FIRST_SEED + LEARNT_SEEDS - 1} were never drawn in training.",
+        "The other laws run at the same quarter gains (as given, not matched: the policy was",
+        "trained at these). A cell is `kept/seeds · median IAE after T_c`; *ppo vs nac* is the",
+        "paired Wilcoxon test on IAE over the seeds (Holm within that comparison) and the median",
+        "of the per-seed differences nac − ppo. *Torque rate* is the median ∫(dτ/dt)² of ppo over",
+        "nac's: the residual is held for a decision (20 ms), so the torque steps at every decision.",
+        "",
+        "| condition | " + " | ".join(LEARNT_LAWS) + " | ppo | ppo vs nac (IAE) | torque rate ppo / nac |",
+        "|---" * (len(LEARNT_LAWS) + 4) + "|",
+    ]
+    for name, sets in LEARNT_STRESS:
+        c = run_json(learnt_args(QUARTER + sets, LEARNT_LAWS, True))
+        t = next(x for x in c["paired"] if x["law"] == "nac" and x["versus"] == "ppo" and x["metric"] == "iae")
+        test = t["test"]
+        cells = [kept_iae(c, law) for law in LEARNT_LAWS + ["ppo"]]
+        cells.append(f"nac − ppo {g(test['median_difference'], 3)}; ppo lower on {test['b_smaller']} of "
+                     f"{test['pairs']}; p Holm {g(t['p_holm'], 2)}")
+        rate = {r["name"]: r["median"]["torque_rate"] for r in c["laws"]}
+        cells.append(g(rate["ppo"] / rate["nac"], 3))
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    full = run_json(learnt_args([], ["nac", "pd-gravity"], False))
+    lines += [
+        "",
+        f"At the paper's full gains (K1 = K2 = 15) on the same seeds, as trained: nac {kept_iae(full, 'nac')},",
+        f"pd-gravity {kept_iae(full, 'pd-gravity')}.",
+        "",
+    ]
+    return "\n".join(lines)
+
+
 # Sweep files whose report is a page: the parameters the paper leaves open
 # and PPC's funnel floor, where the barrier acts (#37 item 6).
 SWEEPS = ["nac_open_parameters", "ppc_rho"]
@@ -467,6 +548,7 @@ PAGES = {
     "compare.md": compare_page,
     "findings.md": findings_page,
     "robustness.md": robustness_page,
+    "learnt.md": learnt_page,
     "sweeps.md": sweeps_page,
 }
 

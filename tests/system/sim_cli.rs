@@ -244,6 +244,8 @@ fn the_docs_generated_numbers_are_current() {
         .arg("docs/regenerate.py")
         .args(["--check", "--skip", "robustness.md"])
         .env("TESTBED", env!("CARGO_BIN_EXE_testbed"))
+        // learnt.md runs the shipped ONNX policy as a compare row.
+        .env("TESTBED_POLICY", env!("CARGO_BIN_EXE_testbed-policy"))
         .current_dir(crate::util::repo_root())
         .output()
         .unwrap();
