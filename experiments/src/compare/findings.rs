@@ -56,7 +56,7 @@ pub const BLOW_UP: f64 = 100.0;
 
 /// The claims, in the order [`findings`] lists them (3 and 6 once per
 /// law they are tested against, 4 once per law and metric).
-const CLAIMS: [&str; 7] = [
+const CLAIMS: [&str; 8] = [
     "nac keeps |e| < k_c after T_c",
     "nac may start outside the envelope and is inside by T_c",
     "nac keeps the envelope on seeds where a law without a barrier leaves it",
@@ -64,6 +64,7 @@ const CLAIMS: [&str; 7] = [
     "the actor-critic lowers the error after T_c",
     "nac keeps the envelope on seeds where a reviewer's baseline leaves it",
     "the critic lowers the error after T_c",
+    "nac's error after T_c is lower than a user's controller's",
 ];
 
 /// Every claim's finding on `c`.
@@ -114,6 +115,11 @@ pub fn findings(c: &Comparison) -> Vec<Finding> {
         drafts.push(separates(c, nac, other, CLAIMS[5], runs));
     }
     drafts.push(better(c, nac, LawName::NacNoCritic, "iae", CLAIMS[6], runs));
+    // A user's controller (an offline-learnt policy, say) is judged by the
+    // same rule as the critic: learning's place is a question of error.
+    for user in c.laws.iter().filter(|r| r.external.is_some()) {
+        drafts.push(better(c, nac, Other::User(user), "iae", CLAIMS[7], runs));
+    }
     decide(drafts)
 }
 
@@ -196,6 +202,29 @@ fn verdict_of(t: Tested, p_holm: f64, family: usize) -> Finding {
             "{}; {} p = {:.2e}, Holm p = {:.2e} over the {family} tests of these findings{why}",
             t.evidence, t.test, t.p, p_holm
         ),
+    }
+}
+
+/// The law `nac` is tested against: a built-in one (looked up in the
+/// comparison), or a user's controller's row.
+#[derive(Clone, Copy)]
+enum Other<'a> {
+    Law(LawName),
+    User(&'a LawRow),
+}
+
+impl std::fmt::Display for Other<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Law(law) => write!(f, "{law}"),
+            Self::User(r) => write!(f, "{}", r.name),
+        }
+    }
+}
+
+impl From<LawName> for Other<'_> {
+    fn from(law: LawName) -> Self {
+        Self::Law(law)
     }
 }
 
@@ -335,10 +364,14 @@ fn done(claim: &str, verdict: Verdict, evidence: String) -> Draft {
 fn opponent<'a>(
     c: &'a Comparison,
     nac: &LawRow,
-    other: LawName,
+    other: Other<'a>,
     claim: &str,
 ) -> Result<&'a LawRow, Draft> {
-    let Some(o) = row(c, other) else {
+    let found = match other {
+        Other::Law(law) => row(c, law),
+        Other::User(r) => Some(r),
+    };
+    let Some(o) = found else {
         return Err(done(
             claim,
             Verdict::NotTested,
@@ -359,7 +392,7 @@ fn opponent<'a>(
 /// and 5): McNemar's exact test on the discordant seeds.
 fn separates(c: &Comparison, nac: &LawRow, other: LawName, claim: &str, runs: usize) -> Draft {
     let claim = format!("{claim} (vs {other})");
-    let o = match opponent(c, nac, other, &claim) {
+    let o = match opponent(c, nac, other.into(), &claim) {
         Ok(o) => o,
         Err(done) => return done,
     };
@@ -408,14 +441,15 @@ fn separates(c: &Comparison, nac: &LawRow, other: LawName, claim: &str, runs: us
 
 /// `nac` against `other` on `metric` (smaller is better), paired seed by
 /// seed (claims 4–6).
-fn better(
-    c: &Comparison,
+fn better<'a>(
+    c: &'a Comparison,
     nac: &LawRow,
-    other: LawName,
+    other: impl Into<Other<'a>>,
     metric: &str,
     claim: &str,
     runs: usize,
 ) -> Draft {
+    let other = other.into();
     let claim = format!("{claim} (vs {other}, {metric})");
     let o = match opponent(c, nac, other, &claim) {
         Ok(o) => o,
@@ -556,6 +590,7 @@ fn num(x: Option<f64>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::compare::types::ExternalRow;
     use crate::compare::{CompareOptions, compare};
 
     fn run(laws: Vec<LawName>) -> Comparison {
@@ -680,5 +715,61 @@ mod tests {
     fn without_nac_nothing_is_tested() {
         let f = findings(&run(vec![LawName::Pd]));
         assert!(f.iter().all(|f| f.verdict == Verdict::NotTested));
+    }
+
+    /// A row of `r` as if a user's controller had made it.
+    fn as_user(r: &LawRow, name: &str) -> LawRow {
+        let mut u = r.clone();
+        u.name = name.into();
+        u.external = Some(ExternalRow {
+            command: format!("./{name}"),
+            declared: None,
+        });
+        u
+    }
+
+    #[test]
+    fn a_users_controller_is_tested_against_nac_on_the_error() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../scenarios/paper_randomised.toml"
+        );
+        let plan = scenario::load(
+            Some(std::path::Path::new(path)),
+            &scenario::Overrides {
+                duration_s: Some(2.5),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let opts = CompareOptions {
+            law_sets: Vec::new(),
+            external: Vec::new(),
+            runs_dir: std::path::PathBuf::from("runs"),
+            progress: false,
+            laws: vec![LawName::Nac, LawName::Pd],
+            seeds: 8,
+            threads: Some(1),
+            series: false,
+            tuning: None,
+        };
+        let mut c = compare(&plan, &opts).unwrap();
+        let (nac, pd) = (c.laws[0].clone(), c.laws[1].clone());
+        c.laws.push(as_user(&nac, "twin"));
+        c.laws.push(as_user(&pd, "mine"));
+        let f = findings(&c);
+        let of = |name: &str| {
+            f.iter()
+                .find(|f| f.claim.contains(&format!("(vs {name}, iae)")))
+                .unwrap_or_else(|| panic!("no finding against {name}: {f:#?}"))
+        };
+        // The same runs: nothing to test.
+        assert_eq!(of("twin").verdict, Verdict::NotTested, "{:?}", of("twin"));
+        assert!(of("twin").evidence.starts_with("identical, not tested"));
+        // pd's runs under another name: tested, seed by seed, as pd's are.
+        let mine = of("mine");
+        assert!(mine.evidence.contains("Wilcoxon signed-rank"), "{mine:?}");
+        assert!(mine.evidence.contains("paired over 8 runs"), "{mine:?}");
+        assert!(mine.claim.starts_with(CLAIMS[7]), "{mine:?}");
     }
 }
