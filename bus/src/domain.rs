@@ -63,7 +63,10 @@ impl RunPrefix {
         // management segment is removed. The prefix is unique to one run
         // (process id and start time), and the listing above found no live
         // node in it: every process of that run has ended.
-        #[allow(unsafe_code, reason = "iceoryx2 removes a dead run's domain only this way; SAFETY above")]
+        #[allow(
+            unsafe_code,
+            reason = "iceoryx2 removes a dead run's domain only this way; SAFETY above"
+        )]
         let removed =
             unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(&config) };
         removed.map_err(|e| WireError::Ipc {
