@@ -47,6 +47,21 @@ def _seed_from(rng: np.random.Generator) -> int:
     return int(rng.integers(0, 2**63 - 1))
 
 
+def _real_actions(actions, what: str = "step: action") -> np.ndarray:
+    """The actions as float64, refusing what would be read silently wrong:
+    complex (its imaginary part dropped), bool (True as 1.0), float16 (an
+    action rounded to 3 digits), strings and objects. Integers are taken
+    (exact as floats)."""
+    arr = np.asarray(actions)
+    kind, size = arr.dtype.kind, arr.dtype.itemsize
+    if kind in "iu" or (kind == "f" and size >= 4):
+        return arr.astype(np.float64, copy=False)
+    why = {"c": "complex: its imaginary part would be dropped",
+           "b": "bool: True would be read as 1.0",
+           "f": "float16: the action would be rounded to 3 significant digits"}.get(kind, "not numbers")
+    raise TypeError(f"{what}: dtype {arr.dtype} is refused ({why}); give float32 or float64")
+
+
 def _render_mode(render_mode):
     if render_mode is not None and render_mode not in RENDER_MODES:
         raise ValueError(f"render_mode = {render_mode!r}: the modes are None and 'rgb_array'")
@@ -109,7 +124,7 @@ class ArmTrackingEnv(gymnasium.Env):
     def step(self, action):
         if self._ended:
             raise RuntimeError("step() after the episode ended: call reset() first")
-        out = self._core.step(action)
+        out = self._core.step(_real_actions(action))
         self._ended = out[2] or out[3]
         return out
 
@@ -170,7 +185,7 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         return obs, {}
 
     def step(self, actions):
-        actions = np.asarray(actions, dtype=np.float64)
+        actions = _real_actions(actions, "step: actions")
         obs, rewards, terminated, truncated, costs = self._core.step(actions)
         return obs, rewards, terminated, truncated, {"cost": costs, "_cost": self._all}
 

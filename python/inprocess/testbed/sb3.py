@@ -32,7 +32,7 @@ except ImportError as e:  # pragma: no cover - the message is the point
     raise ImportError("testbed.sb3 needs Stable-Baselines3: pip install stable-baselines3") from e
 
 from ._native import VecEnvCore
-from .env import RENDER_MODES, RENDER_SIZE, _render_mode, _spaces
+from .env import RENDER_MODES, RENDER_SIZE, _real_actions, _render_mode, _spaces
 
 __all__ = ["ArmTrackingSB3VecEnv"]
 
@@ -137,7 +137,7 @@ class ArmTrackingSB3VecEnv(VecEnv):
         return out
 
     def step_async(self, actions: np.ndarray) -> None:
-        self._actions = np.asarray(actions, dtype=np.float64)
+        self._actions = _real_actions(actions, "step_async: actions")
 
     def step_wait(self):
         if self._actions is None:

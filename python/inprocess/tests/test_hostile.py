@@ -91,6 +91,29 @@ class Boundary(unittest.TestCase):
             venv.reset(seed=[5, 9, 7])
 
 
+class ActionTypes(unittest.TestCase):
+    """#48 item 14 (N13): actions that would be read silently wrong are
+    refused by every step, naming the dtype; float32, float64 and
+    integers are taken."""
+
+    BAD = {"complex": np.complex128, "bool": np.bool_, "float16": np.float16}
+
+    def test_complex_bool_and_float16_actions_are_refused(self):
+        env = gymnasium.make(testbed.ENV_ID, scenario="paper", episode_s=0.1)
+        vec = testbed.ArmTrackingVecEnv(2, scenario="paper", episode_s=0.1, num_threads=1)
+        env.reset(seed=1)
+        vec.reset(seed=1)
+        for name, dtype in self.BAD.items():
+            with self.subTest(dtype=name):
+                with self.assertRaisesRegex(TypeError, f"dtype {np.dtype(dtype)} is refused"):
+                    env.unwrapped.step(np.zeros(2, dtype))
+                with self.assertRaisesRegex(TypeError, f"dtype {np.dtype(dtype)} is refused"):
+                    vec.step(np.zeros((2, 2), dtype))
+        for good in (np.zeros(2, np.float32), np.zeros(2), np.zeros(2, np.int64), [0, 0]):
+            env.unwrapped.step(good)
+        vec.step(np.zeros((2, 2), np.float32))
+
+
 class PolicyFiles(unittest.TestCase):
     def node(self, path):
         return subprocess.run([sys.executable, "-m", "testbed.policy_node", "--policy", str(path),
