@@ -45,6 +45,9 @@ pub struct Dynamics {
     bodies: Vec<Body>,
     /// (follower coordinate, leader, multiplier, offset) of each mimic joint.
     mimic: Vec<(usize, usize, f64, f64)>,
+    /// Each moving joint's armature (rotor inertia), by full coordinate:
+    /// a torque armature · q̈ of its own, on M's diagonal.
+    armature: Vec<f64>,
     // Scratch.
     q: Vec<f64>,
     qd: Vec<f64>,
@@ -106,12 +109,14 @@ impl Dynamics {
             .enumerate()
             .map(|(i, c)| (n + i, c.leader, c.multiplier, c.offset))
             .collect();
+        let armature = moving.iter().map(|&ji| model.joints[ji].armature).collect();
         let (nl, nf) = (model.links.len(), moving.len());
         Self {
             n,
             steps,
             bodies,
             mimic,
+            armature,
             q: vec![0.0; nf],
             qd: vec![0.0; nf],
             qdd: vec![0.0; nf],
@@ -157,6 +162,13 @@ impl Dynamics {
     fn solve(&mut self) -> &[f64] {
         self.forward_pass();
         self.backward_pass();
+        for (t, (a, qdd)) in self
+            .tau_full
+            .iter_mut()
+            .zip(self.armature.iter().zip(&self.qdd))
+        {
+            *t += a * qdd;
+        }
         let n = self.n;
         self.tau.copy_from_slice(&self.tau_full[..n]);
         for &(k, leader, mult, _) in &self.mimic {

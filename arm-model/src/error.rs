@@ -104,6 +104,18 @@ pub enum ModelError {
         /// The value.
         value: f64,
     },
+    /// The text is MJCF that the parser cannot read (an include not
+    /// found, an unknown default class, malformed XML).
+    #[error("not a valid MJCF: {0}")]
+    MjcfParse(String),
+    /// An MJCF element the testbed cannot simulate, named.
+    #[error("MJCF {element}: {reason}")]
+    MjcfRefused {
+        /// The element, e.g. `<joint name='free'>` in `<body name='base'>`.
+        element: String,
+        /// Why it is refused and what to do.
+        reason: String,
+    },
     /// A setting out of range (a lock, say).
     #[error("{key} = {value} is invalid: it must be {need}")]
     InvalidConfig {

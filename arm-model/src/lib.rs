@@ -34,6 +34,8 @@ mod extra_elements;
 mod file_refs;
 mod fold;
 mod inertia;
+mod mjcf;
+mod mjcf_inertia;
 mod parse;
 mod prefixes;
 mod tree;
@@ -147,6 +149,10 @@ pub struct JointInfo {
     pub friction: f64,
     /// `<mimic>` as written.
     pub mimic: Option<MimicSpec>,
+    /// Rotor inertia reflected to the joint (MJCF `armature`), kg m² or
+    /// kg, added to M(q)'s diagonal; 0 from a URDF, which has none (there
+    /// the scenario's `[plant] armature` gives it).
+    pub armature: f64,
 }
 
 /// A joint that moves with a controlled joint and is not controlled itself.
@@ -217,6 +223,9 @@ pub struct ArmModel {
     /// Links folded away by a merge: where each one now sits, so that a
     /// scenario can still name it (a payload at a tool link, say).
     pub merged_links: Vec<MergedLink>,
+    /// The pose the file names as the arm's home, per controlled joint
+    /// (MJCF keyframe `home`, or its first key); None from a URDF.
+    pub home: Option<Vec<f64>>,
 }
 
 /// A link that a fixed joint folded into another one.
@@ -249,6 +258,11 @@ impl ArmModel {
                  nest a few levels)",
                 xml_depth::MAX_XML_DEPTH
             )));
+        }
+        // Chosen by content, so every place that takes a robot file takes
+        // MJCF too; a self-contained document's includes are none.
+        if mjcf::is_mjcf(text) {
+            return mjcf::from_str(text, std::path::Path::new("."), locks);
         }
         let (text, undeclared) = prefixes::declare_undeclared(text);
         // What is read past goes first: a removed <axis> needs no xyz.
@@ -295,6 +309,24 @@ impl ArmModel {
             );
         }
         Ok(model)
+    }
+
+    /// Reads an MJCF file (its `<include>`s relative to its folder) with
+    /// the joints in `locks` held; errors name the file.
+    pub fn from_mjcf_file(path: &std::path::Path, locks: &Locks) -> Result<Self, ModelError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ModelError::MjcfParse(format!("cannot read {}: {e}", path.display())))?;
+        let dir = path.parent().unwrap_or(std::path::Path::new("."));
+        mjcf::from_str(&text, dir, locks).map_err(|e| match e {
+            ModelError::MjcfParse(why) => {
+                ModelError::MjcfParse(format!("{}: {why}", path.display()))
+            }
+            ModelError::MjcfRefused { element, reason } => ModelError::MjcfRefused {
+                element: format!("{element} (in {})", path.display()),
+                reason,
+            },
+            other => other,
+        })
     }
 
     /// The link called `name` (a merged one too): the index of the body it

@@ -173,6 +173,7 @@ pub(super) fn joint_info(
         } else {
             None
         },
+        armature: 0.0,
     })
 }
 

@@ -475,5 +475,6 @@ fn finish(
         notes: Vec::new(),
         merged: f.merged,
         merged_links: f.merged_links,
+        home: None,
     })
 }

@@ -1,0 +1,492 @@
+//! MJCF (MuJoCo's format) into the same checked [`ArmModel`] the URDF path
+//! builds. `mjcf-rs` reads the file (includes, default classes, angle
+//! units and Euler sequences resolved); this module turns its body tree
+//! into URDF links and joints and hands them to the URDF path's checks
+//! (`tree::build`: roots, locks, inertia checks, folding of welded bodies),
+//! so that the two formats cannot drift apart. What URDF cannot say
+//! (armature, the home keyframe, actuator limits) is set on the result.
+//!
+//! A MuJoCo joint turns about an anchor `pos` in its body's frame; a URDF
+//! joint turns about its child link's origin. Each body's link frame is
+//! therefore its body frame moved to its (last) joint's anchor, and what
+//! the body holds (inertia, geoms, child bodies) is shifted back by it.
+//! Several joints in one body become a chain of massless links.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use mjcf_rs::body::{Body, Geom, GeomType, InertiaSpec, Joint, JointType};
+use mjcf_rs::extras::ActuatorKind;
+use nalgebra::{Isometry3, Quaternion, UnitQuaternion, Vector3};
+
+use super::inertia::origin_of;
+use super::{ArmModel, JointKind, Locks, Origin};
+use crate::ModelError;
+
+/// True when the document's root element is `<mujoco>` (MJCF), read past
+/// the XML declaration, comments and a doctype.
+pub(crate) fn is_mjcf(text: &str) -> bool {
+    let mut rest = text.trim_start_matches('\u{feff}').trim_start();
+    loop {
+        let skip = if rest.starts_with("<?") {
+            rest.find("?>").map(|i| i + 2)
+        } else if rest.starts_with("<!--") {
+            rest.find("-->").map(|i| i + 3)
+        } else if rest.starts_with("<!") {
+            rest.find('>').map(|i| i + 1)
+        } else {
+            break;
+        };
+        match skip {
+            Some(i) => rest = rest[i..].trim_start(),
+            None => return false,
+        }
+    }
+    rest.strip_prefix("<mujoco")
+        .and_then(|r| r.chars().next())
+        .is_some_and(|c| c.is_whitespace() || c == '>' || c == '/')
+}
+
+/// Reads an MJCF document whose `<include>`s are relative to `base_dir`.
+pub(crate) fn from_str(text: &str, base_dir: &Path, locks: &Locks) -> Result<ArmModel, ModelError> {
+    let m = mjcf_rs::Model::from_str(text, base_dir)
+        .map_err(|e| ModelError::MjcfParse(e.to_string()))?;
+    convert(&m, locks)
+}
+
+/// What the conversion learns beside the URDF tree.
+struct Converted {
+    robot: urdf_rs::Robot,
+    /// MJCF joint name → armature.
+    armature: HashMap<String, f64>,
+    /// MJCF joints in qpos order (keyframes index them so).
+    qpos_order: Vec<String>,
+    notes: Vec<String>,
+}
+
+fn convert(m: &mjcf_rs::Model, locks: &Locks) -> Result<ArmModel, ModelError> {
+    let c = tree(m)?;
+    let mut model = super::tree::build(&c.robot, locks)?;
+    for j in &mut model.joints {
+        j.armature = c.armature.get(&j.name).copied().unwrap_or(0.0);
+    }
+    let mut notes = c.notes;
+    notes.extend(actuators(m, &mut model));
+    model.home = home(m, &model, &c.qpos_order)?;
+    notes.append(&mut model.notes);
+    model.notes = notes;
+    Ok(model)
+}
+
+/// `<body name>`, or its index when unnamed.
+fn body_name(b: &Body, id: usize) -> String {
+    b.name.clone().unwrap_or_else(|| format!("body{id}"))
+}
+
+fn iso_of(p: &mjcf_rs::Pose) -> Isometry3<f64> {
+    let (q, t) = (p.rotation, p.translation);
+    Isometry3::from_parts(
+        Vector3::new(t.x, t.y, t.z).into(),
+        UnitQuaternion::from_quaternion(Quaternion::new(q.w, q.x, q.y, q.z)),
+    )
+}
+
+fn pose(o: Origin) -> urdf_rs::Pose {
+    urdf_rs::Pose {
+        xyz: urdf_rs::Vec3(o.xyz),
+        rpy: urdf_rs::Vec3(o.rpy),
+    }
+}
+
+/// The body tree as URDF links and joints; the world body is link `world`.
+fn tree(m: &mjcf_rs::Model) -> Result<Converted, ModelError> {
+    let mut c = Converted {
+        robot: urdf_rs::Robot {
+            name: m.name.clone().unwrap_or_else(|| "mjcf".into()),
+            version: None,
+            links: Vec::new(),
+            joints: Vec::new(),
+            materials: Vec::new(),
+        },
+        armature: HashMap::new(),
+        qpos_order: Vec::new(),
+        notes: Vec::new(),
+    };
+    // Each body's link: its name and the anchor its link frame sits at.
+    let mut link_of: Vec<(String, Vector3<f64>)> = Vec::with_capacity(m.bodies.len());
+    for (id, entry) in m.bodies.iter().enumerate() {
+        let b = &entry.body;
+        let Some(parent) = entry.parent else {
+            c.robot
+                .links
+                .push(link(m, "world", b, Vector3::zeros(), true)?);
+            link_of.push(("world".into(), Vector3::zeros()));
+            continue;
+        };
+        let name = body_name(b, id);
+        let (parent_link, parent_anchor) = link_of
+            .get(parent)
+            .cloned()
+            .ok_or_else(|| ModelError::MjcfParse(format!("body '{name}' precedes its parent")))?;
+        let placed = iso_of(&b.pose);
+        let anchor = joints(
+            m,
+            &mut c,
+            &name,
+            b,
+            parent == 0,
+            (&parent_link, parent_anchor, &placed),
+        )?;
+        c.robot.links.push(link(m, &name, b, anchor, false)?);
+        link_of.push((name, anchor));
+    }
+    Ok(c)
+}
+
+/// The joints from the parent link to body `name`'s link (a chain of
+/// massless links when the body has several; a fixed joint when none),
+/// and the anchor of its last joint in the body frame.
+fn joints(
+    m: &mjcf_rs::Model,
+    c: &mut Converted,
+    name: &str,
+    b: &Body,
+    on_world: bool,
+    (parent_link, parent_anchor, placed): (&str, Vector3<f64>, &Isometry3<f64>),
+) -> Result<Vector3<f64>, ModelError> {
+    // The body frame in the parent's link frame.
+    let mut at = Isometry3::from_parts(
+        (placed.translation.vector - parent_anchor).into(),
+        placed.rotation,
+    );
+    let mut from = parent_link.to_string();
+    let mut anchor = Vector3::zeros();
+    if b.joints.is_empty() {
+        c.robot.joints.push(urdf_joint(
+            format!("{name}_weld"),
+            urdf_rs::JointType::Fixed,
+            (&from, name),
+            origin_of(&at),
+            None,
+        ));
+        return Ok(anchor);
+    }
+    for (k, j) in b.joints.iter().enumerate() {
+        let jname = j.name.clone().unwrap_or_else(|| format!("{name}_joint{k}"));
+        let element = format!("<joint name='{jname}'> in <body name='{name}'>");
+        let pos = Vector3::from(j.pos);
+        let origin =
+            at * Isometry3::translation(pos.x - anchor.x, pos.y - anchor.y, pos.z - anchor.z);
+        let to = if k + 1 == b.joints.len() {
+            name.to_string()
+        } else {
+            let virtual_link = format!("{name}/{jname}");
+            c.robot.links.push(empty_link(&virtual_link));
+            virtual_link
+        };
+        let (kind, limit) = kind_and_limit(m, j, &element, on_world)?;
+        let mut joint = urdf_joint(
+            jname.clone(),
+            kind,
+            (&from, &to),
+            origin_of(&origin),
+            Some(j),
+        );
+        joint.limit = limit;
+        c.robot.joints.push(joint);
+        c.armature.insert(jname.clone(), j.armature);
+        c.notes.extend(joint_notes(j, &element));
+        c.qpos_order.push(jname);
+        at = Isometry3::identity();
+        anchor = pos;
+        from = to;
+    }
+    Ok(anchor)
+}
+
+/// The URDF kind and limits of an MJCF joint; ball and free joints refused.
+fn kind_and_limit(
+    m: &mjcf_rs::Model,
+    j: &Joint,
+    element: &str,
+    on_world: bool,
+) -> Result<(urdf_rs::JointType, urdf_rs::JointLimit), ModelError> {
+    let refuse = |reason: String| ModelError::MjcfRefused {
+        element: element.to_string(),
+        reason,
+    };
+    let limited = j.limited.resolve(m.compiler.autolimits, j.range.is_some());
+    let range = j.range.filter(|_| limited);
+    let kind = match (j.type_, range) {
+        (JointType::Free, _) if on_world => {
+            return Err(refuse(
+                "a free joint on a body of the world is a floating base; the testbed's arms are fixed to the world (remove it to weld the base)".into(),
+            ));
+        }
+        (JointType::Free | JointType::Ball, _) => {
+            return Err(refuse(format!(
+                "a {} joint has {} degrees of freedom; the testbed simulates hinge and slide joints only (lock it by replacing it with a hinge, or remove it to weld the body)",
+                if j.type_ == JointType::Free {
+                    "free"
+                } else {
+                    "ball"
+                },
+                if j.type_ == JointType::Free { 6 } else { 3 }
+            )));
+        }
+        (JointType::Slide, None) => {
+            return Err(refuse(
+                "a slide joint without a range has no scale to choose a posture or an envelope from: give it range (and limited=\"true\" without autolimits)".into(),
+            ));
+        }
+        (JointType::Hinge, None) => urdf_rs::JointType::Continuous,
+        (JointType::Hinge, Some(_)) => urdf_rs::JointType::Revolute,
+        (JointType::Slide, Some(_)) => urdf_rs::JointType::Prismatic,
+    };
+    if j.ref_ != 0.0 {
+        return Err(refuse(format!(
+            "ref = {} moves the joint's zero away from the pose the body is written in; the testbed measures joints from the written pose (set ref to 0)",
+            j.ref_
+        )));
+    }
+    let (lower, upper) = range.map_or((0.0, 0.0), |r| (r[0], r[1]));
+    Ok((
+        kind,
+        urdf_rs::JointLimit {
+            lower,
+            upper,
+            ..urdf_rs::JointLimit::default()
+        },
+    ))
+}
+
+/// What an MJCF joint has that the testbed does not simulate.
+fn joint_notes(j: &Joint, element: &str) -> Vec<String> {
+    let mut notes = Vec::new();
+    if j.stiffness != 0.0 {
+        notes.push(format!(
+            "{element}: stiffness {} (spring to springref {}) is not simulated",
+            j.stiffness, j.springref
+        ));
+    }
+    if j.springdamper.is_some() {
+        notes.push(format!("{element}: springdamper is not simulated"));
+    }
+    notes
+}
+
+fn urdf_joint(
+    name: String,
+    joint_type: urdf_rs::JointType,
+    (parent, child): (&str, &str),
+    origin: Origin,
+    j: Option<&Joint>,
+) -> urdf_rs::Joint {
+    urdf_rs::Joint {
+        name,
+        joint_type,
+        origin: pose(origin),
+        parent: urdf_rs::LinkName {
+            link: parent.into(),
+        },
+        child: urdf_rs::LinkName { link: child.into() },
+        axis: urdf_rs::Axis {
+            xyz: urdf_rs::Vec3(j.map_or([1.0, 0.0, 0.0], |j| j.axis)),
+        },
+        limit: urdf_rs::JointLimit::default(),
+        calibration: None,
+        // frictionloss is MuJoCo's dry friction, the URDF's `friction`.
+        dynamics: j.map(|j| urdf_rs::Dynamics {
+            damping: j.damping,
+            friction: j.frictionloss,
+        }),
+        mimic: None,
+        safety_controller: None,
+    }
+}
+
+fn empty_link(name: &str) -> urdf_rs::Link {
+    urdf_rs::Link {
+        name: name.into(),
+        inertial: urdf_rs::Inertial::default(),
+        visual: Vec::new(),
+        collision: Vec::new(),
+    }
+}
+
+/// A body's link: its mass properties and collision primitives in its
+/// link frame (the body frame moved to `anchor`).
+fn link(
+    m: &mjcf_rs::Model,
+    name: &str,
+    b: &Body,
+    anchor: Vector3<f64>,
+    world: bool,
+) -> Result<urdf_rs::Link, ModelError> {
+    use mjcf_rs::compiler::InertiaFromGeom;
+    let shift = Isometry3::translation(-anchor.x, -anchor.y, -anchor.z);
+    let mut l = empty_link(name);
+    l.collision = b
+        .geoms
+        .iter()
+        .filter(|g| g.contype != 0 || g.conaffinity != 0)
+        .filter_map(|g| collision(g, &shift))
+        .collect();
+    if world {
+        return Ok(l);
+    }
+    let from_geoms = match (&b.inertial, m.compiler.inertia_from_geom) {
+        (_, InertiaFromGeom::True) | (None, InertiaFromGeom::Auto) => true,
+        (Some(_), _) => false,
+        (None, InertiaFromGeom::False) => return Ok(l),
+    };
+    let (mass, at, tensor) = if from_geoms {
+        let sum = super::mjcf_inertia::from_geoms(name, &b.geoms)?;
+        (
+            sum.mass,
+            super::inertia::iso(&sum.inertial_origin),
+            sum.inertia,
+        )
+    } else {
+        let Some(i) = &b.inertial else {
+            return Ok(l);
+        };
+        let t = match i.inertia {
+            InertiaSpec::Diagonal([a, b, c]) => [a, 0.0, 0.0, b, 0.0, c],
+            // MJCF orders fullinertia ixx iyy izz ixy ixz iyz.
+            InertiaSpec::Full([xx, yy, zz, xy, xz, yz]) => [xx, xy, xz, yy, yz, zz],
+        };
+        (i.mass, iso_of(&i.pose), t)
+    };
+    let [ixx, ixy, ixz, iyy, iyz, izz] = tensor;
+    l.inertial = urdf_rs::Inertial {
+        origin: pose(origin_of(&(shift * at))),
+        mass: urdf_rs::Mass { value: mass },
+        inertia: urdf_rs::Inertia {
+            ixx,
+            ixy,
+            ixz,
+            iyy,
+            iyz,
+            izz,
+        },
+    };
+    Ok(l)
+}
+
+/// A geom that collides as a URDF collision element: primitives as
+/// shapes, meshes by name (listed, not shapes); ellipsoids, planes and
+/// height fields are not URDF shapes and are left out.
+fn collision(g: &Geom, shift: &Isometry3<f64>) -> Option<urdf_rs::Collision> {
+    let (at, s) = super::mjcf_inertia::placed(g);
+    let geometry = match g.type_ {
+        GeomType::Sphere => urdf_rs::Geometry::Sphere { radius: s[0] },
+        GeomType::Capsule => urdf_rs::Geometry::Capsule {
+            radius: s[0],
+            length: 2.0 * s[1],
+        },
+        GeomType::Cylinder => urdf_rs::Geometry::Cylinder {
+            radius: s[0],
+            length: 2.0 * s[1],
+        },
+        GeomType::Box => urdf_rs::Geometry::Box {
+            size: urdf_rs::Vec3([2.0 * s[0], 2.0 * s[1], 2.0 * s[2]]),
+        },
+        GeomType::Mesh => urdf_rs::Geometry::Mesh {
+            filename: g.mesh.clone().unwrap_or_default(),
+            scale: None,
+        },
+        _ => return None,
+    };
+    Some(urdf_rs::Collision {
+        name: g.name.clone(),
+        origin: pose(origin_of(&(shift * at))),
+        geometry,
+    })
+}
+
+/// Effort limits from the actuators that drive a joint (a motor's gear ×
+/// its control range, any actuator's force range), and notes on what is
+/// not used: servo gains (the controller is the testbed's own) and
+/// actuators on tendons or sites.
+fn actuators(m: &mjcf_rs::Model, model: &mut ArmModel) -> Vec<String> {
+    let mut notes = Vec::new();
+    let auto = m.compiler.autolimits;
+    for (i, a) in m.actuators.iter().enumerate() {
+        let label = a.name.clone().unwrap_or_else(|| format!("#{i}"));
+        let Some(joint) = &a.joint else {
+            notes.push(format!(
+                "actuator '{label}' drives no joint (a tendon, site or body): ignored"
+            ));
+            continue;
+        };
+        let bound = |r: Option<[f64; 2]>, limited: mjcf_rs::types::Tristate| {
+            r.filter(|_| limited.resolve(auto, r.is_some()))
+                .map(|r| r[0].abs().max(r[1].abs()))
+        };
+        let force = bound(a.force_range, a.force_limited);
+        let ctrl = match a.kind {
+            ActuatorKind::Motor => bound(a.ctrl_range, a.ctrl_limited).map(|c| c * a.gear[0].abs()),
+            _ => {
+                notes.push(format!(
+                    "actuator '{label}' is a {:?} servo on '{joint}': its gains are ignored (the controller is the testbed's own)",
+                    a.kind
+                ));
+                None
+            }
+        };
+        let effort = match (force, ctrl) {
+            (Some(f), Some(c)) => Some(f.min(c)),
+            (f, c) => f.or(c),
+        };
+        let target = model
+            .joints
+            .iter_mut()
+            .find(|j| &j.name == joint && j.kind != JointKind::Fixed);
+        if let (Some(j), Some(e)) = (target, effort.filter(|e| *e > 0.0)) {
+            j.effort = Some(j.effort.map_or(e, |old| old.min(e)));
+        }
+    }
+    notes
+}
+
+/// The keyframe named `home` (else the first) as a pose of the controlled
+/// joints; None when the file has no key.
+fn home(
+    m: &mjcf_rs::Model,
+    model: &ArmModel,
+    qpos_order: &[String],
+) -> Result<Option<Vec<f64>>, ModelError> {
+    let Some(key) = (m.keyframes.iter())
+        .find(|k| k.name.as_deref() == Some("home"))
+        .or_else(|| m.keyframes.first())
+    else {
+        return Ok(None);
+    };
+    let label = key.name.clone().unwrap_or_else(|| "#0".into());
+    if key.qpos.is_empty() {
+        return Ok(None);
+    }
+    if key.qpos.len() != qpos_order.len() {
+        return Err(ModelError::MjcfRefused {
+            element: format!("<key name='{label}'>"),
+            reason: format!(
+                "qpos has {} values for {} joints",
+                key.qpos.len(),
+                qpos_order.len()
+            ),
+        });
+    }
+    let by_name: HashMap<&str, f64> = qpos_order
+        .iter()
+        .map(String::as_str)
+        .zip(key.qpos.iter().copied())
+        .collect();
+    Ok(Some(
+        model
+            .joint_names()
+            .iter()
+            .map(|n| by_name.get(n.as_str()).copied().unwrap_or(0.0))
+            .collect(),
+    ))
+}

@@ -1,0 +1,138 @@
+//! MJCF files read into the model: what is taken, what is refused by name,
+//! what is said (issue #47). The dynamics against MuJoCo are in mujoco.rs.
+
+// The helpers outside #[test] fail the test on bad input too.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use std::path::{Path, PathBuf};
+
+use arm_model::{ArmModel, JointKind, Locks, ModelError};
+
+fn data(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(file)
+}
+
+fn load(file: &str) -> Result<ArmModel, ModelError> {
+    ArmModel::from_mjcf_file(&data(file), &Locks::new())
+}
+
+fn joint<'a>(m: &'a ArmModel, name: &str) -> &'a arm_model::JointInfo {
+    m.joints.iter().find(|j| j.name == name).unwrap()
+}
+
+#[test]
+fn a_hinge_arm_takes_its_limits_in_degrees_its_dynamics_and_its_actuators() {
+    let m = load("two_link_hinge.xml").unwrap();
+    assert_eq!(m.joint_names(), ["shoulder", "elbow"]);
+    let shoulder = joint(&m, "shoulder");
+    assert_eq!(shoulder.kind, JointKind::Revolute);
+    let (lo, hi) = shoulder.limits.unwrap();
+    assert!((hi - 170f64.to_radians()).abs() < 1e-12 && (lo + hi).abs() < 1e-12);
+    assert_eq!((shoulder.damping, shoulder.friction), (0.5, 0.1));
+    assert_eq!(shoulder.armature, 0.01);
+    // A motor's limit is gear × ctrlrange; a servo's its forcerange.
+    assert_eq!(shoulder.effort, Some(100.0));
+    assert_eq!(joint(&m, "elbow").effort, Some(30.0));
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.contains("elbow_servo") && n.contains("gains are ignored")),
+        "{:?}",
+        m.notes
+    );
+    assert_eq!(
+        m.home,
+        Some(vec![0.3, -0.7]),
+        "the key named home, not the first"
+    );
+}
+
+#[test]
+fn mjcf_text_is_told_from_urdf_by_its_root_element() {
+    let text = std::fs::read_to_string(data("two_link_hinge.xml")).unwrap();
+    let from_text = ArmModel::from_urdf_str(&text).unwrap();
+    assert_eq!(from_text, load("two_link_hinge.xml").unwrap());
+}
+
+#[test]
+fn bodies_without_inertial_weigh_their_geoms() {
+    let m = load("geom_inertia.xml").unwrap();
+    let link2 = m.links.iter().find(|l| l.name == "link2").unwrap();
+    // Cylinder 0.03 × 0.2 m of water, a 0.7 kg sphere, an ellipsoid; the
+    // density-0 sphere weighs nothing.
+    let pi = std::f64::consts::PI;
+    let expected = 1000.0 * (pi * 0.03 * 0.03 * 0.2 + 4.0 / 3.0 * pi * 0.02 * 0.03 * 0.04) + 0.7;
+    assert!((link2.mass - expected).abs() < 1e-12, "{}", link2.mass);
+    assert_eq!(
+        joint(&m, "j1").kind,
+        JointKind::Continuous,
+        "no range: turns freely"
+    );
+}
+
+#[test]
+fn a_slide_joint_and_two_hinges_in_one_body_keep_their_armature() {
+    let m = load("slide_armature.xml").unwrap();
+    assert_eq!(m.joint_names(), ["rail", "yaw", "pitch"]);
+    let rail = joint(&m, "rail");
+    assert_eq!(rail.kind, JointKind::Prismatic);
+    assert_eq!((rail.armature, rail.damping), (0.3, 2.0));
+    // min(forcerange 60, gear 1 × ctrlrange 100).
+    assert_eq!(rail.effort, Some(60.0));
+    assert_eq!(joint(&m, "pitch").armature, 0.05);
+    assert_eq!(m.home, None);
+}
+
+#[test]
+fn includes_and_default_classes_are_resolved() {
+    let m = load("includes_defaults.xml").unwrap();
+    assert_eq!(m.joint_names(), ["a1", "a2", "a3"]);
+    assert_eq!(
+        (joint(&m, "a1").damping, joint(&m, "a1").armature),
+        (0.3, 0.04)
+    );
+    assert_eq!(
+        (joint(&m, "a3").damping, joint(&m, "a3").armature),
+        (0.1, 0.01)
+    );
+    assert_eq!(joint(&m, "a2").limits, Some((-2.5, 2.5)));
+}
+
+#[test]
+fn a_floating_base_is_refused_by_name() {
+    let e = load("free_joint.xml").unwrap_err().to_string();
+    assert!(
+        e.contains("'root'") && e.contains("floating base") && e.contains("free_joint.xml"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_ball_joint_is_refused_by_name() {
+    let text = r#"<mujoco><worldbody><body name="b"><joint name="shoulder" type="ball"/>
+        <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/></body></worldbody></mujoco>"#;
+    let e = ArmModel::from_urdf_str(text).unwrap_err().to_string();
+    assert!(e.contains("'shoulder'") && e.contains("ball"), "{e}");
+}
+
+#[test]
+fn a_mesh_body_without_inertial_is_refused_by_name() {
+    let text = r#"<mujoco><asset><mesh name="shell" vertex="0 0 0 1 0 0 0 1 0 0 0 1"/></asset>
+        <worldbody><body name="link1"><joint name="j"/>
+        <geom name="hull" type="mesh" mesh="shell"/></body></worldbody></mujoco>"#;
+    let e = ArmModel::from_urdf_str(text).unwrap_err().to_string();
+    assert!(
+        e.contains("hull") && e.contains("link1") && e.contains("<inertial>"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_missing_include_names_the_file() {
+    let text = r#"<mujoco><include file="nowhere.xml"/></mujoco>"#;
+    let e = ArmModel::from_urdf_str(text).unwrap_err();
+    assert!(matches!(e, ModelError::MjcfParse(_)), "{e}");
+    assert!(e.to_string().contains("nowhere.xml"), "{e}");
+}

@@ -1,0 +1,59 @@
+"""MuJoCo's own dynamics of an MJCF file at given states, for
+arm-model/tests/mujoco.rs to compare the testbed's with.
+
+    python mujoco_dynamics.py MODEL.xml STATES.json
+
+STATES.json: {"names": [joint, ...], "states": [{"q", "qd", "tau"}, ...]},
+every vector in the order of "names" (the testbed's joint order). Prints
+JSON {"M": [...], "bias": [...], "qacc": [...]} per state in that order:
+M from mj_fullM (armature included; MuJoCo 4 signature), bias = qfrc_bias (C q̇ + G), and the
+accelerations mj_forward gives under tau with joint damping on and every
+constraint (joint limits, dry friction `frictionloss`, contacts) and the
+actuators off.
+"""
+
+import json
+import sys
+
+import mujoco
+import numpy as np
+
+
+def main(model_path, states_path):
+    m = mujoco.MjModel.from_xml_path(model_path)
+    # frictionloss and limits are constraints in MuJoCo; the comparison is
+    # of the smooth dynamics, so they are off (the testbed's are elsewhere).
+    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    # A position servo pushes even at ctrl 0; the torque is tau alone.
+    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_ACTUATION
+    d = mujoco.MjData(m)
+    with open(states_path) as f:
+        spec = json.load(f)
+    joints = [m.joint(n) for n in spec["names"]]
+    qadr = [int(j.qposadr[0]) for j in joints]
+    vadr = [int(j.dofadr[0]) for j in joints]
+    if len(joints) != m.nv:
+        sys.exit(f"{len(joints)} joints named for {m.nv} MuJoCo dofs")
+    out = []
+    for s in spec["states"]:
+        d.qpos[:] = m.qpos0
+        d.qpos[qadr] = s["q"]
+        d.qvel[:] = 0
+        d.qvel[vadr] = s["qd"]
+        d.qfrc_applied[:] = 0
+        d.qfrc_applied[vadr] = s["tau"]
+        mujoco.mj_forward(m, d)
+        full = np.zeros((m.nv, m.nv))
+        mujoco.mj_fullM(m, d, full)
+        out.append(
+            {
+                "M": full[np.ix_(vadr, vadr)].tolist(),
+                "bias": d.qfrc_bias[vadr].tolist(),
+                "qacc": d.qacc[vadr].tolist(),
+            }
+        )
+    json.dump(out, sys.stdout)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2])
