@@ -35,6 +35,7 @@ mod file_refs;
 mod fold;
 mod inertia;
 mod mjcf;
+mod mjcf_include;
 mod mjcf_inertia;
 mod parse;
 mod prefixes;
@@ -309,6 +310,17 @@ impl ArmModel {
             );
         }
         Ok(model)
+    }
+
+    /// The robot file's text as the model reads it again from text alone:
+    /// an MJCF document's `<include>`s inlined (paths relative to `dir`,
+    /// the main file's folder, as MuJoCo takes them); a URDF unchanged.
+    pub fn self_contained(text: &str, dir: &std::path::Path) -> Result<String, ModelError> {
+        if mjcf::is_mjcf(text) {
+            mjcf_include::inline(text, dir)
+        } else {
+            Ok(text.to_string())
+        }
     }
 
     /// Reads an MJCF file (its `<include>`s relative to its folder) with

@@ -136,3 +136,15 @@ fn a_missing_include_names_the_file() {
     assert!(matches!(e, ModelError::MjcfParse(_)), "{e}");
     assert!(e.to_string().contains("nowhere.xml"), "{e}");
 }
+
+#[test]
+fn a_file_with_includes_becomes_text_that_reads_alone() {
+    let path = data("includes_defaults.xml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let alone = ArmModel::self_contained(&text, path.parent().unwrap()).unwrap();
+    assert!(!alone.contains("<include"), "{alone}");
+    assert_eq!(
+        ArmModel::from_urdf_str(&alone).unwrap(),
+        load("includes_defaults.xml").unwrap()
+    );
+}

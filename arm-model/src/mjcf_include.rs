@@ -1,0 +1,137 @@
+//! An MJCF file's `<include>`s inlined, so that its text alone is the
+//! model: the scenario keeps the text, the plant node and `replay` read it
+//! again from there (a log's attachment needs no other file). As in
+//! MuJoCo, an included file's root `<mujoco>` element is replaced by its
+//! children, and every path is relative to the main file's folder.
+
+use std::path::Path;
+
+use crate::ModelError;
+
+/// Includes nest no deeper than this: deeper is a file including itself.
+const MAX_DEPTH: usize = 16;
+
+/// `text` with every `<include file>` replaced by that file's contents.
+pub(crate) fn inline(text: &str, dir: &Path) -> Result<String, ModelError> {
+    inline_at(text, dir, 0)
+}
+
+fn inline_at(text: &str, dir: &Path, depth: usize) -> Result<String, ModelError> {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = next_include(rest) {
+        out.push_str(&rest[..i]);
+        let tag_end = rest[i..]
+            .find('>')
+            .map(|e| i + e + 1)
+            .ok_or_else(|| refuse("<include>", "the tag is not closed"))?;
+        let tag = &rest[i..tag_end];
+        let file = attribute(tag, "file").ok_or_else(|| refuse(tag, "it names no file"))?;
+        if depth >= MAX_DEPTH {
+            return Err(refuse(
+                tag,
+                &format!("includes nest more than {MAX_DEPTH} deep: a file includes itself"),
+            ));
+        }
+        let path = dir.join(file);
+        let inner = std::fs::read_to_string(&path)
+            .map_err(|e| refuse(tag, &format!("cannot read {}: {e}", path.display())))?;
+        out.push_str(&inline_at(children(&inner), dir, depth + 1)?);
+        rest = &rest[tag_end..];
+        // `<include …></include>` written in full.
+        if !tag.ends_with("/>") {
+            rest = rest.trim_start().strip_prefix("</include>").unwrap_or(rest);
+        }
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
+fn refuse(element: &str, reason: &str) -> ModelError {
+    ModelError::MjcfParse(format!("{element}: {reason}"))
+}
+
+/// Where the next `<include` tag starts.
+fn next_include(text: &str) -> Option<usize> {
+    let mut from = 0;
+    while let Some(i) = text[from..].find("<include") {
+        let at = from + i;
+        let next = text[at + "<include".len()..].chars().next();
+        if next.is_some_and(|c| c.is_whitespace() || c == '/' || c == '>') {
+            return Some(at);
+        }
+        from = at + 1;
+    }
+    None
+}
+
+/// The value of `name="…"` (or single-quoted) in a tag.
+fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let mut from = 0;
+    while let Some(i) = tag[from..].find(name) {
+        let at = from + i;
+        let before = tag[..at].chars().next_back();
+        let after = tag[at + name.len()..].trim_start();
+        if before.is_some_and(char::is_whitespace)
+            && let Some(value) = after.strip_prefix('=')
+        {
+            let value = value.trim_start();
+            let quote = value.chars().next()?;
+            if quote == '"' || quote == '\'' {
+                let body = &value[1..];
+                return body.find(quote).map(|end| &body[..end]);
+            }
+        }
+        from = at + name.len();
+    }
+    None
+}
+
+/// What lies inside the root `<mujoco>` element of an included file.
+fn children(text: &str) -> &str {
+    let Some(open) = text.find("<mujoco") else {
+        return text;
+    };
+    let Some(open_end) = text[open..].find('>').map(|e| open + e + 1) else {
+        return "";
+    };
+    if text[..open_end].ends_with("/>") {
+        return "";
+    }
+    let close = text.rfind("</mujoco>").unwrap_or(text.len());
+    text.get(open_end..close).unwrap_or("")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_attribute_is_found_by_its_whole_name() {
+        assert_eq!(
+            attribute(r#"<include xfile="a" file='b.xml'/>"#, "file"),
+            Some("b.xml")
+        );
+        assert_eq!(attribute("<include/>", "file"), None);
+    }
+
+    #[test]
+    fn an_included_root_gives_its_children() {
+        assert_eq!(children("<?xml?><mujoco model='x'><a/></mujoco>"), "<a/>");
+        assert_eq!(children("<mujoco/>"), "");
+    }
+
+    #[test]
+    fn a_file_that_includes_itself_is_refused() {
+        let dir = std::env::temp_dir().join(format!("mjcf-include-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("loop.xml"),
+            r#"<mujoco><include file="loop.xml"/></mujoco>"#,
+        )
+        .unwrap();
+        let e = inline(r#"<mujoco><include file="loop.xml"/></mujoco>"#, &dir).unwrap_err();
+        assert!(e.to_string().contains("includes itself"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
