@@ -261,8 +261,9 @@ impl ArmModel {
             )));
         }
         // Chosen by content, so every place that takes a robot file takes
-        // MJCF too; a self-contained document's includes are none.
+        // MJCF too; text names no other file (see `self_contained`).
         if mjcf::is_mjcf(text) {
+            mjcf_include::refuse_includes(text)?;
             return mjcf::from_str(text, std::path::Path::new("."), locks);
         }
         let (text, undeclared) = prefixes::declare_undeclared(text);

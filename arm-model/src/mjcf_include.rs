@@ -47,6 +47,20 @@ fn inline_at(text: &str, dir: &Path, depth: usize) -> Result<String, ModelError>
     Ok(out)
 }
 
+/// Text given alone (a log's attachment, a string) names no other file:
+/// an `<include>` there is refused, so that reading a model never reads
+/// files its reader did not name.
+pub(crate) fn refuse_includes(text: &str) -> Result<(), ModelError> {
+    let Some(i) = next_include(text) else {
+        return Ok(());
+    };
+    let tag = text[i..].find('>').map_or(&text[i..], |e| &text[i..=i + e]);
+    Err(refuse(
+        tag,
+        "an include in a model given as text: read the file itself, whose includes are inlined relative to its folder",
+    ))
+}
+
 fn refuse(element: &str, reason: &str) -> ModelError {
     ModelError::MjcfParse(format!("{element}: {reason}"))
 }

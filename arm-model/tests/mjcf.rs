@@ -131,10 +131,22 @@ fn a_mesh_body_without_inertial_is_refused_by_name() {
 
 #[test]
 fn a_missing_include_names_the_file() {
-    let text = r#"<mujoco><include file="nowhere.xml"/></mujoco>"#;
-    let e = ArmModel::from_urdf_str(text).unwrap_err();
+    let path = std::env::temp_dir().join(format!("mjcf-missing-{}.xml", std::process::id()));
+    std::fs::write(&path, r#"<mujoco><include file="nowhere.xml"/></mujoco>"#).unwrap();
+    let e = ArmModel::from_mjcf_file(&path, &Locks::new()).unwrap_err();
+    std::fs::remove_file(&path).ok();
     assert!(matches!(e, ModelError::MjcfParse(_)), "{e}");
     assert!(e.to_string().contains("nowhere.xml"), "{e}");
+}
+
+#[test]
+fn text_given_alone_reads_no_other_file() {
+    let text = r#"<mujoco><include file="/etc/hostname"/></mujoco>"#;
+    let e = ArmModel::from_urdf_str(text).unwrap_err().to_string();
+    assert!(
+        e.contains("/etc/hostname") && e.contains("given as text"),
+        "{e}"
+    );
 }
 
 #[test]
