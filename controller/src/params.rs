@@ -202,7 +202,10 @@ parameters! {
     /// (when every controlled joint has one), through the law's model:
     /// the error acceleration u is kept in a per-joint box whose every
     /// point gives |τ_i| ≤ effort_i at this step's M(q) (BASELINES §3).
-    torque_bounds: bool = true, BOOLEAN;
+    /// Off by default: the box is conservative (it can cut what the
+    /// motors could give), so a bounded law loses seeds the plant's own
+    /// clipping keeps, and the default rows compare the laws themselves.
+    torque_bounds: bool = false, BOOLEAN;
     /// `mpc`: prediction steps N (at most [`MAX_MPC_HORIZON`]). The default,
     /// with `mpc_step`'s, looks 0.1 s ahead for the envelope, 1.5 time
     /// constants of the default gains' error dynamics; beyond it the

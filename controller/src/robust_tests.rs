@@ -170,6 +170,7 @@ fn the_bounded_robust_filter_is_the_projection_onto_its_rows() {
     let mut law = feedback(LawName::CbfCtc, &model, |p| {
         p.cbf_margin = margin;
         p.cbf_rate = lambda;
+        p.torque_bounds = true;
     });
     let mut dynamics = Dynamics::new(&model, 1.0);
     let (kp, kd) = (225.0, 30.0);
@@ -226,7 +227,7 @@ fn the_bounded_robust_filter_is_the_projection_onto_its_rows() {
 fn bounded_laws_keep_the_torque_within_the_effort_limits() {
     let model = weak_arm();
     for law in [LawName::Mpc, LawName::CbfCtc] {
-        let mut bounded = feedback(law, &model, |_| {});
+        let mut bounded = feedback(law, &model, |p| p.torque_bounds = true);
         let mut free = feedback(law, &model, |p| p.torque_bounds = false);
         let mut dynamics = Dynamics::new(&model, 1.0);
         let mut rng = Lcg(17);
