@@ -1,4 +1,4 @@
-//! `mpc`'s quadratic program (BASELINES §4): a constrained linear MPC on
+//! `mpc`'s quadratic program (BASELINES §3): a constrained linear MPC on
 //! the error dynamics that computed torque leaves, ë_i = u_i per joint,
 //! with |e_i| ≤ k_c,i over the horizon from T_c on, solved by `clarabel`
 //! every control step. [`crate::feedback::Feedback`] turns its first input
