@@ -35,6 +35,13 @@ impl RobotSource {
                 cause,
             }
         })?;
+        // An MJCF file's includes inlined: the text is read again alone
+        // (the plant node, a log's attachment), #47.
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let urdf = ArmModel::self_contained(&urdf, dir).map_err(|cause| ScenarioError::Plant {
+            file: file.clone(),
+            cause: cause.into(),
+        })?;
         let model =
             ArmModel::from_urdf_str_locked(&urdf, locks).map_err(|cause| ScenarioError::Plant {
                 file,
