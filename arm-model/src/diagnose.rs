@@ -86,7 +86,7 @@ pub(super) fn diagnose(text: &str, reader_error: &str) -> Option<String> {
         .split("missing field `")
         .nth(1)
         .and_then(|r| r.split('`').next());
-    let wanted = |p: &&Problem| match missing {
+    let wanted = |p: &Problem| match missing {
         Some(field) => p.field == field,
         // Only the shape the reader names: `type="bogus"` on a joint is an
         // unknown variant too, and its own message stands.
@@ -101,7 +101,49 @@ pub(super) fn diagnose(text: &str, reader_error: &str) -> Option<String> {
             p.number && (reader_error.contains("float") || reader_error.contains("element count"))
         }
     };
-    walk(text).iter().find(wanted).map(|p| p.message.clone())
+    let mut found = Found {
+        wanted: &wanted,
+        first: None,
+        more: 0,
+    };
+    walk(text, &mut found);
+    found.first.map(|first| match found.more {
+        0 => first,
+        more => format!("{first} (and {more} more like it)"),
+    })
+}
+
+/// What the walk keeps: the first problem of the kind the reader named and
+/// how many more there are. Only one message is kept, so a file with
+/// 150 000 bad numbers is diagnosed in constant memory (keeping them all
+/// took 966 MB, #48 item 8).
+struct Found<'a> {
+    wanted: &'a dyn Fn(&Problem) -> bool,
+    first: Option<String>,
+    more: usize,
+}
+
+impl Found<'_> {
+    fn push(&mut self, p: Problem) {
+        if (self.wanted)(&p) {
+            match self.first {
+                None => self.first = Some(p.message),
+                Some(_) => self.more += 1,
+            }
+        }
+    }
+}
+
+/// The most characters of a value a message quotes: a 16 MB attribute is
+/// not repeated whole.
+const QUOTED: usize = 80;
+
+/// `v`, cut to [`QUOTED`] characters (with "…" and its length when cut).
+fn cut(v: &str) -> String {
+    match v.char_indices().nth(QUOTED) {
+        None => v.to_string(),
+        Some((at, _)) => format!("{}… ({} bytes in all)", &v[..at], v.len()),
+    }
 }
 
 /// The variant in "unknown variant `plane`, expected …".
@@ -120,25 +162,25 @@ struct Problem {
     message: String,
 }
 
-fn walk(text: &str) -> Vec<Problem> {
+fn walk(text: &str, out: &mut Found) {
     let mut reader = Reader::from_str(text);
-    let (mut stack, mut out): (Vec<Open>, Vec<Problem>) = (Vec::new(), Vec::new());
+    let mut stack: Vec<Open> = Vec::new();
     loop {
         match reader.read_event() {
             Ok(Event::Start(e)) => {
-                let open = opened(&e, &mut stack, &mut out);
+                let open = opened(&e, &mut stack, out);
                 stack.push(open);
             }
             Ok(Event::Empty(e)) => {
-                let open = opened(&e, &mut stack, &mut out);
-                closed(&open, &mut out);
+                let open = opened(&e, &mut stack, out);
+                closed(&open, out);
             }
             Ok(Event::End(_)) => {
                 if let Some(open) = stack.pop() {
-                    closed(&open, &mut out);
+                    closed(&open, out);
                 }
             }
-            Ok(Event::Eof) | Err(_) => return out,
+            Ok(Event::Eof) | Err(_) => return,
             Ok(_) => {}
         }
     }
@@ -146,7 +188,7 @@ fn walk(text: &str) -> Vec<Problem> {
 
 /// A start tag: recorded as its parent's child, and, where `urdf-rs`
 /// reads it, its attributes checked.
-fn opened(e: &BytesStart, stack: &mut [Open], out: &mut Vec<Problem>) -> Open {
+fn opened(e: &BytesStart, stack: &mut [Open], out: &mut Found) -> Open {
     let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
     let parent = stack.last_mut();
     let (parent_owner, parent_read) = parent.as_ref().map_or_else(
@@ -161,9 +203,9 @@ fn opened(e: &BytesStart, stack: &mut [Open], out: &mut Vec<Problem>) -> Open {
         1 => READ.contains(&name.as_str()),
         _ => parent_read,
     };
-    let attrs = attributes(e);
+    let attrs = attributes(e, &name);
     let owner = match (name.as_str(), attr(&attrs, "name"), stack.len()) {
-        ("link" | "joint" | "material", Some(n), 1) => format!("{name} '{n}'"),
+        ("link" | "joint" | "material", Some(n), 1) => format!("{name} '{}'", cut(n)),
         _ => parent_owner,
     };
     if read {
@@ -177,10 +219,32 @@ fn opened(e: &BytesStart, stack: &mut [Open], out: &mut Vec<Problem>) -> Open {
     }
 }
 
-/// A tag's attributes, names without prefix, values unescaped.
-fn attributes(e: &BytesStart) -> Vec<(String, String)> {
+/// The attributes of tag `name` the walk looks at (its name, a joint's
+/// type, what it requires and its numbers), names without prefix, values
+/// unescaped. quick-xml's duplicate check compares each attribute with
+/// every one before it, which made a tag of 100 000 attributes take
+/// minutes (#48 item 8); the reader under `urdf-rs` has already refused
+/// duplicates, so it is off, and only the attributes looked at are kept.
+fn attributes(e: &BytesStart, name: &str) -> Vec<(String, String)> {
+    let required = REQUIRED_ATTRIBUTES
+        .iter()
+        .filter(|(el, _)| *el == name)
+        .flat_map(|(_, fields)| fields.iter().copied());
+    let numbers = NUMBERS
+        .iter()
+        .filter(|(el, _)| *el == name)
+        .flat_map(|(_, fields)| fields.iter().map(|(f, _)| *f));
+    let looked_at: Vec<&str> = ["name", "type"]
+        .into_iter()
+        .chain(required)
+        .chain(numbers)
+        .collect();
     e.attributes()
+        .with_checks(false)
         .flatten()
+        .filter(|a| {
+            std::str::from_utf8(a.key.local_name().as_ref()).is_ok_and(|k| looked_at.contains(&k))
+        })
         .map(|a| {
             let key = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
             let value = a.unescape_value().map_or_else(
@@ -201,7 +265,7 @@ fn attr<'a>(attrs: &'a [(String, String)], key: &str) -> Option<&'a str> {
 }
 
 /// The attributes element `name` (at `at`) must have, and its numbers.
-fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut Vec<Problem>) {
+fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut Found) {
     for (element, required) in REQUIRED_ATTRIBUTES {
         if *element == name {
             for field in required.iter().filter(|f| attr(attrs, f).is_none()) {
@@ -223,7 +287,8 @@ fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut 
             number: false,
             empty: false,
             message: format!(
-                "{at} type=\"{kind}\" is not a URDF joint type; write one of {}",
+                "{at} type=\"{}\" is not a URDF joint type; write one of {}",
+                cut(kind),
                 JOINT_TYPES.join(", ")
             ),
         });
@@ -240,7 +305,7 @@ fn check_attributes(at: &str, name: &str, attrs: &[(String, String)], out: &mut 
                     field: field.to_string(),
                     number: true,
                     empty: false,
-                    message: format!("{at} {field}=\"{v}\": {why}"),
+                    message: format!("{at} {field}=\"{}\": {why}", cut(v)),
                 });
             }
         }
@@ -262,7 +327,7 @@ const JOINT_TYPES: [&str; 7] = [
 const SHAPES: [&str; 5] = ["box", "cylinder", "sphere", "capsule", "mesh"];
 
 /// Checks that a closing element had the children it needs.
-fn closed(open: &Open, out: &mut Vec<Problem>) {
+fn closed(open: &Open, out: &mut Found) {
     if !open.read {
         return;
     }
@@ -330,16 +395,20 @@ fn hint(element: &str, child: &str) -> &'static str {
 
 /// Why `v` is not `count` numbers (0: any positive count), if it is not.
 fn not_numbers(v: &str, count: usize) -> Option<String> {
-    let parts: Vec<&str> = v.split_whitespace().collect();
-    if let Some(bad) = parts.iter().find(|p| p.parse::<f64>().is_err()) {
-        let xacro = if bad.contains("$(") || bad.contains("${") {
-            " (a xacro expression: run `xacro` on the file to get a URDF)"
-        } else {
-            ""
-        };
-        return Some(format!("'{bad}' is not a number{xacro}"));
+    // Counted, not collected: a value may be megabytes of numbers.
+    let mut n = 0usize;
+    for part in v.split_whitespace() {
+        if part.parse::<f64>().is_err() {
+            let xacro = if part.contains("$(") || part.contains("${") {
+                " (a xacro expression: run `xacro` on the file to get a URDF)"
+            } else {
+                ""
+            };
+            return Some(format!("'{}' is not a number{xacro}", cut(part)));
+        }
+        n += 1;
     }
-    match (count, parts.len()) {
+    match (count, n) {
         (0, 0) => Some("no number".into()),
         (0, _) => None,
         (c, n) if c != n => Some(format!("{n} numbers where {c} belong")),
@@ -417,6 +486,54 @@ mod tests {
         assert!(
             got.contains("continous") && !got.contains("has no"),
             "{got}"
+        );
+    }
+
+    /// Every bad number after the first is counted, not kept: 150 000 of
+    /// them took 966 MB (#48 item 8).
+    #[test]
+    fn only_the_first_problem_is_kept_and_the_rest_counted() {
+        let links: String = (0..3)
+            .map(|i| {
+                format!(r#"<link name="l{i}"><inertial><mass value="X{i}"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>"#)
+            })
+            .collect();
+        let got = refusal(&links);
+        assert!(
+            got.contains("link 'l0': <mass> value=\"X0\"") && got.ends_with("(and 2 more like it)"),
+            "{got}"
+        );
+    }
+
+    /// A long bad value is quoted cut to 80 characters.
+    #[test]
+    fn a_long_bad_value_is_quoted_cut() {
+        let long = "Y".repeat(100_000);
+        let got = refusal(&format!(
+            r#"<link name="a"><inertial><mass value="{long}"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>"#
+        ));
+        assert!(
+            got.contains("(100000 bytes in all)") && got.len() < 400,
+            "{got}"
+        );
+    }
+
+    /// Only the attributes the walk looks at are kept from a tag.
+    #[test]
+    fn only_the_attributes_looked_at_are_kept() {
+        let extra: String = (0..1000).map(|i| format!(r#" x{i}="{i}""#)).collect();
+        let tag = format!(r#"<mass value="1"{extra} name="m"/>"#);
+        let mut reader = quick_xml::Reader::from_str(&tag);
+        let Ok(quick_xml::events::Event::Empty(e)) = reader.read_event() else {
+            panic!("not an empty tag: {tag}");
+        };
+        let kept = super::attributes(&e, "mass");
+        assert_eq!(
+            kept,
+            vec![
+                ("value".to_string(), "1".to_string()),
+                ("name".into(), "m".into())
+            ]
         );
     }
 

@@ -126,4 +126,30 @@ pub enum ModelError {
         /// What it must be.
         need: String,
     },
+    /// A document over [`MAX_URDF_BYTES`](crate::MAX_URDF_BYTES).
+    #[error(
+        "the robot file is {bytes} bytes, over the cap of {cap} bytes (a robot's URDF is tens of \
+         kilobytes; meshes belong in their own files)"
+    )]
+    TooLarge {
+        /// Its size.
+        bytes: usize,
+        /// The cap.
+        cap: usize,
+    },
+    /// A tag with more than [`MAX_ATTRIBUTES`](crate::MAX_ATTRIBUTES) attributes.
+    #[error(
+        "line {line}: <{element}> has {count} attributes or more, over the cap of {cap} \
+         (a URDF element has a handful)"
+    )]
+    TooManyAttributes {
+        /// The element's name (cut to 80 characters).
+        element: String,
+        /// Its line, from 1.
+        line: usize,
+        /// How many attributes were counted before stopping.
+        count: usize,
+        /// The cap.
+        cap: usize,
+    },
 }

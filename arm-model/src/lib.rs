@@ -51,6 +51,18 @@ pub use inertia::iso;
 /// The most links (and joints) a URDF may have: real arms have tens.
 pub const MAX_LINKS: usize = 1000;
 
+/// The largest URDF document read, in bytes (16 MiB, the cap
+/// `wire::MAX_URDF_BYTES` puts on a URDF file). Real arms' URDFs are
+/// 10–100 kB (the shipped ones are under 14 kB). Here it also bounds text
+/// that came from elsewhere: a log's attachment of 60 MB was read and took
+/// 101 s to be refused (#48 item 8).
+pub const MAX_URDF_BYTES: usize = 16 << 20;
+
+/// The most attributes one element may have. URDF's elements have at most
+/// six (`<inertia>`); the XML readers compare each attribute with every
+/// earlier one, so a tag of 100 000 took minutes (#48 item 8).
+pub const MAX_ATTRIBUTES: usize = 256;
+
 /// The paper's two-link arm (SPEC §1), embedded so the default scenario
 /// needs no files.
 pub const TWO_LINK_URDF: &str = include_str!("../../robots/two_link.urdf");
@@ -252,6 +264,20 @@ impl ArmModel {
     /// Parses and checks a URDF document with the joints in `locks` held
     /// at the given positions.
     pub fn from_urdf_str_locked(text: &str, locks: &Locks) -> Result<Self, ModelError> {
+        if text.len() > MAX_URDF_BYTES {
+            return Err(ModelError::TooLarge {
+                bytes: text.len(),
+                cap: MAX_URDF_BYTES,
+            });
+        }
+        if let Some(wide) = xml_depth::widest_tag(text, MAX_ATTRIBUTES) {
+            return Err(ModelError::TooManyAttributes {
+                element: wide.element,
+                line: wide.line,
+                count: wide.count,
+                cap: MAX_ATTRIBUTES,
+            });
+        }
         let deepest = xml_depth::depth(text, xml_depth::MAX_XML_DEPTH);
         if deepest > xml_depth::MAX_XML_DEPTH {
             return Err(ModelError::Parse(format!(

@@ -67,6 +67,76 @@ fn tag_end(b: &[u8], mut i: usize) -> (usize, bool) {
     (b.len(), false)
 }
 
+/// A start tag with too many attributes.
+#[derive(Debug, PartialEq)]
+pub struct WideTag {
+    /// The element's name, cut to 80 characters.
+    pub element: String,
+    /// Its line, from 1.
+    pub line: usize,
+    /// The attributes counted (`limit` + 1: counting stops there).
+    pub count: usize,
+}
+
+/// The first start tag of `text` with more than `limit` attributes, if
+/// any, in one pass over the tags (an attribute counted by its `=` outside
+/// quotes), skipping what `depth` skips.
+pub fn widest_tag(text: &str, limit: usize) -> Option<WideTag> {
+    let b = text.as_bytes();
+    let mut i = 0;
+    while let Some(off) = b[i..].iter().position(|&c| c == b'<') {
+        let start = i + off;
+        i = start + 1;
+        let rest = &b[i..];
+        let skip_to = |end: &[u8]| {
+            rest.windows(end.len())
+                .position(|w| w == end)
+                .map_or(b.len(), |p| i + p + end.len())
+        };
+        if rest.starts_with(b"!--") {
+            i = skip_to(b"-->");
+        } else if rest.starts_with(b"![CDATA[") {
+            i = skip_to(b"]]>");
+        } else if rest.starts_with(b"?") {
+            i = skip_to(b"?>");
+        } else if rest.starts_with(b"!") || rest.starts_with(b"/") {
+            i = skip_to(b">");
+        } else {
+            let (mut quote, mut count) = (None, 0usize);
+            while i < b.len() {
+                let c = b[i];
+                i += 1;
+                match quote {
+                    Some(q) if c == q => quote = None,
+                    Some(_) => {}
+                    None if c == b'"' || c == b'\'' => quote = Some(c),
+                    None if c == b'>' => break,
+                    None if c == b'=' => {
+                        count += 1;
+                        if count > limit {
+                            let name: String = text[start + 1..]
+                                .split(|c: char| c.is_whitespace() || c == '/' || c == '>')
+                                .next()
+                                .unwrap_or("")
+                                .chars()
+                                .take(80)
+                                .collect();
+                            let line = b[..start].iter().filter(|&&c| c == b'\n').count() + 1;
+                            return Some(WideTag {
+                                element: name,
+                                line,
+                                count,
+                            });
+                        }
+                    }
+                    None => {}
+                }
+            }
+        }
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -80,5 +150,21 @@ mod tests {
         let deep = "<a>".repeat(50_000) + &"</a>".repeat(50_000);
         assert_eq!(depth(&deep, MAX_XML_DEPTH), MAX_XML_DEPTH + 1);
         assert_eq!(depth("<![CDATA[<a><a>]]><x/>", 10), 0);
+    }
+
+    /// Attributes are counted per tag, `=` in quotes and comments not.
+    #[test]
+    fn attributes_are_counted_per_tag() {
+        let ok = r#"<robot name="r"><!-- a=1 b=2 c=3 --><link name="a=b" x="1"/></robot>"#;
+        assert_eq!(widest_tag(ok, 2), None);
+        let wide = "<robot>\n<origin a=\"1\" b='2' c=\"3\"/></robot>";
+        assert_eq!(
+            widest_tag(wide, 2),
+            Some(WideTag {
+                element: "origin".into(),
+                line: 2,
+                count: 3
+            })
+        );
     }
 }

@@ -228,3 +228,36 @@ fn an_empty_geometry_is_named_with_its_link() {
         "not a valid URDF: link 'b': a <geometry> holds no shape; write one of <box>, <cylinder>, <sphere>, <capsule>, <mesh>"
     );
 }
+
+/// A document over the size cap is refused before it is parsed, with its
+/// size and the cap (#48 item 8: 16 MB took 119 s to refuse).
+#[test]
+fn a_urdf_over_the_size_cap_is_refused_with_the_cap() {
+    let mut text = arm(J1, "");
+    let pad = MAX_URDF_BYTES + 1 - text.len();
+    text.insert_str(text.len() - "</robot>".len(), &" ".repeat(pad));
+    assert_eq!(
+        ArmModel::from_urdf_str(&text).unwrap_err(),
+        ModelError::TooLarge {
+            bytes: MAX_URDF_BYTES + 1,
+            cap: MAX_URDF_BYTES
+        }
+    );
+}
+
+/// A tag with more attributes than the cap is refused by name and line,
+/// before the XML readers compare its attributes pairwise.
+#[test]
+fn a_tag_with_too_many_attributes_is_refused_by_name() {
+    let extra: String = (0..MAX_ATTRIBUTES)
+        .map(|i| format!(r#" x{i}="{i}""#))
+        .collect();
+    let links = format!(
+        r#"<link name="b"><inertial><origin xyz="0 0 0"{extra}/><mass value="BAD"/></inertial></link>"#
+    );
+    let got = err(&arm(J1, &links));
+    assert!(
+        got.starts_with("line 4: <origin> has 257 attributes or more, over the cap of 256"),
+        "{got}"
+    );
+}
