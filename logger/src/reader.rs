@@ -377,6 +377,20 @@ impl Walk {
                 Record::Metadata(m) if m.name == RUN_METADATA => out.run = m.metadata,
                 Record::Metadata(m) if m.name == STATS_METADATA => out.stats = Some(m.metadata),
                 Record::Attachment { header, data, .. } if header.name == URDF_ATTACHMENT => {
+                    // Refused here, by name, rather than handed on: a 60 MB
+                    // attachment took 101 s to be refused by the URDF
+                    // reader's diagnosis (#48 item 8).
+                    if data.len() > arm_model::MAX_URDF_BYTES {
+                        return Err(LogError::NotATestbedLog {
+                            path: self.p.clone(),
+                            reason: format!(
+                                "its {URDF_ATTACHMENT} attachment is {} bytes, over the cap of \
+                                 {} bytes on a URDF (arm_model::MAX_URDF_BYTES)",
+                                data.len(),
+                                arm_model::MAX_URDF_BYTES
+                            ),
+                        });
+                    }
                     out.urdf = Some(String::from_utf8_lossy(&data).to_string());
                 }
                 Record::Footer(_) => out.complete = true,
@@ -590,6 +604,28 @@ mod tests {
         let all = read_log(&path, Some(&mut take)).unwrap();
         assert_eq!((all.messages, all.complete), (3, true));
         assert_eq!(seqs, [0, 1, 2]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A URDF attachment over the URDF cap is refused by name with the cap,
+    /// by the head and the full read alike (#48 item 8).
+    #[test]
+    fn a_urdf_attachment_over_the_cap_is_refused() {
+        let dir = std::env::temp_dir().join(format!("testbed-bigurdf-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("run.mcap");
+        let big = format!("<robot>{}</robot>", " ".repeat(arm_model::MAX_URDF_BYTES));
+        let w = crate::LogWriter::create(&path, &crate::RunMetadata::default(), &big).unwrap();
+        w.finish(BTreeMap::new()).unwrap();
+        let want = format!(
+            "its robot.urdf attachment is {} bytes, over the cap of {} bytes",
+            big.len(),
+            arm_model::MAX_URDF_BYTES
+        );
+        let head = read_log_head(&path).unwrap_err().to_string();
+        assert!(head.contains(&want), "{head}");
+        let all = read_log(&path, None).unwrap_err().to_string();
+        assert!(all.contains(&want), "{all}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
