@@ -6,7 +6,8 @@
 //! Jᵀ τ_full of the whole tree, J the coupling's Jacobian). That is all a
 //! model-based law needs: computed torque is one call with q̈ = v, gravity
 //! one call with q̇ = q̈ = 0. Joint damping and friction are not in it: they
-//! are what a controller's model usually lacks.
+//! are what a controller's model usually lacks. A joint's own armature
+//! (MJCF's; a URDF has none) is: it is part of M(q), as in MuJoCo.
 
 use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
 

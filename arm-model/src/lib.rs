@@ -1,5 +1,7 @@
 //! A URDF arm read into a checked, engine-neutral description, and its
-//! rigid-body dynamics computed from that description alone.
+//! rigid-body dynamics computed from that description alone. An MJCF
+//! (MuJoCo) file, told by its `<mujoco>` root, is read into the same
+//! description through the same checks (`mjcf.rs`, #47).
 //!
 //! Where it sits: under both ends of the loop. The plant (`plant-rapier`)
 //! builds its Rapier multibody from an [`ArmModel`]; the model-based
