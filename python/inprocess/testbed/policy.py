@@ -22,6 +22,12 @@ except ImportError:  # pragma: no cover
 QUOTE_CHARS = 80
 #: Largest embedded scenario (env.scenario_toml), bytes.
 MAX_SCENARIO_TOML = 1 << 20
+#: Largest array of a policy file, bytes, by its zip entry's declared size
+#: and by the shape its .npy header declares, both checked before any
+#: array is read: a 2 MB zip bomb made numpy allocate 2 GiB before the
+#: shapes were checked (#48 item 9). The widest arm (32 joints, 225
+#: observations) needs 58 kB of weights.
+MAX_POLICY_ARRAY_BYTES = 16 << 20
 
 
 @dataclass
@@ -54,6 +60,7 @@ class LinearPolicy:
 
     @classmethod
     def load(cls, path) -> "LinearPolicy":
+        _check_npz_sizes(path)
         with np.load(path, allow_pickle=False) as f:
             missing = {"weights", "bias", "env"} - set(f.files)
             if missing:
@@ -101,6 +108,42 @@ class LinearPolicy:
                 raise ValueError(f"{where}: {name} has a value that is not finite")
         check_scenario(env, where)
         self.weights, self.bias = w.astype(np.float64), b.astype(np.float64)
+
+
+def _check_npz_sizes(path) -> None:
+    """Refuses a policy file whose arrays would be larger than
+    MAX_POLICY_ARRAY_BYTES, from the zip's directory and each .npy header
+    alone (ValueError naming the file, the member and the cap)."""
+    import zipfile
+
+    cap = MAX_POLICY_ARRAY_BYTES
+    try:
+        archive = zipfile.ZipFile(path)
+    except (zipfile.BadZipFile, OSError) as e:
+        raise ValueError(f"{path}: not a testbed policy file (not a readable .npz: {quote(str(e))})") from None
+    with archive:
+        for info in archive.infolist():
+            name = quote(info.filename)
+            if info.file_size > cap:
+                raise ValueError(f"{path}: member {name} is {info.file_size} bytes unpacked, "
+                                 f"over the cap of {cap} bytes on a policy array")
+            if not info.filename.endswith(".npy"):
+                continue
+            with archive.open(info) as member:
+                try:
+                    version = np.lib.format.read_magic(member)
+                    header = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                              else np.lib.format.read_array_header_2_0)
+                    shape, _, dtype = header(member)
+                except (ValueError, OSError) as e:
+                    raise ValueError(f"{path}: member {name} has no readable .npy header "
+                                     f"({quote(str(e))})") from None
+            count = 1
+            for n in shape:
+                count *= n
+            if count * max(dtype.itemsize, 1) > cap:
+                raise ValueError(f"{path}: member {name} declares shape {quote(shape)} of {dtype}, "
+                                 f"over the cap of {cap} bytes on a policy array")
 
 
 def quote(value) -> str:

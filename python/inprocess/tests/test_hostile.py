@@ -148,6 +148,37 @@ class PolicyFiles(unittest.TestCase):
                 self.assertIn(f"testbed.policy_node: {path}:", out.stderr, path.name)
                 self.assertNotIn("Traceback", out.stderr, f"{path.name}: {out.stderr}")
 
+    def test_a_policy_array_over_the_cap_is_refused_before_it_is_read(self):
+        """#48 item 9 (N9): an .npz whose .npy header declares 3.2 GB is
+        refused from the header, naming the member and the cap, before
+        numpy allocates it."""
+        import io
+        import zipfile
+
+        from testbed.policy import MAX_POLICY_ARRAY_BYTES
+
+        def npy(array=None, header=None):
+            out = io.BytesIO()
+            if header is None:
+                np.lib.format.write_array(out, array)
+            else:
+                np.lib.format.write_array_header_1_0(out, header)
+                out.write(b"\0" * 64)
+            return out.getvalue()
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "bomb.npz"
+            with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+                z.writestr("weights.npy", npy(header={"descr": "<f8", "fortran_order": False,
+                                                      "shape": (20000, 20000)}))
+                z.writestr("bias.npy", npy(np.zeros(2)))
+                z.writestr("env.npy", npy(np.array("{}")))
+            with self.assertRaises(ValueError) as caught:
+                LinearPolicy.load(path)
+            message = str(caught.exception)
+            self.assertIn(f"{path}: member 'weights.npy' declares shape (20000, 20000)", message)
+            self.assertIn(f"over the cap of {MAX_POLICY_ARRAY_BYTES} bytes", message)
+
     def test_a_good_policy_file_describes_itself(self):
         p = LinearPolicy.zeros(2, 15, {"dof": 2, "obs_dim": 15, "steps": 100,
                                         "torque_scale": [1.0, 1.0], "base_law": "pd"})
