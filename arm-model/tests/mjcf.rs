@@ -160,3 +160,17 @@ fn a_file_with_includes_becomes_text_that_reads_alone() {
         load("includes_defaults.xml").unwrap()
     );
 }
+
+#[test]
+fn malformed_mjcf_is_an_error_not_a_panic() {
+    for text in [
+        "<mujoco",
+        "<mujoco><worldbody><body><joint range=\"1\"/></body></worldbody></mujoco>",
+        "<mujoco><worldbody><body><joint/><inertial mass=\"nan\" pos=\"0 0 0\" diaginertia=\"1 1 1\"/></body></worldbody></mujoco>",
+        "<mujoco><worldbody><body><joint axis=\"0 0 0\"/><inertial mass=\"1\" pos=\"0 0 0\" diaginertia=\"1 1 1\"/></body></worldbody></mujoco>",
+        "<mujoco><worldbody/><keyframe><key qpos=\"1 2\"/></keyframe></mujoco>",
+    ] {
+        let outcome = std::panic::catch_unwind(|| ArmModel::from_urdf_str(text));
+        assert!(matches!(outcome, Ok(Err(_))), "{text}: {outcome:?}");
+    }
+}
