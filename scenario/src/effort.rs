@@ -76,7 +76,7 @@ pub fn effort_warnings(plan: &Plan) -> Result<Vec<String>, PlantError> {
 fn loads(plan: &Plan) -> Result<(Vec<f64>, Vec<f64>), PlantError> {
     let (model, s) = (&plan.robot.model, &plan.scenario);
     let n = model.dof();
-    let armature = s.plant.armature.resolve("plant.armature", n)?;
+    let armature = s.plant.armature_for(model)?;
     // The run's own gravity: with none, the reference needs no holding torque.
     let mut prober = Prober::with_gravity(model, &armature, s.plant.gravity)?;
     let count = (s.duration_s / SPACING_S).ceil().max(1.0) as usize;

@@ -194,7 +194,7 @@ struct Measured {
 /// Probes the arm at the reference's postures; the load τ*_i of each joint.
 fn measure(model: &ArmModel, s: &Scenario) -> Result<Measured, PlantError> {
     let n = model.dof();
-    let armature = s.plant.armature.resolve("plant.armature", n)?;
+    let armature = s.plant.armature_for(model)?;
     let mut prober = Prober::new(model, &armature)?;
     let probes = postures(s)
         .iter()

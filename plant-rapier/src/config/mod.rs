@@ -40,7 +40,8 @@ pub struct PlantConfig {
     /// (default: true).
     pub urdf_dynamics: bool,
     /// Motor armature (rotor inertia × gear ratio²) per controlled joint,
-    /// which URDFs omit, kg m² (kg for prismatic joints) (default: 0).
+    /// which URDFs omit, kg m² (kg for prismatic joints) (default: 0); an
+    /// MJCF joint's own `armature` is added to it.
     pub armature: PerJoint,
     /// Joint friction.
     pub friction: FrictionConfig,
@@ -376,6 +377,17 @@ impl PlantConfig {
             }
         }
         E(bits)
+    }
+
+    /// The armature the plant simulates per controlled joint: the model's
+    /// own (an MJCF joint's `armature`; 0 from a URDF, which has none) plus
+    /// the scenario's `[plant] armature` (the motors a URDF leaves out).
+    pub fn armature_for(&self, model: &arm_model::ArmModel) -> Result<Vec<f64>, PlantError> {
+        let mut armature = self.armature.resolve("plant.armature", model.dof())?;
+        for (a, &j) in armature.iter_mut().zip(&model.actuated) {
+            *a += model.joints[j].armature;
+        }
+        Ok(armature)
     }
 
     /// Checks the per-joint lengths against an arm of `n` joints and the

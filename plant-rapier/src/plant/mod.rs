@@ -186,7 +186,7 @@ impl Plant {
         if n == 0 {
             return Err(PlantError::NoActuatedJoints);
         }
-        let armature = config.armature.resolve("plant.armature", n)?;
+        let armature = config.armature_for(model)?;
         build::refuse_massless(model, &armature)?;
         let f = &config.friction;
         let friction = Friction {
