@@ -103,13 +103,17 @@ pub fn overrides_set(set: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, to
     if let Ok(d) = set.cast::<PyDict>() {
         let mut out = Vec::new();
         for (k, v) in d.iter() {
-            let key: String = k
-                .extract()
-                .map_err(|_| PyTypeError::new_err(format!("set: key {k} is not a string")))?;
+            let key: String = k.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "set: key {} is not a string",
+                    cut(&k.to_string(), QUOTED)
+                ))
+            })?;
             let value = to_toml(&key, &v, 0)?;
             // Through `--set`'s own reader: the same key checks.
-            let parsed = scenario::parse_set(&format!("{key}={value}"))
-                .map_err(|e| PyValueError::new_err(format!("set: {e}")))?;
+            let parsed = scenario::parse_set(&format!("{key}={value}")).map_err(|e| {
+                PyValueError::new_err(format!("set: {}", cut(&e.to_string(), 2 * QUOTED)))
+            })?;
             out.push(parsed);
         }
         return Ok(out);
@@ -121,8 +125,26 @@ pub fn overrides_set(set: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, to
     })?;
     items
         .iter()
-        .map(|s| scenario::parse_set(s).map_err(|e| PyValueError::new_err(format!("set: {e}"))))
+        .map(|s| {
+            scenario::parse_set(s).map_err(|e| {
+                PyValueError::new_err(format!("set: {}", cut(&e.to_string(), 2 * QUOTED)))
+            })
+        })
         .collect()
+}
+
+/// The most characters of a user's value a refusal quotes: a 2 M-entry
+/// `set=` made a 10 MB message and 650 MB of memory (#48 item 9). The
+/// reader's own messages quote the whole `key=value`, so they are cut at
+/// twice this, which keeps what they say of it.
+const QUOTED: usize = 80;
+
+/// `text` cut to `chars` characters, with its length when cut.
+fn cut(text: &str, chars: usize) -> String {
+    match text.char_indices().nth(chars) {
+        None => text.to_string(),
+        Some((at, _)) => format!("{}… ({} bytes in all)", &text[..at], text.len()),
+    }
 }
 
 /// How deep a `set=` value may nest (a scenario's deepest is 3).
@@ -132,7 +154,8 @@ const MAX_SET_DEPTH: usize = 16;
 fn to_toml(key: &str, v: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::Value> {
     if depth > MAX_SET_DEPTH {
         return Err(PyValueError::new_err(format!(
-            "set: {key}: nested more than {MAX_SET_DEPTH} deep (a list or dict that contains itself?)"
+            "set: {}: nested more than {MAX_SET_DEPTH} deep (a list or dict that contains itself?)",
+            cut(key, QUOTED)
         )));
     }
     if let Ok(b) = v.extract::<bool>() {
@@ -174,7 +197,8 @@ fn to_toml(key: &str, v: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::Valu
         return to_toml(key, &items, depth + 1);
     }
     Err(PyTypeError::new_err(format!(
-        "set: {key}: a {} is not a scenario value (a number, string, bool, list or dict)",
+        "set: {}: a {} is not a scenario value (a number, string, bool, list or dict)",
+        cut(key, QUOTED),
         v.get_type().name()?
     )))
 }

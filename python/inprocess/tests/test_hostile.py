@@ -44,6 +44,18 @@ class Boundary(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "nested more than 16 deep"):
             testbed.sim(set={"controller": d})
 
+    def test_a_refused_set_quotes_its_value_cut(self):
+        """#48 item 9 (N7): a 2 M-entry set= made a 10 MB message."""
+        long = "k" * 1_000_000
+        for set_ in ([long], {"controller.k1": [1.0] * 200_000 + ["x"]}, {long: 1}):
+            try:
+                testbed.sim(set=set_, duration=0.01)
+            except (ValueError, TypeError, testbed.TestbedError) as e:
+                self.assertLess(len(str(e)), 2000, str(e)[:2000])
+                self.assertIn("bytes in all)", str(e))
+            else:
+                self.fail("accepted")
+
     def test_huge_sizes_are_refused_before_anything_is_allocated(self):
         for n in (0, 2**62):
             with self.assertRaisesRegex(testbed.TestbedError, "num_envs = .* must be from 1 to 65536"):
