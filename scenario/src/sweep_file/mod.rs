@@ -52,10 +52,11 @@ pub enum SweepFileError {
 /// Sweeps larger than this are refused. Every run is resolved (its plan
 /// and the hash that names it on disk) before the first starts, so that
 /// a resumed or Slurm-split sweep agrees on each run's identity, and the
-/// manifest lists every run: 10⁵ runs take about 1 GB and a minute before
-/// they end (measured: docs/results.md), where 10⁶ took 10 GB and 7
-/// minutes before the first began. A larger study is several sweeps.
-pub const MAX_RUNS: usize = 100_000;
+/// manifest lists every run. A run's plan is about 13 kB and resolving it
+/// about 0.6 ms: 10⁵ runs took 1.28 GB and 64 s before the first began
+/// (#48, D14), so the cap is 10⁴ (about 130 MB and 6 s). A larger study
+/// is several sweeps.
+pub const MAX_RUNS: usize = 10_000;
 
 /// A sweep file as written.
 #[derive(Debug, Clone, Deserialize)]
@@ -213,9 +214,16 @@ impl Axis {
         if out.is_empty() {
             return Err(bad("no values".into()));
         }
-        // Two equal values would be two identical cells.
-        for (i, v) in out.iter().enumerate() {
-            if out[..i].contains(v) {
+        // Two equal values would be two identical cells. By their text
+        // (−0.0 as 0.0, as == has it), in one pass: comparing each value
+        // with every earlier one was quadratic in the axis's length.
+        let mut seen = std::collections::HashSet::with_capacity(out.len());
+        for v in &out {
+            let text = match v {
+                toml::Value::Float(x) if *x == 0.0 => "0.0".to_string(),
+                other => other.to_string(),
+            };
+            if !seen.insert(text) {
                 return Err(bad(format!("value {v} is listed twice")));
             }
         }
@@ -499,7 +507,7 @@ mod tests {
         let e = refused(
             "[[axis]]\nkey = \"controller.k1\"\nrange = { start = 1.0, stop = 2.0, num = 1000000000 }\n",
         );
-        assert!(e.contains("at most 100000 per sweep"), "{e}");
+        assert!(e.contains(&format!("at most {MAX_RUNS} per sweep")), "{e}");
         let axis = |k: &str| {
             format!("[[axis]]\nkey = \"{k}\"\nrange = {{ start = 1.0, stop = 2.0, num = 1000 }}\n")
         };
