@@ -20,10 +20,16 @@ Needs stable-baselines3 (python/setup-train-venv.sh makes an environment).
 """
 
 import argparse
+import sys
+from pathlib import Path
 
+import gymnasium
 import numpy as np
 
 import testbed
+
+sys.path.insert(0, str(Path(__file__).parent))
+from train_sb3 import evaluate  # noqa: E402  (one episode per seed: mean return, cost steps)
 
 #: Safe mode (no early end; the reward never counts the cost), a weak
 #: base law and a dear effort term.
@@ -82,22 +88,6 @@ def make_dual_ascent(BaseCallback):
     return DualAscent
 
 
-def evaluate(act, seeds):
-    """Mean return and total cost steps over one episode per seed."""
-    import gymnasium
-
-    env = gymnasium.make(testbed.ENV_ID, **KWARGS)
-    returns, costs = [], 0.0
-    for s in seeds:
-        obs, _ = env.reset(seed=s)
-        total, done = 0.0, False
-        while not done:
-            obs, r, term, trunc, info = env.step(act(obs))
-            total, costs, done = total + r, costs + info["cost"], term or trunc
-        returns.append(total)
-    return float(np.mean(returns)), costs
-
-
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--timesteps", type=int, default=100_000, help="decisions to train on")
@@ -124,8 +114,9 @@ def main():
     model.save(a.out)
     seeds = range(HELD_OUT, HELD_OUT + a.eval_seeds)
     zero = np.zeros(venv.action_space.shape, np.float32)
-    base = evaluate(lambda o: zero, seeds)
-    ppo = evaluate(lambda o: model.predict(o, deterministic=True)[0], seeds)
+    env = gymnasium.make(testbed.ENV_ID, **KWARGS)
+    base = evaluate(env, lambda o: zero, seeds)
+    ppo = evaluate(env, lambda o: model.predict(o, deterministic=True)[0], seeds)
     print(f"pd alone:          mean return {base[0]:.2f}, constraint cost {base[1]:.0f} steps")
     print(f"PPO-Lagrangian:    mean return {ppo[0]:.2f}, constraint cost {ppo[1]:.0f} steps")
     print(f"final lambda {penalty.lam:.3f}; saved {a.out}.zip ({a.eval_seeds} held-out seeds from {HELD_OUT})")

@@ -599,8 +599,13 @@ mod tests {
 
     /// The paper scenario for `duration` s, one seed, `laws`.
     fn run_for(duration: f64, laws: Vec<LawName>) -> Comparison {
+        run_on(None, duration, laws, 1)
+    }
+
+    /// `scenario` (the paper's when None) for `duration` s over `seeds`.
+    fn run_on(scenario: Option<&str>, duration: f64, laws: Vec<LawName>, seeds: u64) -> Comparison {
         let plan = scenario::load(
-            None,
+            scenario.map(std::path::Path::new),
             &scenario::Overrides {
                 duration_s: Some(duration),
                 ..Default::default()
@@ -613,7 +618,7 @@ mod tests {
             runs_dir: std::path::PathBuf::from("runs"),
             progress: false,
             laws,
-            seeds: 1,
+            seeds,
             threads: Some(1),
             series: false,
             tuning: None,
@@ -734,26 +739,7 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/../scenarios/paper_randomised.toml"
         );
-        let plan = scenario::load(
-            Some(std::path::Path::new(path)),
-            &scenario::Overrides {
-                duration_s: Some(2.5),
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        let opts = CompareOptions {
-            law_sets: Vec::new(),
-            external: Vec::new(),
-            runs_dir: std::path::PathBuf::from("runs"),
-            progress: false,
-            laws: vec![LawName::Nac, LawName::Pd],
-            seeds: 8,
-            threads: Some(1),
-            series: false,
-            tuning: None,
-        };
-        let mut c = compare(&plan, &opts).unwrap();
+        let mut c = run_on(Some(path), 2.5, vec![LawName::Nac, LawName::Pd], 8);
         let (nac, pd) = (c.laws[0].clone(), c.laws[1].clone());
         c.laws.push(as_user(&nac, "twin"));
         c.laws.push(as_user(&pd, "mine"));
