@@ -310,7 +310,7 @@ impl Children {
 
     /// Notes what the nodes have started so far (at most every 50 ms),
     /// so that it ends with the run wherever it moves
-    /// ([`super::strays::RunTree`]).
+    /// (the run tree of `strays.rs`).
     pub fn watch(&mut self) {
         let nodes = self.node_pids();
         self.1.note(&nodes, false);
