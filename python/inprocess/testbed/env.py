@@ -47,19 +47,22 @@ def _seed_from(rng: np.random.Generator) -> int:
     return int(rng.integers(0, 2**63 - 1))
 
 
-def _real_actions(actions, what: str = "step: action") -> np.ndarray:
-    """The actions as float64, refusing what would be read silently wrong:
-    complex (its imaginary part dropped), bool (True as 1.0), float16 (an
-    action rounded to 3 digits), strings and objects. Integers are taken
-    (exact as floats)."""
-    arr = np.asarray(actions)
-    kind, size = arr.dtype.kind, arr.dtype.itemsize
-    if kind in "iu" or (kind == "f" and size >= 4):
-        return arr.astype(np.float64, copy=False)
+def _real_actions(actions, what: str = "step: action"):
+    """The actions as given, unless they would be read silently wrong:
+    complex (its imaginary part dropped), bool (True as 1.0) or float16
+    (an action rounded to 3 digits) raise TypeError naming the dtype.
+    Anything else goes on to the usual checks (strings and bytes are
+    refused there as not numbers)."""
+    dtype = getattr(actions, "dtype", None)
+    if dtype is None:
+        dtype = np.asarray(actions).dtype
     why = {"c": "complex: its imaginary part would be dropped",
-           "b": "bool: True would be read as 1.0",
-           "f": "float16: the action would be rounded to 3 significant digits"}.get(kind, "not numbers")
-    raise TypeError(f"{what}: dtype {arr.dtype} is refused ({why}); give float32 or float64")
+           "b": "bool: True would be read as 1.0"}.get(dtype.kind)
+    if dtype.kind == "f" and dtype.itemsize < 4:
+        why = "float16: the action would be rounded to 3 significant digits"
+    if why:
+        raise TypeError(f"{what}: dtype {dtype} is refused ({why}); give float32 or float64")
+    return actions
 
 
 def _render_mode(render_mode):
@@ -185,7 +188,7 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         return obs, {}
 
     def step(self, actions):
-        actions = _real_actions(actions, "step: actions")
+        actions = np.asarray(_real_actions(actions, "step: actions"), dtype=np.float64)
         obs, rewards, terminated, truncated, costs = self._core.step(actions)
         return obs, rewards, terminated, truncated, {"cost": costs, "_cost": self._all}
 

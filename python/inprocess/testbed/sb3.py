@@ -137,7 +137,7 @@ class ArmTrackingSB3VecEnv(VecEnv):
         return out
 
     def step_async(self, actions: np.ndarray) -> None:
-        self._actions = _real_actions(actions, "step_async: actions")
+        self._actions = np.asarray(_real_actions(actions, "step_async: actions"), dtype=np.float64)
 
     def step_wait(self):
         if self._actions is None:
