@@ -39,6 +39,7 @@ mod gain;
 mod law_table;
 mod machine;
 mod mpc;
+mod mpc_polish;
 mod nac;
 pub mod node;
 mod params;

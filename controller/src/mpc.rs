@@ -7,6 +7,8 @@
 //! tightened against a disturbance bound w on ë = u + d (tube MPC, [`Tube`]).
 
 use clarabel::algebra::CscMatrix;
+
+use crate::mpc_polish::Polish;
 use clarabel::solver::{
     DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
@@ -70,6 +72,8 @@ struct JointQp {
     tube: Tube,
     /// Whether the QP has input rows.
     bounded: bool,
+    /// The exact optimum from the solver's active rows.
+    polish: Polish,
 }
 
 /// Constraint tightening against |d| ≤ w on ë = u + d, in the form of
@@ -166,6 +170,9 @@ pub(crate) enum MpcSetupError {
     /// The terminal cost's Riccati iteration did not converge.
     #[error("the terminal cost's Riccati equation did not converge")]
     Riccati,
+    /// The dynamics rows could not be inverted to condense the QP.
+    #[error("the QP's dynamics rows are singular")]
+    Dynamics,
     /// clarabel refused the problem.
     #[error("the QP solver refused the problem: {0}")]
     Solver(#[from] clarabel::solver::SolverError),
@@ -302,6 +309,7 @@ impl JointQp {
             SupportedConeT::NonnegativeConeT(a.m - layout.equality_rows()),
         ];
         let solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings()?)?;
+        let polish = Polish::new(&p, &a, layout.equality_rows()).ok_or(MpcSetupError::Dynamics)?;
         let [ke, kv] = lqr_gain(&terminal, theta);
         let lqr = [w.omega * w.omega * ke, w.omega * kv];
         Ok(Self {
@@ -311,6 +319,7 @@ impl JointQp {
             lqr,
             tube: Tube::new(lqr, h, horizon, shape.disturbance),
             bounded: shape.bounded,
+            polish,
         })
     }
 
@@ -374,11 +383,17 @@ impl JointQp {
         self.solver.update_b(&self.b).ok()?;
         self.solver.solve();
         let solution = &self.solver.solution;
-        matches!(
+        if !matches!(
             solution.status,
             SolverStatus::Solved | SolverStatus::AlmostSolved
-        )
-        .then(|| self.omega * self.omega * solution.x[layout.input(0)])
+        ) {
+            return None;
+        }
+        let w0 = match self.polish.inputs(&self.b, &solution.s, &solution.z) {
+            Some(w) => w[0],
+            None => solution.x[layout.input(0)],
+        };
+        Some(self.omega * self.omega * w0)
     }
 }
 
@@ -386,19 +401,16 @@ fn settings() -> Result<DefaultSettings<f64>, clarabel::solver::DefaultSettingsB
     // Presolve and dropped zeros are off so that `update_b` is allowed.
     // The QP is small and well scaled (see `Weights`): iterative
     // refinement would halve the solve rate and change nothing the law
-    // uses (the tests compare u against an independent solution). The
-    // duality gap is closed to 1e-12 (default 1e-8), which puts u₀ within
-    // 1e-6 of the exact optimum where a row is active (at 1e-8 and 1e-10
-    // it was 1e-4 and 2e-5 off) for about two more iterations; the
-    // feasibility tolerance stays at its default, as 1e-12 there stalls
-    // the solver (InsufficientProgress) when rows before T_c are off.
+    // uses. The gap tolerances stay at clarabel's defaults (1e-8), which
+    // leave u₀ up to ~1e-4 off where a row is active; `Polish` then makes
+    // it exact from the active rows. Closing the gap to 1e-12 instead cost
+    // about two more iterations and doubled the step time on the iiwa14
+    // (docs/results.md, "MPC solve time").
     DefaultSettingsBuilder::default()
         .verbose(false)
         .presolve_enable(false)
         .input_sparse_dropzeros(false)
         .iterative_refinement_enable(false)
-        .tol_gap_abs(1e-12)
-        .tol_gap_rel(1e-12)
         .max_iter(50)
         .build()
 }

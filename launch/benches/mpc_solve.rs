@@ -1,8 +1,8 @@
 //! `mpc`'s step time on the KUKA iiwa 14 (7 joints) at 1 kHz in its worst
 //! case: every joint's error near its envelope and heading out of it, so
 //! that every joint's QP goes to the solver on every step (BASELINES §3).
-//! One row per variant: the nominal QP without torque bounds, with them
-//! (the default: the iiwa's effort limits through M(q)), the tube MPC
+//! One row per variant: the nominal QP without torque bounds (the
+//! default), with them (the iiwa's effort limits through M(q)), the tube MPC
 //! tightened against a disturbance bound, and `cbf-ctc` with torque bounds
 //! and a robust margin (closed form, for scale). Prints p50, p99 and the
 //! largest step time against the 1 ms period. With the iiwa's torque box
@@ -39,14 +39,14 @@ fn main() {
         base.mpc_horizon, base.mpc_step
     );
     let variants = [
+        ("mpc (default: no torque bounds)", base.clone()),
         (
-            "mpc, no torque bounds",
+            "mpc, torque bounds",
             ControllerParams {
-                torque_bounds: false,
+                torque_bounds: true,
                 ..base.clone()
             },
         ),
-        ("mpc (torque bounds)", base.clone()),
         (
             "mpc tube, w = 20 rad/s^2",
             ControllerParams {
@@ -58,6 +58,7 @@ fn main() {
             "cbf-ctc, bounds + margin 20",
             ControllerParams {
                 law: LawName::CbfCtc,
+                torque_bounds: true,
                 cbf_margin: 20.0,
                 ..base.clone()
             },
