@@ -1,7 +1,9 @@
 //! `[plant.contact]` through Rapier: a pendulum whose tip strikes a wall
 //! rebounds at −e times its speed (restitution), stops at e = 0, sinks into
 //! the wall by under a millimetre, and the state says `contact` only
-//! while it touches; the articulated engine refuses contact by name.
+//! while it touches; pushed into the wall and at rest, its contact has
+//! points and a force that balances the torque; the articulated engine
+//! refuses contact by name.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
@@ -526,4 +528,31 @@ fn an_object_lighter_than_a_microgram_is_refused() {
     }
     .validate()
     .unwrap();
+}
+
+/// The pendulum pushed into the wall by a steady torque τ comes to rest
+/// against it: the contact then has points, and its mean force balances
+/// the torque about the joint (F · r_y = τ, the wall's normal along x).
+#[test]
+fn a_resting_contact_has_points_and_balances_the_torque() {
+    let mut r = rig(EngineName::Rapier, 0.0).unwrap();
+    let tau = 2.0;
+    r.set_state(&[1.4], &[0.0]).unwrap();
+    let (mut q, mut qd) = ([0.0], [0.0]);
+    for _ in 0..3000 {
+        r.step(Some(&[tau])).unwrap();
+    }
+    r.true_state_into(&mut q, &mut qd);
+    let c = r.plant().contact().unwrap();
+    assert!(qd[0].abs() < 1e-6, "still moving: q̇ {}", qd[0]);
+    assert!(
+        c.points > 0,
+        "resting on the wall with no contact point: {c:?}"
+    );
+    let want = tau / q[0].sin();
+    assert!(
+        (c.force - want).abs() <= 1e-6 * want,
+        "mean force {} N, torque balance {want} N",
+        c.force
+    );
 }

@@ -170,9 +170,15 @@ impl Contacts {
             }
             self.impulse += pair.total_impulse_magnitude();
             for m in pair.manifolds() {
-                // Points within the contact skin count; Rapier measures
-                // them before its solver moves the bodies.
-                for p in m.points.iter().filter(|p| p.dist <= 0.0) {
+                // A point counts if it overlaps or the solver pushed on
+                // it: Rapier measures distances before its solver moves
+                // the bodies, so a resting contact sits just apart (dist
+                // > 0) while it carries the whole load.
+                for p in m
+                    .points
+                    .iter()
+                    .filter(|p| p.dist <= 0.0 || p.data.impulse > 0.0)
+                {
                     points += 1;
                     if p.dist < deepest.0 {
                         let w = c1.position() * p.local_p1;
