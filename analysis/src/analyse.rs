@@ -279,10 +279,10 @@ impl Analyser<'_, '_> {
             Some(Logged::Timing(t)) => self.on_timing(&t),
             Some(Logged::OwnDiagnostics(o)) => {
                 if o.count as usize != self.own_len {
-                    return Err(DecodeError(format!(
-                        "{} values where the run's controller_diagnostics declares {}",
-                        o.count, self.own_len
-                    ))
+                    return Err(DecodeError::DiagnosticsCount {
+                        got: o.count as usize,
+                        declared: self.own_len,
+                    }
                     .into());
                 }
                 self.assembler.push_own(o);
@@ -454,8 +454,6 @@ fn check_dof(dof: u32, n: usize) -> Result<(), DecodeError> {
     if dof as usize == n {
         Ok(())
     } else {
-        Err(DecodeError(format!(
-            "dof {dof} but the logged robot has {n} joints"
-        )))
+        Err(DecodeError::Dof { dof, joints: n })
     }
 }

@@ -4,7 +4,7 @@
 //! Text is drawn with an embedded DejaVu Sans (see `assets/`), so figures do
 //! not depend on the fonts of the machine.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -66,9 +66,9 @@ pub fn category(names: &[String], x: f64) -> String {
     }
 }
 
-/// A drawing error (plotters' own, or a file's) as a [`PlotError`].
+/// plotters' drawing error as a [`PlotError`].
 pub fn err(e: impl std::fmt::Display) -> PlotError {
-    PlotError(e.to_string())
+    PlotError::Draw(e.to_string())
 }
 
 fn decimate(t: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
@@ -178,7 +178,7 @@ pub fn save(
         panels,
         vline,
     )
-    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
+    .map_err(PlotError::in_file(&png))?;
     let svg = dir.join(format!("{name}.svg"));
     draw_panels(
         &SVGBackend::new(&svg, (1000, h)).into_drawing_area(),
@@ -187,7 +187,7 @@ pub fn save(
         panels,
         vline,
     )
-    .map_err(|e| PlotError(format!("{}: {e}", svg.display())))
+    .map_err(PlotError::in_file(&svg))
 }
 
 fn bounds(a: &[f64], b: &[f64], sign: f64) -> Vec<f64> {
@@ -196,12 +196,47 @@ fn bounds(a: &[f64], b: &[f64], sign: f64) -> Vec<f64> {
 
 /// A figure could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct PlotError(pub String);
+pub enum PlotError {
+    /// plotters could not draw (its message: its errors are generic over
+    /// the backend).
+    #[error("{0}")]
+    Draw(String),
+    /// The data hold nothing the figure can show.
+    #[error("nothing to draw: {0}")]
+    Empty(&'static str),
+    /// Drawing or writing one figure's file failed.
+    #[error("{}: {source}", path.display())]
+    Figure {
+        /// The figure's file.
+        path: PathBuf,
+        /// Why.
+        source: Box<PlotError>,
+    },
+    /// The figures' folder could not be made.
+    #[error("{}: {source}", path.display())]
+    Folder {
+        /// The folder.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+}
 
-impl From<&str> for PlotError {
-    fn from(why: &str) -> Self {
-        Self(why.to_string())
+impl PlotError {
+    /// Names the figure file `path` in an error drawing it.
+    pub fn in_file(path: &Path) -> impl FnOnce(PlotError) -> PlotError + '_ {
+        move |e| PlotError::Figure {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        }
+    }
+
+    /// Names the folder `path` in an error making it.
+    pub fn folder(path: &Path) -> impl FnOnce(std::io::Error) -> PlotError + '_ {
+        move |source| PlotError::Folder {
+            path: path.to_path_buf(),
+            source,
+        }
     }
 }
 
@@ -211,7 +246,7 @@ pub fn write_all(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, PlotError
 }
 
 fn write_figures(dir: &Path, s: &Series, plan: &Plan) -> Result<usize, PlotError> {
-    std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(dir).map_err(PlotError::folder(dir))?;
     // Registering twice is harmless; the bytes are a valid font by construction.
     let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
     let names = plan.robot.model.joint_names();
@@ -441,10 +476,10 @@ fn timing_figure(dir: &Path, s: &Series) -> Result<(), PlotError> {
         &BitMapBackend::new(&png, (1000, 640)).into_drawing_area(),
         s,
     )
-    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
+    .map_err(PlotError::in_file(&png))?;
     let svg = dir.join("fig6_timing.svg");
     draw_timing(&SVGBackend::new(&svg, (1000, 640)).into_drawing_area(), s)
-        .map_err(|e| PlotError(format!("{}: {e}", svg.display())))
+        .map_err(PlotError::in_file(&svg))
 }
 
 fn draw_timing<DB: DrawingBackend>(

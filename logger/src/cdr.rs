@@ -129,7 +129,9 @@ pub struct CdrReader<'a> {
 }
 
 fn short(what: &str) -> DecodeError {
-    DecodeError(format!("the CDR message ends inside its {what}"))
+    DecodeError::Truncated {
+        field: what.to_string(),
+    }
 }
 
 impl<'a> CdrReader<'a> {
@@ -141,11 +143,10 @@ impl<'a> CdrReader<'a> {
                 buf: &data[4..],
                 pos: 0,
             }),
-            Some(h) => Err(DecodeError(format!(
-                "not little-endian CDR (encapsulation {:02x} {:02x})",
-                h[0], h[1]
-            ))),
-            None => Err(DecodeError("shorter than a CDR header".into())),
+            Some(h) => Err(DecodeError::NotLittleEndianCdr {
+                encapsulation: [h[0], h[1]],
+            }),
+            None => Err(DecodeError::ShorterThanHeader),
         }
     }
 
@@ -201,9 +202,10 @@ impl<'a> CdrReader<'a> {
     pub fn len(&mut self, what: &str, min_size: usize) -> Result<usize, DecodeError> {
         let n = self.u32(what)? as usize;
         if n.saturating_mul(min_size) > self.buf.len() - self.pos {
-            return Err(DecodeError(format!(
-                "its {what} claims {n} entries, more than the message holds"
-            )));
+            return Err(DecodeError::LengthPastEnd {
+                field: what.to_string(),
+                entries: n,
+            });
         }
         Ok(n)
     }
@@ -214,7 +216,9 @@ impl<'a> CdrReader<'a> {
         let bytes = &self.buf[self.pos..self.pos + n];
         self.pos += n;
         let text = bytes.strip_suffix(&[0]).unwrap_or(bytes);
-        std::str::from_utf8(text).map_err(|_| DecodeError(format!("its {what} is not UTF-8")))
+        std::str::from_utf8(text).map_err(|_| DecodeError::NotUtf8 {
+            field: what.to_string(),
+        })
     }
 
     /// A `float64[]` into `out` (cleared first).
@@ -232,9 +236,11 @@ impl<'a> CdrReader<'a> {
         let sec = self.i32(what)?;
         let nsec = self.u32(what)?;
         if sec < 0 || nsec >= 1_000_000_000 {
-            return Err(DecodeError(format!(
-                "its {what} is not a time ({sec} s {nsec} ns)"
-            )));
+            return Err(DecodeError::NotATime {
+                field: what.to_string(),
+                sec,
+                nsec,
+            });
         }
         Ok(sec as u64 * 1_000_000_000 + nsec as u64)
     }
@@ -283,11 +289,12 @@ mod tests {
         assert!(CdrReader::new(&[0, 1]).is_err());
         assert!(CdrReader::new(&[0, 0, 0, 0]).is_err());
         let mut r = CdrReader::new(&[0, 1, 0, 0, 255, 255, 255, 255]).unwrap();
-        assert!(
-            r.f64s("q", &mut Vec::new())
-                .unwrap_err()
-                .0
-                .contains("claims")
+        assert_eq!(
+            r.f64s("q", &mut Vec::new()).unwrap_err(),
+            DecodeError::LengthPastEnd {
+                field: "q".into(),
+                entries: u32::MAX as usize
+            }
         );
         let mut r = CdrReader::new(&[0, 1, 0, 0, 1, 0, 0]).unwrap();
         assert!(r.u32("dof").is_err());

@@ -69,7 +69,7 @@ impl FieldSource for CdrFields<'_> {
 /// The message back from its CDR, written with this build's own schema
 /// for `M` (a log is read by the schema it stores: [`decode_by`]).
 pub fn decode<M: LogMessage>(data: &[u8]) -> Result<M, DecodeError> {
-    let schema = msg_schema::<M>().map_err(|e| DecodeError(e.to_string()))?;
+    let schema = msg_schema::<M>()?;
     decode_by(&schema, data)
 }
 
@@ -97,10 +97,11 @@ pub fn decode_by<M: LogMessage>(schema: &MsgSchema, data: &[u8]) -> Result<M, De
             SchemaKind::F64s => {
                 r.f64s(name, &mut xs)?;
                 if xs.len() > MAX_DOF {
-                    return Err(DecodeError(format!(
-                        "field '{name}' has {} entries (at most {MAX_DOF})",
-                        xs.len()
-                    )));
+                    return Err(DecodeError::TooManyEntries {
+                        field: name.to_string(),
+                        entries: xs.len(),
+                        max: MAX_DOF,
+                    });
                 }
                 Val::J(Box::new(joints(&xs)))
             }
@@ -112,13 +113,15 @@ pub fn decode_by<M: LogMessage>(schema: &MsgSchema, data: &[u8]) -> Result<M, De
         }
     }
     if !r.at_end() {
-        return Err(DecodeError(format!(
-            "the CDR message is longer than its schema {} says",
-            schema.name
-        )));
+        return Err(DecodeError::LongerThanSchema {
+            schema: schema.name.to_string(),
+        });
     }
-    let need = |v: Option<u64>, what: &str| {
-        v.ok_or_else(|| DecodeError(format!("schema {} has no {what}", schema.name)))
+    let need = |v: Option<u64>, field: &'static str| {
+        v.ok_or_else(|| DecodeError::SchemaLacks {
+            schema: schema.name.to_string(),
+            field,
+        })
     };
     let header = Header {
         seq: need(seq, "uint64 seq")?,

@@ -40,9 +40,8 @@ fn decode_one<M: LogMessage>(m: &RawMessage<'_>) -> Result<M, DecodeError> {
     match (m.encoding, m.schema) {
         (Encoding::Json, _) => M::parse(m.data),
         (Encoding::Cdr, Some(schema)) => crate::cdr_decode::decode_by(schema, m.data),
-        (Encoding::Cdr, None) => Err(DecodeError(format!(
-            "channel {} has no testbed_msgs schema to read its CDR by",
-            m.topic
-        ))),
+        (Encoding::Cdr, None) => Err(DecodeError::NoSchema {
+            topic: m.topic.to_string(),
+        }),
     }
 }

@@ -40,9 +40,7 @@ impl<'a> JsonObject<'a> {
         let mut de = serde_json::Deserializer::from_slice(text);
         let fields = (&mut de).deserialize_any(TopLevel).map_err(not_json)?;
         de.end().map_err(not_json)?;
-        fields
-            .map(JsonObject)
-            .ok_or(DecodeError("not a JSON object".into()))
+        fields.map(JsonObject).ok_or(DecodeError::NotJsonObject)
     }
 
     /// Checks that `text` is JSON, of any shape (for messages nothing
@@ -111,7 +109,7 @@ impl FieldSource for JsonObject<'_> {
 }
 
 fn not_json(e: serde_json::Error) -> DecodeError {
-    DecodeError(format!("not JSON ({e})"))
+    DecodeError::NotJson(e.to_string())
 }
 
 /// The whole text: `Some(fields)` for an object, `None` for anything else.
@@ -301,27 +299,16 @@ mod tests {
 
     #[test]
     fn not_json_and_not_an_object_are_named() {
-        assert!(
-            JsonObject::parse(b"{\"a\":")
-                .unwrap_err()
-                .0
-                .starts_with("not JSON")
-        );
-        assert!(
-            JsonObject::parse(b"{} x")
-                .unwrap_err()
-                .0
-                .starts_with("not JSON")
-        );
-        assert!(
-            JsonObject::check(b"[1,")
-                .unwrap_err()
-                .0
-                .starts_with("not JSON")
-        );
+        let not_json = |e: DecodeError| matches!(e, DecodeError::NotJson(_));
+        assert!(not_json(JsonObject::parse(b"{\"a\":").unwrap_err()));
+        assert!(not_json(JsonObject::parse(b"{} x").unwrap_err()));
+        assert!(not_json(JsonObject::check(b"[1,").unwrap_err()));
         for text in [&b"[1,{}]"[..], b"3", b"null", b"\"s\"", b"true"] {
             JsonObject::check(text).unwrap();
-            assert_eq!(JsonObject::parse(text).unwrap_err().0, "not a JSON object");
+            assert_eq!(
+                JsonObject::parse(text).unwrap_err(),
+                DecodeError::NotJsonObject
+            );
         }
     }
 }

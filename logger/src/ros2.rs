@@ -434,7 +434,10 @@ mod tests {
             assert!(decode::<Command>(&out[..cut]).is_err(), "{cut}");
         }
         out.extend([1; 8]);
-        assert!(decode::<Command>(&out).unwrap_err().0.contains("longer"));
+        assert!(matches!(
+            decode::<Command>(&out).unwrap_err(),
+            crate::DecodeError::LongerThanSchema { .. }
+        ));
         // A JointState's bytes are not a Timing.
         out.clear();
         encode(&JointState::default(), &mut out);

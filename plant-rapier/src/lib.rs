@@ -34,6 +34,7 @@
 mod config;
 pub mod effects;
 mod engine;
+mod engine_error;
 mod machine;
 pub mod node;
 mod plant;
@@ -50,6 +51,7 @@ pub use config::{
 };
 pub use effects::Effects;
 pub use engine::EngineName;
+pub use engine_error::EngineError;
 pub use machine::{PlantMachine, PlantMachineConfig};
 pub use plant::{
     ContactReading, MAX_SUBSTEPS_PER_SECOND, PeriodCost, Plant, StiffCause, check_contact,
@@ -126,9 +128,10 @@ pub enum PlantError {
         /// Substeps a simulated second needs.
         per_second: f64,
     },
-    /// Rapier did something this crate did not expect.
+    /// The engine did something this crate did not expect, or was asked
+    /// what it cannot do.
     #[error("physics engine: {0}")]
-    Engine(String),
+    Engine(#[from] EngineError),
     /// M(q) is singular at a joint: nothing it moves has inertia about its
     /// axis beyond what the joints before it account for.
     #[error(

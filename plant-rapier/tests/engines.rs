@@ -7,7 +7,7 @@
 mod common;
 
 use arm_model::dynamics::Dynamics;
-use plant_rapier::{ArmModel, EngineName, Plant, PlantConfig};
+use plant_rapier::{ArmModel, EngineError, EngineName, Plant, PlantConfig, PlantError};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -164,5 +164,24 @@ fn stiff_damping_stays_stable() {
     assert!(
         q.iter().chain(&qd).all(|x| x.is_finite() && x.abs() < 10.0),
         "{q:?} {qd:?}"
+    );
+}
+
+/// What one engine cannot do is refused as data: M(q) from Rapier, contact
+/// objects from the articulated engine.
+#[test]
+fn an_engine_refuses_what_it_cannot_do_as_data() {
+    let model = ArmModel::from_urdf_str(include_str!("../../robots/two_link.urdf")).unwrap();
+    let mut rapier = plant(&model, EngineName::Rapier, None);
+    assert_eq!(
+        rapier.inertia_and_bias().unwrap_err(),
+        PlantError::Engine(EngineError::NoJointSpaceDynamics)
+    );
+    let mut articulated = plant(&model, EngineName::Articulated, None);
+    assert_eq!(
+        articulated.hold_object(0, true).unwrap_err(),
+        PlantError::Engine(EngineError::NoContactObjects {
+            engine: "articulated"
+        })
     );
 }

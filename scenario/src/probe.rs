@@ -4,7 +4,7 @@
 //! it leads to.
 
 use nalgebra::{DMatrix, DVector};
-use plant_rapier::{ArmModel, EngineName, Plant, PlantConfig, PlantError};
+use plant_rapier::{ArmModel, EngineError, EngineName, Plant, PlantConfig, PlantError};
 
 /// M(q)⁻¹ and G(q) at one posture, in the controlled joints' coordinates
 /// (mimic couplings included, as the controller feels them).
@@ -64,16 +64,21 @@ impl Prober {
         let n = self.rest.len();
         self.plant.set_state(q, &self.rest)?;
         let (m, bias) = self.plant.inertia_and_bias()?;
-        let engine = |what: &str| PlantError::Engine(format!("probing M(q) at {q:?}: {what}"));
+        let engine = |what: &'static str| {
+            PlantError::from(EngineError::Probe {
+                q: q.to_vec(),
+                what,
+            })
+        };
         let m = DMatrix::from_row_slice(n, n, &m);
         let m = (&m + m.transpose()) * 0.5;
         let minv = m
             .clone()
             .cholesky()
             .map(|c| c.inverse())
-            .ok_or_else(|| engine("M(q) is not positive definite"))?;
+            .ok_or_else(|| engine("is not positive definite"))?;
         if minv.iter().any(|x| !x.is_finite()) {
-            return Err(engine("M(q)⁻¹ is not finite"));
+            return Err(engine("has an inverse that is not finite"));
         }
         // At rest the bias is G(q) alone.
         let gravity = DVector::from_vec(bias);

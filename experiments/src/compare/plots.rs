@@ -14,7 +14,7 @@ use analysis::plots::{COLORS, FAMILY, FONT, Line, Panel, PlotError, RED, categor
 /// Writes `compare_errors`, `compare_error_ratio` and `compare_bars` (PNG
 /// and SVG) into `dir`; returns how many figures.
 pub fn write_all(dir: &Path, c: &Comparison, plan: &Plan) -> Result<usize, PlotError> {
-    std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(dir).map_err(PlotError::folder(dir))?;
     let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
     errors(dir, c, plan)?;
     crate::compare::ratio_plot::write(dir, c, plan)?;
@@ -30,7 +30,7 @@ fn errors(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), PlotError> {
         .filter_map(|row| Some((row, row.runs.first()?.series.as_ref()?)))
         .collect();
     let Some((_, first)) = curves.first() else {
-        return Err(PlotError("no law kept its curves".into()));
+        return Err(PlotError::Empty("no law kept its curves"));
     };
     let names = plan.robot.model.joint_names();
     let neg_kc: Vec<Vec<f64>> = first
@@ -89,10 +89,10 @@ fn bars(dir: &Path, c: &Comparison) -> Result<(), PlotError> {
         &BitMapBackend::new(&png, (1000, 700)).into_drawing_area(),
         c,
     )
-    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
+    .map_err(PlotError::in_file(&png))?;
     let svg = dir.join("compare_bars.svg");
     draw_bars(&SVGBackend::new(&svg, (1000, 700)).into_drawing_area(), c)
-        .map_err(|e| PlotError(format!("{}: {e}", svg.display())))
+        .map_err(PlotError::in_file(&svg))
 }
 
 fn draw_bars<DB: DrawingBackend>(
@@ -230,7 +230,7 @@ pub fn write_tradeoff(
     t: &crate::compare::tradeoff::Tradeoff,
     scenario: &str,
 ) -> Result<usize, PlotError> {
-    std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(dir).map_err(PlotError::folder(dir))?;
     let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
     let png = dir.join("compare_tradeoff.png");
     draw_tradeoff(
@@ -238,14 +238,14 @@ pub fn write_tradeoff(
         t,
         scenario,
     )
-    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
+    .map_err(PlotError::in_file(&png))?;
     let svg = dir.join("compare_tradeoff.svg");
     draw_tradeoff(
         &SVGBackend::new(&svg, (1000, 750)).into_drawing_area(),
         t,
         scenario,
     )
-    .map_err(|e| PlotError(format!("{}: {e}", svg.display())))?;
+    .map_err(PlotError::in_file(&svg))?;
     Ok(1)
 }
 
@@ -296,7 +296,9 @@ fn tradeoff_panel<DB: DrawingBackend>(
     };
     let ok: Vec<(f64, f64)> = t.points.iter().filter_map(xy).collect();
     if ok.is_empty() {
-        return Err("no law has a finite, positive IAE and cost at any scale".into());
+        return Err(PlotError::Empty(
+            "no law has a finite, positive IAE and cost at any scale",
+        ));
     }
     let span = |v: Vec<f64>| {
         let lo = v.iter().copied().fold(f64::INFINITY, f64::min);

@@ -21,10 +21,10 @@ pub fn write(dir: &Path, c: &Comparison, plan: &Plan) -> Result<(), PlotError> {
         c,
         plan,
     )
-    .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
+    .map_err(PlotError::in_file(&png))?;
     let svg = dir.join("compare_error_ratio.svg");
     draw(&SVGBackend::new(&svg, (w, h)).into_drawing_area(), c, plan)
-        .map_err(|e| PlotError(format!("{}: {e}", svg.display())))
+        .map_err(PlotError::in_file(&svg))
 }
 
 /// Columns and rows of the grid for `n` panels.
@@ -84,7 +84,7 @@ fn draw<DB: DrawingBackend>(
         });
     // NaN-free: both come from finite times, or are the fold's ±∞.
     if t_lo >= t_hi {
-        return Err("no law's run reaches past T_c".into());
+        return Err(PlotError::Empty("no law's run reaches past T_c"));
     }
     // One scale for every panel: the largest finite ratio, clipped at 2
     // (a failed law past it is marked as failed), at least 1.1.

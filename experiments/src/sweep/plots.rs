@@ -21,16 +21,16 @@ macro_rules! both {
     ($dir:expr, $name:expr, $size:expr, $draw:expr) => {{
         let png = $dir.join(format!("{}.png", $name));
         ($draw)(&BitMapBackend::new(&png, $size).into_drawing_area())
-            .map_err(|e| PlotError(format!("{}: {e}", png.display())))?;
+            .map_err(PlotError::in_file(&png))?;
         let svg = $dir.join(format!("{}.svg", $name));
         ($draw)(&SVGBackend::new(&svg, $size).into_drawing_area())
-            .map_err(|e| PlotError(format!("{}: {e}", svg.display())))?;
+            .map_err(PlotError::in_file(&svg))?;
     }};
 }
 
 /// Writes `sweep_boxes` and, with two axes, `sweep_heatmap` (PNG and SVG).
 pub fn write_all(dir: &Path, r: &SweepReport) -> Result<usize, PlotError> {
-    std::fs::create_dir_all(dir).map_err(|e| PlotError(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(dir).map_err(PlotError::folder(dir))?;
     let _ = plotters::style::register_font(FAMILY, FontStyle::Normal, FONT);
     let h = 320 * BOXED.len() as u32 + 80;
     both!(dir, "sweep_boxes", (1100, h), |a| boxes(a, r));

@@ -4,7 +4,7 @@
 use rapier3d_f64::prelude::*;
 
 use super::shapes::pose;
-use crate::{PlantConfig, PlantError};
+use crate::{EngineError, PlantConfig, PlantError};
 use arm_model::{ArmModel, JointKind};
 
 /// Where one actuated joint lives inside the Rapier multibody.
@@ -65,13 +65,19 @@ fn locate(
 ) -> Result<(usize, usize, Pose), PlantError> {
     let link = joints
         .rigid_body_link(child)
-        .ok_or_else(|| PlantError::Engine(format!("joint '{name}' is not in the multibody")))?;
+        .ok_or_else(|| EngineError::JointNotInMultibody {
+            joint: name.to_owned(),
+        })?;
     let (mb, _) = joints
         .get(multibody)
-        .ok_or_else(|| PlantError::Engine("multibody vanished".into()))?;
+        .ok_or(EngineError::MultibodyVanished {
+            when: "while building",
+        })?;
     let l = mb
         .link(link.id)
-        .ok_or_else(|| PlantError::Engine(format!("no link for joint '{name}'")))?;
+        .ok_or_else(|| EngineError::NoLinkForJoint {
+            joint: name.to_owned(),
+        })?;
     Ok((link.id, l.assembly_id(), l.joint().data.local_frame1))
 }
 
@@ -91,7 +97,9 @@ pub(super) fn couple_mimics(
         let leader = &dofs[m.leader];
         let (mb, _) = joints
             .get_mut(multibody)
-            .ok_or_else(|| PlantError::Engine("multibody vanished".into()))?;
+            .ok_or(EngineError::MultibodyVanished {
+                when: "while building",
+            })?;
         mb.add_dof_coupling(MultibodyDofCoupling {
             link1: leader.link_id,
             dof1: 0,
@@ -146,7 +154,9 @@ pub(super) fn joint_dynamics(
 ) -> Result<(), PlantError> {
     let (mb, _) = joints
         .get_mut(multibody)
-        .ok_or_else(|| PlantError::Engine("multibody vanished".into()))?;
+        .ok_or(EngineError::MultibodyVanished {
+            when: "while building",
+        })?;
     let at = dofs
         .iter()
         .map(|d| d.assembly_id)
@@ -265,7 +275,9 @@ pub(super) fn insert_joints(
         let handle = world
             .multibody_joints
             .insert(handles[j.parent], handles[j.child], builder.build(), true)
-            .ok_or_else(|| PlantError::Engine(format!("Rapier refused joint '{}'", j.name)))?;
+            .ok_or_else(|| EngineError::JointRefused {
+                joint: j.name.clone(),
+            })?;
         multibody.get_or_insert(handle);
     }
     multibody.ok_or(PlantError::NoActuatedJoints)
@@ -280,7 +292,9 @@ pub(super) fn settle(
 ) -> Result<(), PlantError> {
     let (mb, _) = joints
         .get_mut(multibody)
-        .ok_or_else(|| PlantError::Engine("multibody vanished after insertion".into()))?;
+        .ok_or(EngineError::MultibodyVanished {
+            when: "after insertion",
+        })?;
     // The root is fixed: this drops the free root DOFs Rapier counts at first.
     mb.forward_kinematics(bodies, true);
     mb.update_rigid_bodies(bodies, true);

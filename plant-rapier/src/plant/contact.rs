@@ -7,7 +7,7 @@ use arm_model::ArmModel;
 use rapier3d_f64::prelude::*;
 
 use super::shapes::{pose, shape};
-use crate::{ContactConfig, PlantError};
+use crate::{ContactConfig, EngineError, PlantError};
 
 /// Arm colliders are in group 1, obstacles in group 2, free objects in 3:
 /// the arm meets obstacles and objects (it can push one); objects rest on
@@ -262,7 +262,7 @@ impl Contacts {
         i: usize,
         world: &PhysicsWorld,
     ) -> Result<(&Held, Pose, RigidBody), PlantError> {
-        let vanished = || PlantError::Engine(format!("object {i} or its link vanished"));
+        let vanished = || EngineError::ObjectVanished { index: i };
         let h = self.objects.get(i).ok_or_else(vanished)?;
         let c = world.colliders.get(h.collider).ok_or_else(vanished)?;
         let link = world.bodies.get(h.link).ok_or_else(vanished)?;

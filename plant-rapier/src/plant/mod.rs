@@ -2,7 +2,7 @@
 //! two engines ([`EngineName`]): its equations of motion in joint
 //! coordinates (the default), or Rapier's multibody pipeline.
 
-use crate::{EngineName, PlantConfig, PlantError};
+use crate::{EngineError, EngineName, PlantConfig, PlantError};
 use arm_model::ArmModel;
 
 mod articulated;
@@ -452,10 +452,7 @@ impl Plant {
         match &mut self.engine {
             Engine::Articulated(a) => a.inertia_and_bias(&mut m, &mut h)?,
             Engine::Rapier(_) => {
-                return Err(PlantError::Engine(
-                    "the Rapier engine does not give M(q) and h(q, q̇); use the articulated engine"
-                        .into(),
-                ));
+                return Err(EngineError::NoJointSpaceDynamics.into());
             }
         }
         Ok((m, h))
@@ -508,9 +505,10 @@ impl Plant {
     /// go (only a plant with contact has objects).
     pub fn hold_object(&mut self, i: usize, on: bool) -> Result<(), PlantError> {
         match &mut self.engine {
-            Engine::Articulated(_) => Err(PlantError::Engine(
-                "the articulated engine has no contact objects".into(),
-            )),
+            Engine::Articulated(_) => Err(EngineError::NoContactObjects {
+                engine: "articulated",
+            }
+            .into()),
             Engine::Rapier(r) => r.hold(i, on),
         }
     }
@@ -532,7 +530,7 @@ impl Plant {
         match &mut self.engine {
             Engine::Articulated(a) => match a.attach_point_mass(link, point, mass) {
                 true => Ok(()),
-                false => Err(PlantError::Engine(format!("no link with index {link}"))),
+                false => Err(EngineError::NoLink { link }.into()),
             },
             Engine::Rapier(r) => r.attach_point_mass(link, point, mass),
         }

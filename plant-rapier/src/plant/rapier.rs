@@ -10,7 +10,7 @@ use super::build::{
     Coupled, Dof, couple_mimics, dof_of, insert_bodies, insert_joints, joint_dynamics, settle,
 };
 use super::contact::{self, ContactReading, Contacts};
-use crate::{PlantConfig, PlantError};
+use crate::{EngineError, PlantConfig, PlantError};
 use arm_model::ArmModel;
 
 /// An arm simulated by Rapier in double precision.
@@ -63,10 +63,11 @@ impl RapierArm {
             .map(|(mb, _)| mb.ndofs())
             .unwrap_or(0);
         if ndofs != dofs.len() + coupled.len() {
-            return Err(PlantError::Engine(format!(
-                "the multibody has {ndofs} degrees of freedom but the URDF {} moving joints",
-                dofs.len() + coupled.len()
-            )));
+            return Err(EngineError::DofMismatch {
+                multibody: ndofs,
+                model: dofs.len() + coupled.len(),
+            }
+            .into());
         }
         let parts = (&dofs[..], &coupled[..]);
         joint_dynamics(
@@ -141,7 +142,10 @@ impl RapierArm {
             ..
         } = &mut self.world;
         let Some((mb, _)) = multibody_joints.get_mut(self.multibody) else {
-            return Err(PlantError::Engine("multibody vanished".into()));
+            return Err(EngineError::MultibodyVanished {
+                when: "while stepping",
+            }
+            .into());
         };
         let targets = self
             .dofs
@@ -208,7 +212,7 @@ impl RapierArm {
     /// lets it go.
     pub(crate) fn hold(&mut self, i: usize, on: bool) -> Result<(), PlantError> {
         let Some(c) = &self.contacts else {
-            return Err(PlantError::Engine("no contact objects".into()));
+            return Err(EngineError::NoContactObjects { engine: "Rapier" }.into());
         };
         match on {
             true => c.grasp(i, &mut self.world),
@@ -239,7 +243,7 @@ impl RapierArm {
         mass: f64,
     ) -> Result<(), PlantError> {
         let (Some(handle), Some(base)) = (self.bodies.get(link), self.link_mprops.get(link)) else {
-            return Err(PlantError::Engine(format!("no link with index {link}")));
+            return Err(EngineError::NoLink { link }.into());
         };
         let payload = MassProperties::new(
             Vector::new(point[0], point[1], point[2]),
@@ -251,7 +255,7 @@ impl RapierArm {
             .world
             .bodies
             .get_mut(*handle)
-            .ok_or_else(|| PlantError::Engine(format!("link {link} has no body")))?;
+            .ok_or(EngineError::LinkWithoutBody { link })?;
         body.set_additional_mass_properties(total, true);
         Ok(())
     }
