@@ -58,7 +58,10 @@ pub fn gaps(contents: &LogContents, counts: &HashMap<String, u64>, own: bool) ->
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use std::collections::BTreeMap;
 
     use super::*;

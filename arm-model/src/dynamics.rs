@@ -267,7 +267,10 @@ impl Dynamics {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
     use crate::TWO_LINK_URDF;
 

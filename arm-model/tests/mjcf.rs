@@ -2,7 +2,12 @@
 //! what is said (issue #47). The dynamics against MuJoCo are in mujoco.rs.
 
 // The helpers outside #[test] fail the test on bad input too.
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use std::path::{Path, PathBuf};
 

@@ -5,7 +5,12 @@
 //! (once); the test fails, saying why, when it cannot be made.
 
 // The helpers outside #[test] fail the test on bad input too.
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

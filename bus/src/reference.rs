@@ -91,7 +91,10 @@ fn pick(recent: &mut VecDeque<ReferenceSample>, t_ns: u64) -> Option<ReferenceSa
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     fn sample(t_ns: u64) -> ReferenceSample {

@@ -455,7 +455,10 @@ impl<T: Debug + ZeroCopySend + MessageFields + 'static> TopicSubscriber<T> {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
     use wire::Timing;
 

@@ -92,7 +92,10 @@ impl std::fmt::Display for Gain {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// A value of neither form says what a gain is, not serde's "no
@@ -101,7 +104,7 @@ mod tests {
     fn a_value_of_neither_form_says_what_a_gain_is() {
         #[derive(Debug, serde::Deserialize)]
         struct T {
-            #[allow(dead_code)]
+            #[allow(dead_code, reason = "only its parse error is read")]
             k: Gain,
         }
         let e = toml::from_str::<T>("k = \"[1,\"").unwrap_err().to_string();

@@ -1,4 +1,7 @@
-#![allow(clippy::unwrap_used)]
+#![allow(
+    clippy::unwrap_used,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 use super::*;
 
 fn input<'a>(

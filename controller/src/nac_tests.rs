@@ -1,7 +1,9 @@
 //! Unit tests of one control step against values worked out by hand.
 
-// The expected values are quoted from 40-digit decimal arithmetic.
-#![allow(clippy::excessive_precision)]
+#![allow(
+    clippy::excessive_precision,
+    reason = "the expected values are quoted from 40-digit decimal arithmetic"
+)]
 
 use super::*;
 use crate::{LawName, RbfLayout};

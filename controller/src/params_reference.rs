@@ -70,7 +70,11 @@ fn prose(doc: &str) -> String {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    #![allow(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// The shipped page equals what the declaration gives (write it with

@@ -1,6 +1,9 @@
 //! The funnel law on steps worked out by hand.
 
-#![allow(clippy::unwrap_used)]
+#![allow(
+    clippy::unwrap_used,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use super::*;
 use crate::LawName;

@@ -4,7 +4,10 @@
 //! bounded filter by a projection computed another way, and both laws'
 //! torques against the effort limits.
 
-#![allow(clippy::unwrap_used)]
+#![allow(
+    clippy::unwrap_used,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use super::*;
 use crate::LawName;

@@ -5,7 +5,12 @@
 //! `cargo bench -p experiments --bench compare` (each sample is a whole
 //! comparison of 8 laws × 20 s, about 4 s on two cores, or a whole sweep).
 
-#![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    missing_docs,
+    reason = "bench code: a broken expectation should fail loudly"
+)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use experiments::compare::{CompareOptions, DEFAULT_LAWS, compare};

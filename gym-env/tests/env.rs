@@ -2,7 +2,12 @@
 //! reward, ends, options, vector form and picture.
 
 // Reason: a test's helpers stop it with a message, as the tests do.
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use gym_env::{ActionMode, ArmEnv, ArmEnvs, ERROR_CAP, EnvError, EnvOptions, Outcome};
 use scenario::{Overrides, Plan};

@@ -3,7 +3,12 @@
 //! one with the reset steps taken out.
 
 // Reason: a test's helpers stop it with a message, as the tests do.
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use std::path::Path;
 

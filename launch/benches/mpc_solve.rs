@@ -12,7 +12,12 @@
 //! proving that.
 //! `cargo bench -p launch --bench mpc_solve [-- STEPS]`.
 
-#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
+#![allow(
+    missing_docs,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "bench code: a broken expectation should fail loudly"
+)]
 
 use std::time::Instant;
 

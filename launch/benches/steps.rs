@@ -3,7 +3,12 @@
 //! states, with the default plant settings.
 //! `cargo bench -p launch --bench steps`.
 
-#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
+#![allow(
+    missing_docs,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "bench code: a broken expectation should fail loudly"
+)]
 
 use controller::{Controller, ControllerInput, ControllerParams};
 use criterion::{Criterion, criterion_group, criterion_main};

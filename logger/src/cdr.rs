@@ -253,7 +253,10 @@ impl<'a> CdrReader<'a> {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// The bytes ROS 2 writes for `std_msgs/Header{stamp: 1.5 s, frame_id:

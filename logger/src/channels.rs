@@ -112,7 +112,11 @@ pub fn python_schemas_module() -> String {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used, clippy::expect_used)]
+    #![allow(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// The committed Python module equals what this build writes (write it

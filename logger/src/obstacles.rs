@@ -166,7 +166,10 @@ const CYLINDER: i32 = 3;
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
     use crate::scene::ArmScene;
 

@@ -271,7 +271,10 @@ impl OtherJoint {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// #39 row 14: `/joint_states` lists the joints that are not

@@ -482,7 +482,10 @@ fn deliver(
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// Every input the fuzzer found a crash with (fuzz/regressions/log) is

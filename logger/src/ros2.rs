@@ -369,7 +369,10 @@ pub fn marker_array(out: &mut Vec<u8>, t_ns: u64, markers: &[Marker]) {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
     use crate::cdr_decode::decode;
     use wire::{Command, ControllerDiagnostics, JointState, Timing};

@@ -190,7 +190,10 @@ fn color(link: usize) -> [f32; 4] {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// The elbow's frame sits at the end of link 1 (0.35 m along it), and
@@ -226,7 +229,10 @@ mod tests {
 
 #[cfg(test)]
 mod tree_tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     fn attribute_values(urdf: &str, tag: &str) -> Vec<String> {

@@ -321,7 +321,10 @@ fn open_new(path: &Path) -> std::io::Result<File> {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// #39 row 3: an existing log is never opened for writing.

@@ -2,7 +2,12 @@
 //! generator's output for the paper's arm, and every series and 3D topic it
 //! names is a channel the testbed publishes, with that field in its schema.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use std::path::Path;
 

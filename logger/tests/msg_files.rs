@@ -4,7 +4,12 @@
 //! wire's list of logged messages. `TESTBED_WRITE_MSG=1 cargo test -p
 //! logger --test msg_files` rewrites them after a message changes.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use std::path::Path;
 

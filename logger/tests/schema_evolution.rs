@@ -4,7 +4,11 @@
 //! added reads with the field at the value its declaration gives older logs,
 //! a field since dropped is read past, and a required field a log lacks is
 //! named, without a new log format.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use logger::cdr::CdrWriter;
 use logger::cdr_decode;

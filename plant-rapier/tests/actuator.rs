@@ -3,7 +3,12 @@
 //! series-elastic joint, backlash and cogging — and the errors a setting
 //! missing its partner gives.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use plant_rapier::{
     ActuatorConfig, ArmModel, Effects, EngineName, Harmonic, PerJoint, PlantConfig, PlantError, Rig,

@@ -5,7 +5,12 @@
 //! points and a force that balances the torque; the articulated engine
 //! refuses contact by name.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use plant_rapier::{
     ArmModel, ContactConfig, ContactObject, Effects, EngineName, Obstacle, PayloadConfig,

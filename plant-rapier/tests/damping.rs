@@ -2,7 +2,12 @@
 //! integrates it exactly (ETDRK4), so one step per period is stable and
 //! accurate where explicit RK4 needed a thousand.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use plant_rapier::{ArmModel, EngineName, PerJoint, Plant, PlantConfig};
 

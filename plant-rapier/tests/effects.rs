@@ -1,7 +1,12 @@
 //! Each effect of a scenario's `[plant]` changes the arm as it should,
 //! checked against the closed form of SPEC §1 where there is one.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 mod common;
 

@@ -2,7 +2,12 @@
 //! with what the URDF says on (damping, mimic joints; dry friction in a
 //! test of its own): the two are written independently, so agreement checks both.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 mod common;
 

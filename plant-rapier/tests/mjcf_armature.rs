@@ -3,7 +3,12 @@
 //! dynamics, which add each joint's armature), and the scenario's
 //! `[plant] armature` comes on top.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use plant_rapier::{ArmModel, PerJoint, Plant, PlantConfig};
 

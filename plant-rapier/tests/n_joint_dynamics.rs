@@ -4,7 +4,12 @@
 //! model-based controller laws use that same code, so this test checks
 //! their model too.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 mod common;
 

@@ -1,6 +1,11 @@
 //! The Rapier plant against the closed form of SPEC §1.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 mod common;
 

@@ -99,7 +99,10 @@ fn differs(a: &Value, b: &Value, n: usize) -> bool {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
     use std::path::Path;
 

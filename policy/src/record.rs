@@ -176,7 +176,10 @@ impl EnvRecord {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     const GOOD: &str = r#"{"dof": 2, "obs_dim": 15, "steps": 4000, "torque_scale": [50.0, 25.0],

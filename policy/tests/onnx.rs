@@ -2,7 +2,12 @@
 //! (`tests/fixtures/make.py`, `testbed.onnx_export`): loading, the
 //! record, refusals by file and field, and the network's numbers.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use std::path::{Path, PathBuf};
 

@@ -584,7 +584,10 @@ fn stiffness_warning(plan: &Plan) -> Result<Option<String>, ScenarioError> {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     fn overrides(law: Option<&str>, set: &[&str]) -> Overrides {

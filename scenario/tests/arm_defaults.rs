@@ -2,7 +2,12 @@
 //! ones do not cover: gains stable along the whole reference, a mobile
 //! base swung within its effort, URDF friction no motor overcomes.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use plant_rapier::ArmModel;
 use scenario::{ArmDefault, Prober};

@@ -1,6 +1,11 @@
 //! System tests: the `testbed` binary as a user runs it.
 
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 mod compare;
 mod false_success;

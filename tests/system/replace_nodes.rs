@@ -13,7 +13,10 @@ use crate::util::{testbed, wait_bounded};
 /// and returns the child and that command's arguments (the caller waits
 /// for the child; a panic here fails the test, and the run's node exits
 /// when its launcher does).
-#[allow(clippy::zombie_processes)]
+#[allow(
+    clippy::zombie_processes,
+    reason = "the caller waits for the child it is handed"
+)]
 fn start_with_external(args: &[&str], node: &str) -> (std::process::Child, Vec<String>) {
     let mut child = testbed()
         .args(args)

@@ -224,7 +224,10 @@ macro_rules! field_decode {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
     use crate::{ControllerDiagnostics, JointState, MAX_DOF, Timing};
 

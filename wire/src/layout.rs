@@ -178,8 +178,11 @@ mod tests {
                 .all(|n| n.is_empty() || n.starts_with("testbed."))
         );
         // The derive and the layout read the same literal.
-        #[allow(unsafe_code)]
         // SAFETY: type_name only returns a static string.
+        #[allow(
+            unsafe_code,
+            reason = "iceoryx2's type_name is unsafe to call; it is what the test checks"
+        )]
         let derived = unsafe { <crate::Command as iceoryx2::prelude::ZeroCopySend>::type_name() };
         assert_eq!(derived, <crate::Command as WireLayout>::TYPE_NAME);
     }

@@ -1,7 +1,10 @@
 //! The loader on small URDFs written inline: reading and the tree here;
 //! mass properties and mimics/locks in their own files.
 
-#![allow(clippy::unwrap_used)]
+#![allow(
+    clippy::unwrap_used,
+    reason = "test code: a broken expectation should fail loudly"
+)]
 
 use super::*;
 

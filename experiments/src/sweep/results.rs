@@ -217,7 +217,10 @@ fn io(path: &Path, cause: std::io::Error) -> SweepError {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// #39 row 16: the final check (made after the last line, where no

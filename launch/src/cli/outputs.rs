@@ -48,7 +48,10 @@ pub(crate) fn files_in(dir: &Path) -> Vec<PathBuf> {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     #[test]

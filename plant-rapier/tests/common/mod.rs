@@ -1,7 +1,10 @@
 //! The paper's two-link arm in closed form (SPEC §1) and an RK4 integrator,
 //! written independently of Rapier to check the plant against.
 
-#![allow(dead_code)]
+#![allow(
+    dead_code,
+    reason = "shared by several test binaries; each uses only some of it"
+)]
 
 pub const M1: f64 = 2.0;
 pub const M2: f64 = 0.85;

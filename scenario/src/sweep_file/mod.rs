@@ -488,7 +488,10 @@ pub struct ManifestRun {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// `load` of a sweep file with `text`; the error's text.
@@ -565,7 +568,10 @@ mod tests {
 
 #[cfg(test)]
 mod later_values {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
 
     /// #31 row 20: a bad value that is not an axis's first is named at the
     /// user's file and key, not at a line of a generated scenario.

@@ -558,7 +558,10 @@ fn mass_structure(tree: &Tree, follow: &[Follow], n: usize) -> Cholesky {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used)]
+    #![allow(
+        clippy::unwrap_used,
+        reason = "test code: a broken expectation should fail loudly"
+    )]
     use super::*;
 
     /// A torque past any the state can hold: q̈ overflows within a substep.
