@@ -11,7 +11,7 @@ use std::time::{Duration, SystemTime};
 
 use iceoryx2::prelude::*;
 
-use crate::topics::{RunPrefix, WireError};
+use crate::topics::{BusError, RunPrefix};
 
 /// A domain whose segment is younger than this may belong to a run that is
 /// still starting up (its first node not yet registered), so it is left alone.
@@ -28,7 +28,7 @@ pub struct DomainNodes {
 
 impl RunPrefix {
     /// Removes the leftovers of dead nodes in this domain and counts the live ones.
-    pub fn clean_dead_nodes(&self) -> Result<DomainNodes, WireError> {
+    pub fn clean_dead_nodes(&self) -> Result<DomainNodes, BusError> {
         let config = self.config()?;
         let mut nodes = DomainNodes::default();
         Node::<ipc::Service>::list(&config, |state| {
@@ -44,7 +44,7 @@ impl RunPrefix {
             }
             CallbackProgression::Continue
         })
-        .map_err(|e| WireError::Ipc {
+        .map_err(|e| BusError::Ipc {
             what: "list nodes",
             topic: self.as_str().to_string(),
             cause: format!("{e:?}"),
@@ -54,7 +54,7 @@ impl RunPrefix {
 
     /// Removes this domain from shared memory if no node of it is alive.
     /// Returns true if it was removed.
-    pub fn remove_domain_if_unused(&self) -> Result<bool, WireError> {
+    pub fn remove_domain_if_unused(&self) -> Result<bool, BusError> {
         if self.clean_dead_nodes()?.alive > 0 {
             return Ok(false);
         }
@@ -69,7 +69,7 @@ impl RunPrefix {
         )]
         let removed =
             unsafe { iceoryx2::testing::remove_global_mgmt_segment::<ipc::Service>(&config) };
-        removed.map_err(|e| WireError::Ipc {
+        removed.map_err(|e| BusError::Ipc {
             what: "remove domain",
             topic: self.as_str().to_string(),
             cause: format!("{e:?}"),

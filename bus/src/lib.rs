@@ -25,7 +25,7 @@ pub use connections::{CONNECTION_FAILED, connection_failures};
 pub use domain::DomainNodes;
 pub use node::{NodeError, NodeLink};
 pub use reference::ReferenceWindow;
-pub use topics::{Bus, RunPrefix, TopicPublisher, TopicSubscriber, WireError, monotonic_ns};
+pub use topics::{Bus, BusError, RunPrefix, TopicPublisher, TopicSubscriber, monotonic_ns};
 
 /// iceoryx2's own messages on stderr: only its errors unless `verbose`
 /// (then its information too). `IOX2_LOG_LEVEL` in the environment still

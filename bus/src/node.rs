@@ -7,7 +7,7 @@
 use std::time::Duration;
 
 use crate::{
-    Bus, CONNECTION_FAILED, RunPrefix, TopicPublisher, TopicSubscriber, WireError, monotonic_ns,
+    Bus, BusError, CONNECTION_FAILED, RunPrefix, TopicPublisher, TopicSubscriber, monotonic_ns,
 };
 use wire::{
     CONTROL_START, CONTROL_STOP, Control, Delivery, HEARTBEAT, Header, Mode, NODE_DONE,
@@ -19,7 +19,7 @@ use wire::{
 pub enum NodeError {
     /// The bus failed.
     #[error(transparent)]
-    Wire(#[from] WireError),
+    Wire(#[from] BusError),
     /// The launcher is gone.
     #[error("the launcher (pid {0}) is gone")]
     ParentGone(u32),
@@ -58,7 +58,7 @@ impl NodeLink {
         prefix: &RunPrefix,
         parent_pid: Option<u32>,
         mode: Mode,
-    ) -> Result<Self, WireError> {
+    ) -> Result<Self, BusError> {
         let bus = Bus::new(prefix, kind.name())?;
         let status = bus.publisher(Delivery::DropWhenFull)?;
         let control = bus.subscriber()?;

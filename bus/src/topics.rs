@@ -24,7 +24,7 @@ use wire::{
 
 /// Why a bus operation failed.
 #[derive(Debug, thiserror::Error)]
-pub enum WireError {
+pub enum BusError {
     /// The prefix is not a valid file-name fragment.
     #[error("invalid run prefix '{0}': use letters, digits, '_' or '-' (at most 40)")]
     BadPrefix(String),
@@ -43,9 +43,9 @@ pub enum WireError {
     Terminated,
 }
 
-fn ipc(what: &'static str, topic: impl Into<String>) -> impl FnOnce(String) -> WireError {
+fn ipc(what: &'static str, topic: impl Into<String>) -> impl FnOnce(String) -> BusError {
     let topic = topic.into();
-    move |cause| WireError::Ipc { what, topic, cause }
+    move |cause| BusError::Ipc { what, topic, cause }
 }
 
 /// The prefix that keeps one run's shared memory apart from every other's.
@@ -77,7 +77,7 @@ impl RunPrefix {
     }
 
     /// Checks a prefix given on a command line.
-    pub fn parse(s: &str) -> Result<Self, WireError> {
+    pub fn parse(s: &str) -> Result<Self, BusError> {
         let ok = !s.is_empty()
             && s.len() <= 40
             && s.chars()
@@ -85,7 +85,7 @@ impl RunPrefix {
         if ok {
             Ok(Self(s.to_string()))
         } else {
-            Err(WireError::BadPrefix(s.to_string()))
+            Err(BusError::BadPrefix(s.to_string()))
         }
     }
 
@@ -119,7 +119,7 @@ impl RunPrefix {
     }
 
     /// The iceoryx2 configuration for this run.
-    pub fn config(&self) -> Result<Config, WireError> {
+    pub fn config(&self) -> Result<Config, BusError> {
         let mut config = Config::default();
         config.global.prefix = FileName::new(self.0.as_bytes())
             .map_err(|e| ipc("prefix", self.0.clone())(format!("{e:?}")))?;
@@ -192,7 +192,7 @@ fn terminated() -> &'static AtomicBool {
 
 impl Bus {
     /// Creates this process's node; `name` appears in iceoryx2's node list.
-    pub fn new(prefix: &RunPrefix, name: &str) -> Result<Self, WireError> {
+    pub fn new(prefix: &RunPrefix, name: &str) -> Result<Self, BusError> {
         let config = prefix.config()?;
         let node_name =
             NodeName::new(name).map_err(|e| ipc("node name", name)(format!("{e:?}")))?;
@@ -210,18 +210,18 @@ impl Bus {
     }
 
     /// Sleeps up to `timeout`; `Err(Terminated)` once SIGINT or SIGTERM arrived.
-    pub fn wait(&self, timeout: Duration) -> Result<(), WireError> {
+    pub fn wait(&self, timeout: Duration) -> Result<(), BusError> {
         if terminated().load(Ordering::Relaxed) {
-            return Err(WireError::Terminated);
+            return Err(BusError::Terminated);
         }
         match self.node.wait(timeout) {
             Ok(()) => Ok(()),
-            Err(NodeWaitFailure::TerminationRequest) => Err(WireError::Terminated),
+            Err(NodeWaitFailure::TerminationRequest) => Err(BusError::Terminated),
             // A signal cut the sleep short: Ctrl-C shows as a termination
             // request on a second, zero wait; anything else (SIGCONT after
             // Ctrl-Z and `fg`, a paused VM) is only an early wake-up.
             Err(NodeWaitFailure::Interrupt) => match self.node.wait(Duration::ZERO) {
-                Err(NodeWaitFailure::TerminationRequest) => Err(WireError::Terminated),
+                Err(NodeWaitFailure::TerminationRequest) => Err(BusError::Terminated),
                 _ => Ok(()),
             },
         }
@@ -232,7 +232,7 @@ impl Bus {
         topic: Topic,
     ) -> Result<
         iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>,
-        WireError,
+        BusError,
     > {
         let name: ServiceName = topic
             .name()
@@ -256,7 +256,7 @@ impl Bus {
     fn event(
         &self,
         topic: Topic,
-    ) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, WireError> {
+    ) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, BusError> {
         let name: ServiceName = topic
             .name()
             .try_into()
@@ -276,7 +276,7 @@ impl Bus {
     pub fn publisher<T: Debug + ZeroCopySend + Bound + 'static>(
         &self,
         delivery: Delivery,
-    ) -> Result<TopicPublisher<T>, WireError> {
+    ) -> Result<TopicPublisher<T>, BusError> {
         let topic = T::TOPIC;
         let service = self.service::<T>(topic)?;
         let builder = service
@@ -322,14 +322,14 @@ impl Bus {
     /// wake-ups ([`Topic::has_waiters`]).
     pub fn subscriber<T: Debug + ZeroCopySend + Bound + 'static>(
         &self,
-    ) -> Result<TopicSubscriber<T>, WireError> {
+    ) -> Result<TopicSubscriber<T>, BusError> {
         self.subscriber_with(T::TOPIC, T::TOPIC.has_waiters())
     }
 
     /// A subscriber read by polling: no listener, so publishers do not wake it.
     pub fn polling_subscriber<T: Debug + ZeroCopySend + Bound + 'static>(
         &self,
-    ) -> Result<TopicSubscriber<T>, WireError> {
+    ) -> Result<TopicSubscriber<T>, BusError> {
         self.subscriber_with(T::TOPIC, false)
     }
 
@@ -337,7 +337,7 @@ impl Bus {
         &self,
         topic: Topic,
         listen: bool,
-    ) -> Result<TopicSubscriber<T>, WireError> {
+    ) -> Result<TopicSubscriber<T>, BusError> {
         let service = self.service::<T>(topic)?;
         let subscriber = service
             .subscriber_builder()
@@ -367,7 +367,7 @@ impl Bus {
 impl<T: Debug + ZeroCopySend + MessageFields + 'static> TopicPublisher<T> {
     /// Publishes `value` and wakes the listeners. Returns how many
     /// subscribers received it.
-    pub fn send(&self, value: T) -> Result<usize, WireError> {
+    pub fn send(&self, value: T) -> Result<usize, BusError> {
         let mut attempt = 1;
         let delivered = loop {
             let sample = self
@@ -406,7 +406,7 @@ impl<T: Debug + ZeroCopySend + MessageFields + 'static> TopicPublisher<T> {
 impl<T: Debug + ZeroCopySend + MessageFields + 'static> TopicSubscriber<T> {
     /// The next buffered sample, if any; a copy of the sample before it
     /// (same header: a send that was interrupted and made again) is dropped.
-    pub fn receive(&self) -> Result<Option<T>, WireError> {
+    pub fn receive(&self) -> Result<Option<T>, BusError> {
         loop {
             match self.subscriber.receive() {
                 Ok(Some(sample)) => {
@@ -422,7 +422,7 @@ impl<T: Debug + ZeroCopySend + MessageFields + 'static> TopicSubscriber<T> {
     }
 
     /// Consumes pending wake-ups (a WaitSet spins until they are drained).
-    pub fn drain_events(&self) -> Result<(), WireError> {
+    pub fn drain_events(&self) -> Result<(), BusError> {
         match &self.listener {
             Some(l) => l
                 .try_wait(|_| {})
@@ -434,7 +434,7 @@ impl<T: Debug + ZeroCopySend + MessageFields + 'static> TopicSubscriber<T> {
 
     /// Blocks until a wake-up arrives or `timeout` passes; true if one
     /// arrived. A polling subscriber has no wake-ups: it sleeps for `timeout`.
-    pub fn wait_event(&self, timeout: Duration) -> Result<bool, WireError> {
+    pub fn wait_event(&self, timeout: Duration) -> Result<bool, BusError> {
         match &self.listener {
             Some(l) => {
                 let mut woken = false;

@@ -97,8 +97,8 @@ pub enum ControllerNodeError {
     Controller(#[from] ControllerError),
 }
 
-impl From<bus::WireError> for ControllerNodeError {
-    fn from(e: bus::WireError) -> Self {
+impl From<bus::BusError> for ControllerNodeError {
+    fn from(e: bus::BusError) -> Self {
         Self::Node(e.into())
     }
 }

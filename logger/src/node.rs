@@ -61,8 +61,8 @@ pub enum LoggerNodeError {
     Live(#[from] LiveError),
 }
 
-impl From<bus::WireError> for LoggerNodeError {
-    fn from(e: bus::WireError) -> Self {
+impl From<bus::BusError> for LoggerNodeError {
+    fn from(e: bus::BusError) -> Self {
         Self::Node(e.into())
     }
 }

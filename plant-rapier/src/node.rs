@@ -69,8 +69,8 @@ pub enum PlantNodeError {
     },
 }
 
-impl From<bus::WireError> for PlantNodeError {
-    fn from(e: bus::WireError) -> Self {
+impl From<bus::BusError> for PlantNodeError {
+    fn from(e: bus::BusError) -> Self {
         Self::Node(e.into())
     }
 }
@@ -151,8 +151,8 @@ impl From<NodeError> for LoopError {
     }
 }
 
-impl From<bus::WireError> for LoopError {
-    fn from(e: bus::WireError) -> Self {
+impl From<bus::BusError> for LoopError {
+    fn from(e: bus::BusError) -> Self {
         LoopError::Node(e.into())
     }
 }

@@ -74,8 +74,8 @@ pub enum TrajectoryNodeError {
     Trajectory(#[from] TrajectoryError),
 }
 
-impl From<bus::WireError> for TrajectoryNodeError {
-    fn from(e: bus::WireError) -> Self {
+impl From<bus::BusError> for TrajectoryNodeError {
+    fn from(e: bus::BusError) -> Self {
         Self::Node(e.into())
     }
 }

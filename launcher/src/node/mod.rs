@@ -43,7 +43,7 @@ pub enum NodeRunError {
     Config(#[from] bus::ConfigError),
     /// The bus could not be joined.
     #[error(transparent)]
-    Wire(#[from] bus::WireError),
+    Wire(#[from] bus::BusError),
     /// The plant node failed.
     #[error(transparent)]
     Plant(#[from] plant_rapier::node::PlantNodeError),

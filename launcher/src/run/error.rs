@@ -1,6 +1,6 @@
 //! Why a run failed, and how the log records each failure.
 
-use bus::WireError;
+use bus::BusError;
 use wire::{MAX_DOF, NodeKind, RunEnd};
 
 use analysis::analyse::AnalysisError;
@@ -10,7 +10,7 @@ use analysis::analyse::AnalysisError;
 pub enum RunError {
     /// The bus failed.
     #[error(transparent)]
-    Wire(#[from] WireError),
+    Wire(#[from] BusError),
     /// A file could not be written.
     #[error("{0}: {1}")]
     Output(String, std::io::Error),

@@ -5,7 +5,7 @@
 
 use std::time::{Duration, Instant};
 
-use bus::{Bus, WireError, monotonic_ns};
+use bus::{Bus, BusError, monotonic_ns};
 use wire::{CONTROL_START, Control, NodeKind, NodeStatus};
 
 use super::nodes::NodeStates;
@@ -148,7 +148,7 @@ fn wait_for_ready(
 /// Sleeps one tick; a SIGINT or SIGTERM turns into `Interrupted`.
 fn tick(bus: &Bus) -> Result<(), RunError> {
     bus.wait(TICK).map_err(|e| match e {
-        WireError::Terminated => RunError::Interrupted,
+        BusError::Terminated => RunError::Interrupted,
         other => RunError::Wire(other),
     })
 }
