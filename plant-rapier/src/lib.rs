@@ -28,7 +28,7 @@
 //! friction are the URDF's `<dynamics>` (or zero with `urdf_dynamics =
 //! false`), armature is the scenario's: nothing of Rapier's defaults.
 //!
-//! Limitations: inertia only, no contact (links have no colliders);
+//! Limitations: contact (`[plant.contact]`) only on the Rapier engine;
 //! floating, planar and spherical joints and closed loops are refused.
 
 mod config;
