@@ -11,6 +11,7 @@ use scenario::Plan;
 
 pub mod external;
 pub mod findings;
+mod paired;
 pub mod plots;
 pub mod ratio_plot;
 pub mod runs;
