@@ -12,6 +12,16 @@ use super::options::{load, reset_options};
 use super::{check_finite, picture};
 use crate::convert::{array, err, read_into};
 
+/// A step's return, Gymnasium's: observation, reward, terminated,
+/// truncated, `{"cost": c}`.
+type StepReturn<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    f64,
+    bool,
+    bool,
+    Bound<'py, PyDict>,
+);
+
 /// One arm's episodes (see `testbed.ArmTrackingEnv` for the contract).
 #[pyclass(module = "testbed")]
 pub struct EnvCore {
@@ -55,18 +65,11 @@ impl EnvCore {
     }
 
     /// One step: `(obs, reward, terminated, truncated, {"cost": c})`.
-    #[allow(clippy::type_complexity)] // Reason: the tuple is Gymnasium's step return.
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         action: &Bound<'py, PyAny>,
-    ) -> PyResult<(
-        Bound<'py, PyArray1<f64>>,
-        f64,
-        bool,
-        bool,
-        Bound<'py, PyDict>,
-    )> {
+    ) -> PyResult<StepReturn<'py>> {
         if self.ended {
             return Err(PyRuntimeError::new_err(
                 "step() after the episode ended: call reset() first",

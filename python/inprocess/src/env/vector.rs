@@ -14,6 +14,26 @@ use super::options::{load, take, vec_reset_options};
 use super::{check_finite, picture};
 use crate::convert::{array, err};
 
+/// A vector step's return, Gymnasium's: observations, rewards,
+/// terminated, truncated, costs.
+type StepReturn<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<f64>>,
+);
+
+/// [`StepReturn`] and the ended episodes' last observations.
+type SameStepReturn<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray2<f64>>,
+);
+
 /// Many arms stepped in one call (see `testbed.ArmTrackingVecEnv`).
 #[pyclass(module = "testbed")]
 pub struct VecEnvCore {
@@ -88,18 +108,11 @@ impl VecEnvCore {
     /// One step of every arm: `(obs, rewards, terminated, truncated,
     /// costs)`, arrays of one row per arm; an arm whose episode ended
     /// resets on the next step (Gymnasium's NEXT_STEP).
-    #[allow(clippy::type_complexity)] // Reason: the tuple is Gymnasium's step return.
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         actions: &Bound<'py, PyAny>,
-    ) -> PyResult<(
-        Bound<'py, PyArray2<f64>>,
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<f64>>,
-    )> {
+    ) -> PyResult<StepReturn<'py>> {
         self.step_in(py, actions, Autoreset::NextStep)?;
         self.outcomes(py)
     }
@@ -109,19 +122,11 @@ impl VecEnvCore {
     /// terminated, truncated, costs, final_obs)`, `final_obs` the ended
     /// episodes' last observations (rows of arms that did not end: as
     /// they were).
-    #[allow(clippy::type_complexity)] // Reason: the tuple is the step return and the final rows.
     fn step_same<'py>(
         &mut self,
         py: Python<'py>,
         actions: &Bound<'py, PyAny>,
-    ) -> PyResult<(
-        Bound<'py, PyArray2<f64>>,
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray2<f64>>,
-    )> {
+    ) -> PyResult<SameStepReturn<'py>> {
         self.step_in(py, actions, Autoreset::SameStep)?;
         let (obs, r, term, trunc, cost) = self.outcomes(py)?;
         let fin = PyArray1::from_slice(py, &self.final_obs)
@@ -255,17 +260,7 @@ impl VecEnvCore {
             .map_err(err)
     }
 
-    #[allow(clippy::type_complexity)] // Reason: the tuple is Gymnasium's step return.
-    fn outcomes<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(
-        Bound<'py, PyArray2<f64>>,
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<f64>>,
-    )> {
+    fn outcomes<'py>(&self, py: Python<'py>) -> PyResult<StepReturn<'py>> {
         let pick = |f: fn(&Outcome) -> f64| -> Vec<f64> { self.out.iter().map(f).collect() };
         let flag = |f: fn(&Outcome) -> bool| -> Vec<bool> { self.out.iter().map(f).collect() };
         Ok((
