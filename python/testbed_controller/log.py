@@ -12,7 +12,13 @@
 Built on the official readers: `mcap` for the file and `mcap-ros2-support`
 for the messages (CDR with `ros2msg` schemas, log format 3), so every field
 is decoded by the same code ROS 2 tools use; nothing here knows the
-testbed's message layouts.
+testbed's message layouts beyond checking each channel's stored schema
+against the ones this build writes (`log_schemas.py`) before a message is
+decoded, as the Rust reader checks its own: a schema over 64 KiB, a
+testbed message whose field types differ from this build's (a uint64 where
+it writes a uint32), or that has no header, or that defines types beyond
+the header's, and any other schema that is not this build's text, are
+refused with a ValueError naming the file, the topic and the field.
 
 Each table has a row per message, in log order: `log_time_ns`; `t_ns` and
 `t` (seconds) from `header.stamp` when the message has one; every numeric
@@ -29,7 +35,17 @@ from typing import Dict, Iterable, List, Optional
 
 import numpy as np
 
+from .log_schemas import SCHEMAS
+
 __all__ = ["Log", "read_log", "to_dataframe"]
+
+#: The largest stored schema read (this build's largest is under 3 KiB).
+MAX_SCHEMA_BYTES = 64 * 1024
+#: Most fields a testbed message's schema may have (as the Rust reader).
+MAX_SCHEMA_FIELDS = 256
+#: The field types testbed messages use (as the Rust reader).
+FIELD_TYPES = {"std_msgs/Header", "uint32", "uint64", "int64", "float64", "float64[]"}
+_SEPARATOR = "=" * 80
 
 
 class Log(dict):
@@ -99,6 +115,79 @@ def _table(rows: List[Dict[str, object]], log_times: List[int]) -> Dict[str, np.
     return table
 
 
+def _own_by_name() -> Dict[str, str]:
+    return {name: text for name, text in SCHEMAS.values()}
+
+
+def _fields(where: str, text: str) -> Dict[str, str]:
+    """A testbed message's main fields (name -> type), checked as the Rust
+    reader checks them (`logger/src/msg_schema.rs`)."""
+    fields: Dict[str, str] = {}
+    for number, raw in enumerate(text.split("\n"), 1):
+        line = raw.split("#", 1)[0].strip()
+        if line.startswith("===="):
+            break
+        if not line or "=" in line:
+            continue
+        words = line.split()
+        if len(words) != 2:
+            raise ValueError(f"{where}, line {number}: {line[:80]!r} is not a field (TYPE NAME)")
+        ty, name = words
+        if ty not in FIELD_TYPES:
+            raise ValueError(
+                f"{where}, field '{name[:80]}': type {ty[:80]} is not one testbed messages use "
+                f"({', '.join(sorted(FIELD_TYPES))})"
+            )
+        if name in fields:
+            raise ValueError(f"{where}: field '{name}' appears twice")
+        fields[name] = ty
+        if len(fields) > MAX_SCHEMA_FIELDS:
+            raise ValueError(f"{where}: more than {MAX_SCHEMA_FIELDS} fields")
+    return fields
+
+
+def _definitions(text: str) -> str:
+    """The types a schema defines after its main message."""
+    at = text.find(_SEPARATOR)
+    return text[at:] if at >= 0 else ""
+
+
+def _check_schema(path: str, topic: str, schema, own: Dict[str, str]) -> None:
+    """Refuses a stored schema this reader cannot trust to decode: see the
+    module's docstring."""
+    name = schema.name if schema is not None else ""
+    where = f"{path}: channel {topic} (schema {name[:80] or 'none'})"
+    if schema is None or schema.encoding != "ros2msg":
+        raise ValueError(f"{where}: a log of format 3 stores ros2msg schemas")
+    if len(schema.data) > MAX_SCHEMA_BYTES:
+        raise ValueError(
+            f"{where}: the schema is {len(schema.data)} bytes (at most {MAX_SCHEMA_BYTES})"
+        )
+    try:
+        text = schema.data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ValueError(f"{where}: the schema is not UTF-8 text") from None
+    mine = own.get(name)
+    if mine == text:
+        return
+    if mine is None or not name.startswith("testbed_msgs/"):
+        raise ValueError(
+            f"{where}: not a schema this build writes; read the log with the testbed that wrote it"
+        )
+    # An older or newer testbed message: read by its own fields, as long
+    # as each field this build also has keeps its type.
+    fields = _fields(where, text)
+    if "header" not in fields:
+        raise ValueError(f"{where}: the schema has no std_msgs/Header header")
+    if _definitions(text) != _definitions(mine):
+        raise ValueError(f"{where}: the schema defines types beyond std_msgs/Header's")
+    for field, ty in _fields(name, mine).items():
+        if field in fields and fields[field] != ty:
+            raise ValueError(
+                f"{where}, field '{field}': {fields[field]} in the log, {ty} in this build"
+            )
+
+
 def read_log(path: str, topics: Optional[Iterable[str]] = None) -> Log:
     """Every message of the log at `path` (or of `topics` only), decoded by
     the official ROS 2 decoder, as one table per topic. A log of format 1 or
@@ -110,7 +199,7 @@ def read_log(path: str, topics: Optional[Iterable[str]] = None) -> Log:
     rows: Dict[str, List[Dict[str, object]]] = {}
     times: Dict[str, List[int]] = {}
     with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        reader = make_reader(f)
         for record in reader.iter_metadata():
             if record.name == "testbed.run":
                 log.run = dict(record.metadata)
@@ -122,12 +211,23 @@ def read_log(path: str, topics: Optional[Iterable[str]] = None) -> Log:
                 "read it with `testbed replay --csv`"
             )
         wanted = list(topics) if topics is not None else None
-        for schema, channel, message, decoded in reader.iter_decoded_messages(
-            topics=wanted, log_time_order=False
-        ):
-            log.types.setdefault(channel.topic, schema.name if schema else "")
+        own = _own_by_name()
+        factory = DecoderFactory()
+        decoders: Dict[int, object] = {}
+        for schema, channel, message in reader.iter_messages(topics=wanted, log_time_order=False):
+            decode = decoders.get(channel.id)
+            if decode is None:
+                _check_schema(path, channel.topic, schema, own)
+                decode = factory.decoder_for(channel.message_encoding, schema)
+                if decode is None:
+                    raise ValueError(
+                        f"{path}: channel {channel.topic}: no decoder for "
+                        f"{channel.message_encoding!r} messages"
+                    )
+                decoders[channel.id] = decode
+            log.types.setdefault(channel.topic, schema.name)
             row: Dict[str, object] = {}
-            _flatten(decoded, "", row)
+            _flatten(decode(message.data), "", row)
             rows.setdefault(channel.topic, []).append(row)
             times.setdefault(channel.topic, []).append(message.log_time)
     for topic, r in rows.items():
