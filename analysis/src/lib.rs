@@ -17,6 +17,7 @@ pub mod data_path;
 pub mod law_info;
 pub mod own;
 pub mod percentiles;
+mod plot_error;
 pub mod plots;
 pub mod record;
 pub mod report;
