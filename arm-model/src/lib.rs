@@ -39,6 +39,7 @@ mod inertia;
 mod mjcf;
 mod mjcf_include;
 mod mjcf_inertia;
+mod mjcf_joint_force;
 mod parse;
 mod prefixes;
 mod tree;

@@ -51,7 +51,9 @@ pub(crate) fn is_mjcf(text: &str) -> bool {
 pub(crate) fn from_str(text: &str, base_dir: &Path, locks: &Locks) -> Result<ArmModel, ModelError> {
     let m = mjcf_rs::Model::from_str(text, base_dir)
         .map_err(|e| ModelError::MjcfParse(e.to_string()))?;
-    convert(&m, locks)
+    let whole = super::mjcf_include::inline(text, base_dir)?;
+    let joint_force = super::mjcf_joint_force::joint_force_limits(&whole, m.compiler.autolimits)?;
+    convert(&m, &joint_force, locks)
 }
 
 /// What the conversion learns beside the URDF tree.
@@ -64,7 +66,11 @@ struct Converted {
     notes: Vec<String>,
 }
 
-fn convert(m: &mjcf_rs::Model, locks: &Locks) -> Result<ArmModel, ModelError> {
+fn convert(
+    m: &mjcf_rs::Model,
+    joint_force: &HashMap<String, f64>,
+    locks: &Locks,
+) -> Result<ArmModel, ModelError> {
     let c = tree(m)?;
     let mut model = super::tree::build(&c.robot, locks)?;
     for j in &mut model.joints {
@@ -72,6 +78,16 @@ fn convert(m: &mjcf_rs::Model, locks: &Locks) -> Result<ArmModel, ModelError> {
     }
     let mut notes = c.notes;
     notes.extend(actuators(m, &mut model));
+    // A joint's actuatorfrcrange clamps whatever drives it.
+    for j in model
+        .joints
+        .iter_mut()
+        .filter(|j| j.kind != JointKind::Fixed)
+    {
+        if let Some(&f) = joint_force.get(&j.name).filter(|f| **f > 0.0) {
+            j.effort = Some(j.effort.map_or(f, |e| e.min(f)));
+        }
+    }
     model.home = home(m, &model, &c.qpos_order)?;
     notes.append(&mut model.notes);
     model.notes = notes;
@@ -114,13 +130,16 @@ fn tree(m: &mjcf_rs::Model) -> Result<Converted, ModelError> {
     };
     // Each body's link: its name and the anchor its link frame sits at.
     let mut link_of: Vec<(String, Vector3<f64>)> = Vec::with_capacity(m.bodies.len());
+    // Whether a joint lies between the body and the world.
+    let mut moves: Vec<bool> = Vec::with_capacity(m.bodies.len());
     for (id, entry) in m.bodies.iter().enumerate() {
         let b = &entry.body;
         let Some(parent) = entry.parent else {
             c.robot
                 .links
-                .push(link(m, "world", b, Vector3::zeros(), true)?);
+                .push(link(m, "world", b, Vector3::zeros(), Weld::World)?);
             link_of.push(("world".into(), Vector3::zeros()));
+            moves.push(false);
             continue;
         };
         let name = body_name(b, id);
@@ -137,8 +156,22 @@ fn tree(m: &mjcf_rs::Model) -> Result<Converted, ModelError> {
             parent == 0,
             (&parent_link, parent_anchor, &placed),
         )?;
-        c.robot.links.push(link(m, &name, b, anchor, false)?);
+        let moving = moves.get(parent).copied().unwrap_or(false) || !b.joints.is_empty();
+        let weld = if moving { Weld::Moves } else { Weld::Fixed };
+        let l = match link(m, &name, b, anchor, weld) {
+            // A body welded to the world moves nothing: its mass does not
+            // matter, so a mesh it would take it from is not needed.
+            Err(ModelError::MjcfRefused { element, .. }) if !moving => {
+                c.notes.push(format!(
+                    "{element}: its mass would come from a mesh, which is not read; the body is welded to the world, so its mass does not change the dynamics"
+                ));
+                link(m, &name, b, anchor, Weld::World)?
+            }
+            other => other?,
+        };
+        c.robot.links.push(l);
         link_of.push((name, anchor));
+        moves.push(moving);
     }
     Ok(c)
 }
@@ -314,14 +347,26 @@ fn empty_link(name: &str) -> urdf_rs::Link {
     }
 }
 
+/// How a body hangs from the world.
+#[derive(Clone, Copy, PartialEq)]
+enum Weld {
+    /// The world body itself (or one whose mass is left out).
+    World,
+    /// Welded to the world through fixed joints only.
+    Fixed,
+    /// A joint lies between it and the world.
+    Moves,
+}
+
 /// A body's link: its mass properties and collision primitives in its
-/// link frame (the body frame moved to `anchor`).
+/// link frame (the body frame moved to `anchor`). Meshes are never read:
+/// a body whose mass MuJoCo would take from a mesh is refused by name.
 fn link(
     m: &mjcf_rs::Model,
     name: &str,
     b: &Body,
     anchor: Vector3<f64>,
-    world: bool,
+    weld: Weld,
 ) -> Result<urdf_rs::Link, ModelError> {
     use mjcf_rs::compiler::InertiaFromGeom;
     let shift = Isometry3::translation(-anchor.x, -anchor.y, -anchor.z);
@@ -332,7 +377,7 @@ fn link(
         .filter(|g| g.contype != 0 || g.conaffinity != 0)
         .filter_map(|g| collision(g, &shift))
         .collect();
-    if world {
+    if weld == Weld::World {
         return Ok(l);
     }
     let from_geoms = match (&b.inertial, m.compiler.inertia_from_geom) {
@@ -406,7 +451,8 @@ fn collision(g: &Geom, shift: &Isometry3<f64>) -> Option<urdf_rs::Collision> {
 }
 
 /// Effort limits from the actuators that drive a joint (a motor's gear ×
-/// its control range, any actuator's force range), and notes on what is
+/// its control range, any actuator's force range; the joint's own
+/// `actuatorfrcrange` is applied by the caller), and notes on what is
 /// not used: servo gains (the controller is the testbed's own) and
 /// actuators on tendons or sites.
 fn actuators(m: &mjcf_rs::Model, model: &mut ArmModel) -> Vec<String> {
@@ -424,7 +470,8 @@ fn actuators(m: &mjcf_rs::Model, model: &mut ArmModel) -> Vec<String> {
             r.filter(|_| limited.resolve(auto, r.is_some()))
                 .map(|r| r[0].abs().max(r[1].abs()))
         };
-        let force = bound(a.force_range, a.force_limited);
+        // forcerange clamps the actuator's force; the joint feels gear × it.
+        let force = bound(a.force_range, a.force_limited).map(|f| f * a.gear[0].abs());
         let ctrl = match a.kind {
             ActuatorKind::Motor => bound(a.ctrl_range, a.ctrl_limited).map(|c| c * a.gear[0].abs()),
             _ => {

@@ -179,3 +179,80 @@ fn malformed_mjcf_is_an_error_not_a_panic() {
         assert!(matches!(outcome, Ok(Err(_))), "{text}: {outcome:?}");
     }
 }
+
+/// The shipped Menagerie UR5e reads without its meshes (they are not
+/// shipped): every body has an <inertial>, so meshes are only looked at.
+#[test]
+fn the_menagerie_ur5e_reads_without_its_meshes() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../robots/menagerie/universal_robots_ur5e/ur5e.xml");
+    assert!(
+        !path.parent().unwrap().join("assets").exists(),
+        "the test is of a folder without meshes"
+    );
+    let m = ArmModel::from_mjcf_file(&path, &Locks::new()).unwrap();
+    assert_eq!(m.dof(), 6);
+    // Position servos: forcerange ±150 on the three large joints, ±28 on
+    // the wrist; their gains are named as ignored.
+    let effort: Vec<_> = m.actuated.iter().map(|&j| m.joints[j].effort).collect();
+    assert_eq!(
+        effort,
+        [150.0, 150.0, 150.0, 28.0, 28.0, 28.0].map(Some).to_vec()
+    );
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.contains("'wrist_3'") && n.contains("gains are ignored")),
+        "{:?}",
+        m.notes
+    );
+    assert!(m.actuated.iter().all(|&j| m.joints[j].armature == 0.1));
+    // The file's own digits, not π/2.
+    #[allow(clippy::approx_constant)]
+    let q = 1.5708;
+    assert_eq!(m.home, Some(vec![-q, -q, q, -q, -q, 0.0]));
+    // Collision capsules and cylinders are contact shapes; no mesh is.
+    assert!(m.links.iter().map(|l| l.collisions.len()).sum::<usize>() >= 8);
+}
+
+#[test]
+fn a_base_welded_to_the_world_may_weigh_a_mesh() {
+    // SO-ARM100's base: a collision mesh and no <inertial>, on no joint.
+    let text = r#"<mujoco><asset><mesh name="shell" file="absent.stl"/></asset>
+        <worldbody><body name="base"><geom name="hull" type="mesh" mesh="shell"/>
+        <body name="link1"><joint name="j"/>
+        <inertial pos="0 0 0.1" mass="1" diaginertia="0.01 0.01 0.01"/></body></body>
+        </worldbody></mujoco>"#;
+    let m = ArmModel::from_urdf_str(text).unwrap();
+    assert_eq!(m.joint_names(), ["j"]);
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.contains("hull") && n.contains("welded to the world")),
+        "{:?}",
+        m.notes
+    );
+    // Below a joint the same body is refused, naming the geom.
+    let moving = text.replace(
+        r#"<body name="base">"#,
+        r#"<body name="base"><joint name="j0"/>"#,
+    );
+    let e = ArmModel::from_urdf_str(&moving).unwrap_err().to_string();
+    assert!(e.contains("hull") && e.contains("base"), "{e}");
+}
+
+#[test]
+fn a_joints_actuatorfrcrange_limits_its_effort() {
+    let text = r#"<mujoco><compiler autolimits="true"/>
+        <default><joint actuatorfrcrange="-40 40"/></default>
+        <worldbody><body name="b1"><joint name="j1"/>
+        <inertial pos="0 0 0.1" mass="1" diaginertia="0.01 0.01 0.01"/>
+        <body name="b2" pos="0 0 0.2"><joint name="j2" actuatorfrcrange="-12 10"/>
+        <inertial pos="0 0 0.1" mass="1" diaginertia="0.01 0.01 0.01"/></body></body></worldbody>
+        <actuator><motor joint="j1" gear="2" ctrlrange="-30 30"/>
+        <general joint="j2" gear="3" forcerange="-2 2"/></actuator></mujoco>"#;
+    let m = ArmModel::from_urdf_str(text).unwrap();
+    // j1: min(gear 2 × ctrl 30, actuatorfrcrange 40); j2: min(gear 3 × force 2, 12).
+    assert_eq!(joint(&m, "j1").effort, Some(40.0));
+    assert_eq!(joint(&m, "j2").effort, Some(6.0));
+}

@@ -21,12 +21,17 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
-/// The files compared: every hand-written arm MuJoCo can load.
-const ARMS: [&str; 4] = [
-    "two_link_hinge.xml",
-    "geom_inertia.xml",
-    "slide_armature.xml",
-    "includes_defaults.xml",
+/// The files compared: every hand-written arm MuJoCo can load (in
+/// tests/data) and every shipped MuJoCo Menagerie arm (from the
+/// repository's root). `TESTBED_MJCF_ARMS` adds more: MJCF files, or
+/// folders searched for them, separated by ':' (a Menagerie checkout's
+/// arms, say; a file that includes others is given, not its includes).
+const ARMS: [&str; 5] = [
+    "arm-model/tests/data/two_link_hinge.xml",
+    "arm-model/tests/data/geom_inertia.xml",
+    "arm-model/tests/data/slide_armature.xml",
+    "arm-model/tests/data/includes_defaults.xml",
+    "robots/menagerie/universal_robots_ur5e/ur5e.xml",
 ];
 
 const STATES: usize = 8;
@@ -34,6 +39,34 @@ const TOLERANCE: f64 = 1e-9;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
+}
+
+/// The shipped arms, then those `TESTBED_MJCF_ARMS` names.
+fn arms() -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = ARMS.iter().map(|a| root().join("..").join(a)).collect();
+    let extra = std::env::var("TESTBED_MJCF_ARMS").unwrap_or_default();
+    for item in extra.split(':').filter(|s| !s.is_empty()) {
+        let path = PathBuf::from(item);
+        if path.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(&path)
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .filter(|p| p.extension().is_some_and(|x| x == "xml"))
+                .collect();
+            found.sort();
+            out.extend(found);
+        } else {
+            out.push(path);
+        }
+    }
+    out
+}
+
+/// A path for messages: the repository's own relative to its root.
+fn label(path: &Path) -> String {
+    let base = root().join("..");
+    path.strip_prefix(&base)
+        .map_or_else(|_| path.display().to_string(), |p| p.display().to_string())
 }
 
 /// The venv's python, made by the setup script when missing.
@@ -123,16 +156,17 @@ fn mjcf_dynamics_equal_mujocos() {
     std::fs::create_dir_all(&dir).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(47);
     let mut worst = [0.0_f64; 3];
-    for arm in ARMS {
-        let path = root().join("tests/data").join(arm);
-        let model = ArmModel::from_mjcf_file(&path, &Locks::new()).unwrap();
+    for (k, path) in arms().iter().enumerate() {
+        let arm = label(path);
+        let model = ArmModel::from_mjcf_file(path, &Locks::new())
+            .unwrap_or_else(|e| panic!("{arm} is not read: {e}"));
         let states = states(&model, &mut rng);
-        let spec = dir.join(format!("{arm}.json"));
+        let spec = dir.join(format!("{k}.json"));
         let names = model.joint_names();
         std::fs::write(&spec, json!({"names": names, "states": states}).to_string()).unwrap();
         let out = Command::new(&python)
             .arg(root().join("tests/mujoco_dynamics.py"))
-            .arg(&path)
+            .arg(path)
             .arg(&spec)
             .output()
             .unwrap();
@@ -143,6 +177,7 @@ fn mjcf_dynamics_equal_mujocos() {
         );
         let theirs: Vec<Value> = serde_json::from_slice(&out.stdout).unwrap();
         let mut dynamics = Dynamics::new(&model, 1.0);
+        let mut arm_worst = [0.0_f64; 3];
         for (s, t) in states.iter().zip(&theirs) {
             let mine = ours(&model, &mut dynamics, s);
             let m_theirs: Vec<f64> = (t["M"].as_array().unwrap().iter())
@@ -160,8 +195,16 @@ fn mjcf_dynamics_equal_mujocos() {
                     errors[k]
                 );
                 worst[k] = worst[k].max(errors[k]);
+                arm_worst[k] = arm_worst[k].max(errors[k]);
             }
         }
+        println!(
+            "{arm}: {} joints, largest relative difference M {:.2e}, bias {:.2e}, qacc {:.2e}",
+            model.dof(),
+            arm_worst[0],
+            arm_worst[1],
+            arm_worst[2]
+        );
     }
     println!(
         "largest relative difference from MuJoCo: M {:.2e}, bias {:.2e}, qacc {:.2e}",

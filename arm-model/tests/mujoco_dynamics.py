@@ -6,7 +6,7 @@ arm-model/tests/mujoco.rs to compare the testbed's with.
 STATES.json: {"names": [joint, ...], "states": [{"q", "qd", "tau"}, ...]},
 every vector in the order of "names" (the testbed's joint order). Prints
 JSON {"M": [...], "bias": [...], "qacc": [...]} per state in that order:
-M from mj_fullM (armature included; MuJoCo 4 signature), bias = qfrc_bias (C q̇ + G), and the
+Mesh geoms are removed first (see without_meshes). M from mj_fullM (armature included; MuJoCo 4 signature), bias = qfrc_bias (C q̇ + G), and the
 accelerations mj_forward gives under tau with joint damping on and every
 constraint (joint limits, dry friction `frictionloss`, contacts) and the
 actuators off.
@@ -19,8 +19,23 @@ import mujoco
 import numpy as np
 
 
+def without_meshes(model_path):
+    """The model with its mesh geoms and mesh assets removed: meshes are
+    not shipped (only the MJCF is), and the testbed reads an arm only when
+    no moving body takes its mass from a mesh (each such body has an
+    <inertial>, or its meshes weigh nothing), so they change no dynamics.
+    A body welded to the world may weigh its meshes; it moves nothing."""
+    spec = mujoco.MjSpec.from_file(model_path)
+    for g in list(spec.geoms):
+        if g.type == mujoco.mjtGeom.mjGEOM_MESH:
+            spec.delete(g)
+    for mesh in list(spec.meshes):
+        spec.delete(mesh)
+    return spec.compile()
+
+
 def main(model_path, states_path):
-    m = mujoco.MjModel.from_xml_path(model_path)
+    m = without_meshes(model_path)
     # frictionloss and limits are constraints in MuJoCo; the comparison is
     # of the smooth dynamics, so they are off (the testbed's are elsewhere).
     m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
