@@ -6,7 +6,9 @@
 //! middle of its range, an envelope of about 0.25 rad, an initial state
 //! outside the envelope so the deferred constraint is exercised, and gains
 //! K1_i, K2_i chosen from what the plant reports (the controller itself
-//! still gets no model; see [`crate::gains`]). A joint no gain holds at the
+//! still gets no model; see [`crate::gains`]). An arm whose file names a
+//! home pose (an MJCF keyframe `home`) starts there, the reference placed
+//! so that the start is as far outside the envelope. A joint no gain holds at the
 //! rate against the barrier term (a feather-light link) gets armature, or is
 //! locked if it moves under 1 % of the arm's mass; [`ArmDefault`] says which
 //! and why, with any gravity load beyond an effort limit.
@@ -27,7 +29,7 @@ use checks::{
 };
 pub use locks::GRIPPER_LOCK;
 use locks::{default_locks, lock_position};
-use reference::{kc_cap, shape};
+use reference::{home_start, kc_cap, offsets_for_start, shape};
 pub use types::ArmDefault;
 
 /// A joint that moves less than this fraction of the arm's moving mass is a
@@ -175,8 +177,15 @@ impl ArmDefault {
     ) -> Result<(Self, ArmModel), PlantError> {
         let lock: Locks = chosen.iter().map(|(n, p, _)| (n.clone(), *p)).collect();
         let model = ArmModel::from_urdf_str_locked(urdf, &lock)?;
-        let offsets = crate::posture::choose(&model)?;
+        // An MJCF arm starts at its keyframe `home` (the reference placed
+        // to start it outside the envelope); a URDF's start is chosen.
+        let home = home_start(&model);
+        let offsets = match &home {
+            Some(h) => offsets_for_start(&model, h, amplitude),
+            None => crate::posture::choose(&model)?,
+        };
         let (reference, envelope, q0) = shape(&model, &offsets, amplitude, None);
+        let q0 = home.clone().unwrap_or(q0);
         let n = q0.len();
         let mut s = Scenario {
             name: format!("default for {}", model.name),
@@ -222,7 +231,7 @@ impl ArmDefault {
         let gains = choose_gains(&model, &s, &kc_cap(&model))?;
         let (_, envelope, q0) = shape(&model, &offsets, amplitude, Some(&gains.envelope));
         s.envelope.joints = envelope;
-        s.initial.q = q0;
+        s.initial.q = home.unwrap_or(q0);
         s.rate_hz = gains.rate_hz;
         s.controller.k1 = controller::Gain::Each(gains.joints.iter().map(|g| g.k1).collect());
         s.controller.k2 = controller::Gain::Each(gains.joints.iter().map(|g| g.k2).collect());

@@ -30,6 +30,72 @@ const PRISMATIC_KC_M: f64 = 0.05;
 /// The widest envelope a prismatic joint may be given, m.
 const PRISMATIC_KC_CAP_M: f64 = 0.15;
 
+/// A joint's reference amplitude and default envelope offset.
+fn swing(kind: JointKind, half: f64) -> (f64, f64) {
+    match kind {
+        JointKind::Prismatic => (
+            (0.3 * half).min(PRISMATIC_AMPLITUDE_M),
+            (0.15 * half).min(PRISMATIC_KC_M),
+        ),
+        _ => ((0.3 * half).min(0.5), 0.25f64.min(0.3 * half)),
+    }
+}
+
+/// The arm's start when the file names one (an MJCF keyframe `home`),
+/// inside each joint's limits as the default start is.
+pub(super) fn home_start(model: &ArmModel) -> Option<Vec<f64>> {
+    let home = model.home.as_ref().filter(|h| h.len() == model.dof())?;
+    Some(
+        model
+            .actuated
+            .iter()
+            .zip(home)
+            .map(|(&ji, &q)| match model.joints[ji].limits {
+                Some((lo, hi)) => {
+                    let pad = 0.02 * (hi - lo);
+                    q.clamp(lo + pad, hi - pad)
+                }
+                None => q,
+            })
+            .collect(),
+    )
+}
+
+/// The reference offsets that put `start` where the default start would
+/// be: 1.5 default envelopes from the reference's first sample, so that
+/// an arm starting at its home pose still starts outside the envelope.
+/// Each stays within 0.6 of the half range of the middle, as the posture
+/// search's offsets do.
+pub(super) fn offsets_for_start(
+    model: &ArmModel,
+    start: &[f64],
+    amplitude: &[(String, f64)],
+) -> Vec<f64> {
+    model
+        .actuated
+        .iter()
+        .enumerate()
+        .map(|(i, &ji)| {
+            let j = &model.joints[ji];
+            let half = j.limits.map_or(f64::INFINITY, |(lo, hi)| 0.5 * (hi - lo));
+            let (amp, kc) = swing(j.kind, half);
+            let factor = amplitude
+                .iter()
+                .find(|(n, _)| *n == j.name)
+                .map_or(1.0, |a| a.1);
+            let first = if i % 2 == 0 { 0.0 } else { amp * factor };
+            let centre = start[i] - first - 1.5 * kc;
+            match j.limits {
+                Some((lo, hi)) => {
+                    let mid = 0.5 * (lo + hi);
+                    centre.clamp(mid - 0.6 * half, mid + 0.6 * half)
+                }
+                None => centre,
+            }
+        })
+        .collect()
+}
+
 /// Per joint: the reference about `offsets`, its amplitude times the
 /// joint's factor in `amplitude` (by name; 1 if absent), the envelope
 /// (offset `kc` when given), and the initial position.
@@ -44,13 +110,7 @@ pub(super) fn shape(
         let j = &model.joints[ji];
         let half = j.limits.map_or(f64::INFINITY, |(lo, hi)| 0.5 * (hi - lo));
         let center = offsets[i];
-        let (amp, kc_default) = match j.kind {
-            JointKind::Prismatic => (
-                (0.3 * half).min(PRISMATIC_AMPLITUDE_M),
-                (0.15 * half).min(PRISMATIC_KC_M),
-            ),
-            _ => ((0.3 * half).min(0.5), 0.25f64.min(0.3 * half)),
-        };
+        let (amp, kc_default) = swing(j.kind, half);
         let factor = amplitude
             .iter()
             .find(|(n, _)| *n == j.name)
