@@ -20,7 +20,7 @@ if ! cargo fuzz build ${FUZZ_DEV:+--dev} --fuzz-dir fuzz; then
 fi
 scratch="$(mktemp -d)"
 trap 'rm -rf "$scratch"' EXIT
-for target in scenario urdf log sweep node_config; do
+for target in scenario urdf mjcf log sweep node_config; do
     mkdir -p "$scratch/$target"
     status=0
     cargo fuzz run ${FUZZ_DEV:+--dev} --fuzz-dir fuzz "$target" "$scratch/$target" "fuzz/seeds/$target" -- \

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Runs `testbed sim --robot FILE --json` (each URDF's default scenario) on
-every URDF below a folder and prints one line each: clean, left the
+"""Runs `testbed sim --robot FILE --json` (each arm's default scenario) on
+every URDF and MJCF model below a folder and prints one line each: clean, left the
 envelope, refused (with the message), or timed out; then a summary line
 (starting with `#`): how many of each, and the slowest and median real-time
 factor of the runs.
@@ -48,13 +48,32 @@ def main() -> None:
     ap.add_argument("--testbed", default="target/release/testbed")
     ap.add_argument("--timeout", type=float, default=120.0)
     args = ap.parse_args()
-    # `.URDF` too: Robotiq's grippers ship that way.
-    urdfs = (p for p in args.folder.rglob("*") if p.suffix.lower() == ".urdf" and p.is_file())
+    # `.URDF` too: Robotiq's grippers ship that way; and MJCF models (#47).
+    urdfs = (p for p in args.folder.rglob("*") if is_robot_file(p))
     said = []
     for urdf in sorted(urdfs):
         said.append(check(args.testbed, urdf, args.timeout))
         print(f"{urdf.relative_to(args.folder)} | {said[-1]}", flush=True)
     print(summary(said))
+
+
+def is_robot_file(p: Path) -> bool:
+    """A URDF, or an MJCF model: an `.xml` whose root is `<mujoco>` and
+    that has a `<worldbody>` (a file only included by others has none)."""
+    if not p.is_file():
+        return False
+    if p.suffix.lower() == ".urdf":
+        return True
+    if p.suffix.lower() != ".xml":
+        return False
+    head = p.read_text(errors="replace")
+    start = head.lstrip("\ufeff").lstrip()
+    while start.startswith(("<?", "<!--")):
+        end = start.find("?>" if start.startswith("<?") else "-->")
+        if end < 0:
+            return False
+        start = start[end + (2 if start.startswith("<?") else 3):].lstrip()
+    return start.startswith("<mujoco") and "<worldbody" in head
 
 
 def summary(said: list[str]) -> str:
@@ -64,7 +83,7 @@ def summary(said: list[str]) -> str:
     rt = sorted(float(s.rsplit("rt ", 1)[1].rstrip("x")) for s in said if s.startswith(("ok", "LEFT")))
     speed = f"; real time: slowest {rt[0]:.1f}x, median {rt[len(rt) // 2]:.1f}x" if rt else ""
     return (
-        f"# {len(said)} URDFs: {kinds['ok']} clean, {kinds['LEFT']} left the envelope, "
+        f"# {len(said)} robot files: {kinds['ok']} clean, {kinds['LEFT']} left the envelope, "
         f"{kinds['refused']} refused, {kinds['TIMEOUT']} timed out, {kinds['PANIC']} panicked{speed}"
     )
 
