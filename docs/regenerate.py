@@ -48,6 +48,8 @@ SCENARIOS = [
     "iiwa_wall",
 ]
 ARMS = ["two_link", "three_link_planar", "ur5", "iiwa14", "panda", "xarm7", "so101", "z1"]
+#: The shipped MJCF arms (robots/menagerie/), by path from the root.
+MJCF_ARMS = ["robots/menagerie/universal_robots_ur5e/ur5e.xml"]
 COMPARED = ["paper", "payload_pickup", "actuation_delay", "paper_per_input"]
 
 
@@ -141,6 +143,32 @@ def arms_page() -> str:
             f"| `{arm}` | {s['dof']} | {rng(s['k1'])} | {rng(s['k2'])} | "
             f"{g(m['max_abs_error_after_tc'], 3)} rad | {g(m['min_margin_after_tc'], 3)} rad | "
             f"{m['breaches']} | {'yes' if s['finite'] else '**no**'} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def mjcf_arms_page() -> str:
+    lines = header(
+        "MJCF arms: the default scenario of each, in process",
+        "testbed sim --robot robots/menagerie/DIR/ARM.xml --json   # 10 s",
+    )
+    lines += [
+        "Each arm starts at its keyframe `home`; effort limits come from its actuators' "
+        "force ranges (position servos' gains are not used: the controller is the testbed's).",
+        "",
+        "| arm | joints | locked | K1_i | K2_i | max \\|q − q_d\\| after T_c | min margin | breaches | constraint kept | finite |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for arm in MJCF_ARMS:
+        s = run_json(["sim", "--robot", arm])
+        m = s["metrics"]
+        rng = lambda v: g(min(v), 3) if min(v) == max(v) else f"{g(min(v), 3)}–{g(max(v), 3)}"
+        locked = ", ".join(str(j) for j in s["locked_joints"]) or "none"
+        kept = "yes" if s["constraint_satisfied_after_tc"] else "**no**"
+        lines.append(
+            f"| `{arm}` | {s['dof']} | {locked} | {rng(s['k1'])} | {rng(s['k2'])} | "
+            f"{g(m['max_abs_error_after_tc'], 3)} rad | {g(m['min_margin_after_tc'], 3)} rad | "
+            f"{m['breaches']} | {kept} | {'yes' if s['finite'] else '**no**'} |"
         )
     return "\n".join(lines) + "\n"
 
@@ -545,6 +573,7 @@ def sweeps_page() -> str:
 PAGES = {
     "scenarios.md": scenarios_page,
     "arms.md": arms_page,
+    "mjcf-arms.md": mjcf_arms_page,
     "compare.md": compare_page,
     "findings.md": findings_page,
     "robustness.md": robustness_page,
