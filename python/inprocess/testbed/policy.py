@@ -172,7 +172,7 @@ def check_scenario(env: dict, where: str) -> None:
     that file's first line into stderr, the controller's log and `compare
     --json`). A policy names a shipped scenario (`testbed.SCENARIOS`) or
     embeds its own (env.scenario_toml) holding no path; env.robot must be
-    a `.urdf` file, whose errors are never quoted (see policy_node)."""
+    a `.urdf` or MJCF `.xml` file, whose errors are never quoted (see policy_node)."""
     scenario, text = env.get("scenario"), env.get("scenario_toml")
     if scenario is not None and text is not None:
         raise ValueError(f"{where}: env.scenario and env.scenario_toml are both set; a policy has one scenario")
@@ -194,9 +194,9 @@ def check_scenario(env: dict, where: str) -> None:
             raise ValueError(f"{where}: env.scenario_toml sets {key}, which names a file; an embedded "
                              "scenario holds its data (a trajectory as samples, the robot as env.robot)")
     robot = env.get("robot")
-    if robot is not None and not (isinstance(robot, str) and robot.endswith(".urdf")
+    if robot is not None and not (isinstance(robot, str) and robot.endswith((".urdf", ".xml"))
                                   and len(robot) <= 4096):
-        raise ValueError(f"{where}: env.robot = {quote(robot)} is not a path to a .urdf file")
+        raise ValueError(f"{where}: env.robot = {quote(robot)} is not a path to a .urdf or MJCF .xml file")
     overrides = env.get("set")
     if overrides is None:
         return
