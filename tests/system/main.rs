@@ -18,6 +18,7 @@ mod live;
 mod liveness;
 mod log_replay;
 mod many_joints;
+mod mjcf_arms;
 mod policy_onnx;
 mod python;
 mod python_in_process;
