@@ -24,6 +24,7 @@ mod posture;
 mod probe;
 mod randomise;
 mod robot;
+mod seed;
 pub mod sweep_file;
 
 use controller::{ControllerError, ControllerParams};
@@ -175,7 +176,9 @@ pub struct Scenario {
     /// Control and plant rate (default: 1000, Hz).
     pub rate_hz: f64,
     /// Seed of every random effect (sensor noise, disturbance noise, lost
-    /// commands); the same seed reproduces a run bit for bit (default: 0).
+    /// commands); the same seed reproduces a run bit for bit (default: 0;
+    /// any u64, above `i64::MAX` written as a decimal string).
+    #[serde(with = "seed")]
     pub seed: u64,
     /// Initial state.
     pub initial: Initial,
@@ -401,6 +404,37 @@ mod tests {
             assert!(!e.contains("root:"), "{e}");
         }
         assert!(Scenario::from_log_toml(PAPER_TOML, "log.mcap").is_ok());
+    }
+
+    /// #48 item 16: a seed is any u64; TOML's integers stop at i64::MAX,
+    /// so above it the seed is a decimal string (`--set` reads the bare
+    /// digits so), written back the same way; a negative seed is refused
+    /// naming the key.
+    #[test]
+    fn a_seed_above_i64_max_is_a_seed() {
+        let set = |v: &str| Overrides {
+            set: vec![crate::parse_set(&format!("seed={v}")).unwrap()],
+            ..Default::default()
+        };
+        for (given, want) in [
+            ("18446744073709551615", u64::MAX),
+            ("9223372036854775808", 1 << 63),
+            ("\"18446744073709551615\"", u64::MAX),
+            ("7", 7),
+        ] {
+            let plan = load(None, &set(given)).unwrap();
+            assert_eq!(plan.scenario.seed, want, "{given}");
+            let text = toml::to_string(&plan.scenario).unwrap();
+            let back = Scenario::from_toml_str(&text, "written.toml").unwrap();
+            assert_eq!(back.seed, want, "{text}");
+        }
+        // A seed TOML holds stays an integer in the written text.
+        let text = toml::to_string(&load(None, &set("7")).unwrap().scenario).unwrap();
+        assert!(text.contains("seed = 7\n"), "{text}");
+        for bad in ["-1", "18446744073709551616", "\"12a\"", "1.5"] {
+            let e = load(None, &set(bad)).unwrap_err().to_string();
+            assert!(e.contains("seed"), "{bad}: {e}");
+        }
     }
 
     #[test]

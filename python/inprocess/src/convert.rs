@@ -164,6 +164,12 @@ fn to_toml(key: &str, v: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::Valu
     if let Ok(i) = v.extract::<i64>() {
         return Ok(toml::Value::Integer(i));
     }
+    // Past TOML's i64: a seed up to 2**64 - 1 is written as its digits,
+    // which the scenario's seed takes (it was rounded to a float and
+    // refused).
+    if let Ok(u) = v.extract::<u64>() {
+        return Ok(toml::Value::String(u.to_string()));
+    }
     if let Ok(f) = v.extract::<f64>() {
         return Ok(toml::Value::Float(f));
     }

@@ -81,6 +81,22 @@ class Errors(unittest.TestCase):
                 testbed.Robot(str(bad))
 
 
+class Seeds(unittest.TestCase):
+    def test_a_seed_above_i64_max_is_a_seed(self):
+        # #48 item 16: a seed is a u64; past 2**63 - 1 it was rounded to a
+        # float and refused.
+        for seed in (2**63, 2**64 - 1):
+            for set_ in ({"seed": seed}, [f"seed={seed}"]):
+                rows, _ = testbed.sim("friction_noise", duration=0.01, set=set_)
+                self.assertEqual(rows["q"].shape[0], 10)
+        a, _ = testbed.sim("friction_noise", duration=0.01, set={"seed": 2**64 - 1})
+        b, _ = testbed.sim("friction_noise", duration=0.01, set={"seed": 2**64 - 2})
+        self.assertFalse(np.array_equal(a["q"], b["q"]))
+        for bad in (2**64, -1):
+            with self.assertRaisesRegex(testbed.TestbedError, "seed"):
+                testbed.sim(duration=0.01, set={"seed": bad})
+
+
 class CompareEqualsCli(unittest.TestCase):
     def test_rows_and_scores(self):
         import json
