@@ -782,4 +782,21 @@ mod tests {
         let e = with("t,joint2\n0,0\n1,0\n").unwrap_err().to_string();
         assert!(e.contains("no column for joint joint1"), "{e}");
     }
+
+    /// #48 item 16: a file that opens with a UTF-8 byte-order mark (a
+    /// Windows editor's) reads as without it: the CSV's first column is
+    /// `t`, not `'\u{feff}t'`, and the scenario's first key its own.
+    #[test]
+    fn a_byte_order_mark_opens_no_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let csv = dir.path().join("traj.csv");
+        std::fs::write(&csv, "\u{feff}t,joint1,joint2\n0,0.1,0.2\n1,0.3,0.4\n").unwrap();
+        let set = format!("reference.file={:?}", csv.display().to_string());
+        let plan = load(None, &overrides(None, &[set.as_str()])).unwrap();
+        assert_eq!(plan.reference.sample(0.0).q_d, [0.1, 0.2]);
+        let toml = dir.path().join("s.toml");
+        std::fs::write(&toml, "\u{feff}name = \"bom\"\nduration_s = 1.0\n").unwrap();
+        let plan = load(Some(&toml), &overrides(None, &[])).unwrap();
+        assert_eq!(plan.scenario.name, "bom");
+    }
 }

@@ -59,11 +59,19 @@ pub fn read_regular_file(path: &Path, max_bytes: Option<u64>) -> std::io::Result
     Ok(buf)
 }
 
-/// [`read_regular_file`] as UTF-8 text.
+/// [`read_regular_file`] as UTF-8 text, without a leading byte-order mark
+/// (editors on Windows write one; left in, it became part of the first
+/// key or column name, `'\u{feff}t'`).
 pub fn read_text_file(path: &Path, max_bytes: u64) -> std::io::Result<String> {
-    String::from_utf8(read_regular_file(path, Some(max_bytes))?)
-        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+    let mut bytes = read_regular_file(path, Some(max_bytes))?;
+    if bytes.starts_with(UTF8_BOM) {
+        bytes.drain(..UTF8_BOM.len());
+    }
+    String::from_utf8(bytes).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
 }
+
+/// The UTF-8 byte-order mark.
+const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
 
 #[cfg(test)]
 mod tests {
@@ -86,5 +94,17 @@ mod tests {
             "{e}"
         );
         std::fs::remove_file(&dir).unwrap();
+    }
+
+    /// #48 item 16: a UTF-8 byte-order mark is not text of the file.
+    #[test]
+    fn a_byte_order_mark_is_stripped() {
+        let path = std::env::temp_dir().join(format!("wire-bom-{}", std::process::id()));
+        std::fs::write(&path, b"\xEF\xBB\xBFt,joint1\n").unwrap();
+        assert_eq!(read_text_file(&path, 100).unwrap(), "t,joint1\n");
+        // Only at the start: one later is the file's own character.
+        std::fs::write(&path, "a\u{feff}".as_bytes()).unwrap();
+        assert_eq!(read_text_file(&path, 100).unwrap(), "a\u{feff}");
+        std::fs::remove_file(&path).unwrap();
     }
 }
