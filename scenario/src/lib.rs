@@ -305,12 +305,15 @@ impl Scenario {
             need: need.to_string(),
         };
         // The name reaches terminals, file names and logs: printable text only.
-        if self.name.chars().any(char::is_control) || self.name.chars().count() > 200 {
+        // A bidirectional override makes it read as another name.
+        if wire::forbidden_name_char(&self.name).is_some() || self.name.chars().count() > 200 {
             return Err(ScenarioError::Invalid {
                 file: file.to_string(),
                 key: "name".into(),
                 value: format!("{:?}", self.name.chars().take(60).collect::<String>()),
-                need: "at most 200 characters, none of them control characters".into(),
+                need: "at most 200 characters, none of them control or bidirectional \
+                       formatting characters"
+                    .into(),
             });
         }
         if !(self.duration_s.is_finite() && self.duration_s > 0.0 && self.duration_s <= 1e6) {
@@ -435,6 +438,65 @@ mod tests {
             let e = load(None, &set(bad)).unwrap_err().to_string();
             assert!(e.contains("seed"), "{bad}: {e}");
         }
+    }
+
+    /// #48 item 16: obstacle and object names each name one body, in
+    /// plain text: a name twice (across obstacles and objects, or an
+    /// unnamed one's "obstacle N"), a control or bidirectional formatting
+    /// character, is refused naming the field.
+    #[test]
+    fn contact_names_are_one_each_and_plain() {
+        let body = |kind: &str, name: &str| {
+            let extra = if kind == "object" {
+                "mass = 0.1\nlink = \"link2\"\ngrasp_at_s = 1.0\n"
+            } else {
+                ""
+            };
+            format!(
+                "[[plant.contact.{kind}]]\nname = {}\nshape = \"sphere\"\nsize = [0.05]\n\
+                 xyz = [0.0, 0.0, -0.9]\n{extra}",
+                toml::Value::from(name)
+            )
+        };
+        let check = |bodies: &[String]| {
+            let text = format!("[plant]\nengine = \"rapier\"\n{}", bodies.concat());
+            Scenario::from_toml_str(&text, "s.toml")
+                .and_then(|s| s.validate("s.toml"))
+                .map_err(|e| e.to_string())
+        };
+        check(&[body("obstacle", "table"), body("object", "cup")]).unwrap();
+        for (bodies, key) in [
+            (
+                vec![body("obstacle", "table"), body("obstacle", "table")],
+                "plant.contact.obstacle[1].name",
+            ),
+            (
+                vec![body("obstacle", "cup"), body("object", "cup")],
+                "plant.contact.object[0].name",
+            ),
+            (
+                vec![body("obstacle", ""), body("obstacle", "obstacle 1")],
+                "plant.contact.obstacle[1].name",
+            ),
+            (
+                vec![body("obstacle", "tab\nle")],
+                "plant.contact.obstacle[0].name",
+            ),
+            (
+                vec![body("obstacle", "a"), body("object", "cup\u{202E}")],
+                "plant.contact.object[0].name",
+            ),
+        ] {
+            let e = check(&bodies).unwrap_err();
+            assert!(e.contains(key), "{key}: {e}");
+        }
+        let e = check(&[body("obstacle", &"x".repeat(65))]).unwrap_err();
+        assert!(e.contains("at most 64 characters"), "{e}");
+        let e = Scenario::from_toml_str("name = \"paper\\u202E\"\n", "s.toml")
+            .and_then(|s| s.validate("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("name"), "{e}");
     }
 
     #[test]

@@ -36,6 +36,7 @@ mod fields;
 mod files;
 mod layout;
 mod messages;
+mod names;
 mod own;
 mod protocol;
 mod reference_rule;
@@ -53,6 +54,7 @@ pub use layout::{
     FieldLayout, FieldType, TypeLayout, WireField, WireLayout, all_layouts, field_size,
 };
 pub use messages::*;
+pub use names::{describe_char, forbidden_name_char};
 pub use own::{OwnLayout, OwnLayoutError, OwnShape, is_diagnostic_name};
 pub use protocol::{HEARTBEAT, Mode, SILENT_AFTER, UnknownMode, ns_to_s};
 pub use reference_rule::is_stale;

@@ -166,6 +166,7 @@ impl ContactConfig {
                 ));
             }
         }
+        self.check_names()?;
         for (i, o) in self.object.iter().enumerate() {
             o.validate(i)?;
         }
@@ -177,6 +178,63 @@ impl ContactConfig {
         Ok(())
     }
 }
+
+impl ContactConfig {
+    /// Names are shown in errors, the log's contact diagnostics and the 3D
+    /// view, so each names one body: no two alike (obstacles and objects
+    /// together, counting the "obstacle N" / "object N" given to unnamed
+    /// ones), no control or bidirectional formatting character, at most
+    /// [`MAX_NAME_CHARS`] characters.
+    fn check_names(&self) -> Result<(), PlantError> {
+        let named = self
+            .obstacle
+            .iter()
+            .enumerate()
+            .map(|(i, o)| (format!("plant.contact.obstacle[{i}].name"), o.label(i)))
+            .chain(
+                self.object
+                    .iter()
+                    .enumerate()
+                    .map(|(i, o)| (format!("plant.contact.object[{i}].name"), o.label(i))),
+            );
+        let mut seen = std::collections::HashMap::new();
+        for (key, name) in named {
+            let quoted = || {
+                let cut: String = name.chars().take(MAX_NAME_CHARS).collect();
+                format!("{cut:?}")
+            };
+            if let Some(c) = wire::forbidden_name_char(&name) {
+                return Err(invalid(
+                    &key,
+                    quoted(),
+                    format!(
+                        "a name without control or bidirectional formatting characters (it holds {})",
+                        wire::describe_char(c)
+                    ),
+                ));
+            }
+            let chars = name.chars().count();
+            if chars > MAX_NAME_CHARS {
+                return Err(invalid(
+                    &key,
+                    format!("{}… ({chars} characters)", quoted()),
+                    format!("a name of at most {MAX_NAME_CHARS} characters"),
+                ));
+            }
+            if let Some(first) = seen.insert(name.clone(), key.clone()) {
+                return Err(invalid(
+                    &key,
+                    quoted(),
+                    format!("a name of its own: {first} is named so too"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The longest obstacle or object name, characters.
+pub const MAX_NAME_CHARS: usize = 64;
 
 /// The lightest object taken, kg (a microgram).
 pub const MIN_OBJECT_MASS_KG: f64 = 1e-9;
@@ -227,6 +285,15 @@ impl ContactObject {
         Origin {
             xyz: self.xyz,
             rpy: self.rpy,
+        }
+    }
+
+    /// Its name, or "object N" (from 1) when none is given.
+    pub fn label(&self, i: usize) -> String {
+        if self.name.is_empty() {
+            format!("object {}", i + 1)
+        } else {
+            self.name.clone()
         }
     }
 
