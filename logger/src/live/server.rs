@@ -10,7 +10,9 @@
 //! server disconnects it. How many of a client's messages the server
 //! dropped, foxglove 0.30 does not tell (its `ConnectedClient::log` throws
 //! the count away); what the stats record per client is what was handed to
-//! the server for it, and whether it was still subscribed at the end.
+//! the server for it, and how many topics it was subscribed to at the end
+//! (a client that left, or that the server disconnected, is counted among
+//! those gone).
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::sync::{Arc, Mutex};
@@ -39,52 +41,128 @@ struct LiveTopic {
 /// Who is connected and what they subscribed to, kept by the server's
 /// callbacks (its own threads), read by the logger.
 #[derive(Default)]
-struct ClientBook(Mutex<Book>);
+struct ClientBook(Mutex<Book<ClientId>>);
 
-#[derive(Default)]
-struct Book {
-    /// Clients in the order they first subscribed.
-    order: Vec<ClientId>,
-    clients: HashMap<ClientId, ClientCount>,
+/// The clients by id: an entry from a client's first subscription until it
+/// disconnects, when its count joins the totals of those gone, so that the
+/// book holds the clients connected now, not every one that ever came (30
+/// reconnecting viewers once left thousands of entries).
+struct Book<K> {
+    /// Clients that ever subscribed; a client's number is its place here.
+    ever: u64,
+    clients: HashMap<K, ClientCount>,
+    /// Clients gone, and the messages handed to the server for them.
+    gone: u64,
+    gone_messages: u64,
 }
 
-#[derive(Default)]
+impl<K> Default for Book<K> {
+    fn default() -> Self {
+        Self {
+            ever: 0,
+            clients: HashMap::new(),
+            gone: 0,
+            gone_messages: 0,
+        }
+    }
+}
+
 struct ClientCount {
+    /// 1 for the first client that subscribed, and so on.
+    number: u64,
     channels: HashSet<ChannelId>,
     /// Messages handed to the server for this client.
     messages: u64,
 }
 
+impl<K: Eq + std::hash::Hash> Book<K> {
+    fn subscribe(&mut self, client: K, channel: ChannelId) {
+        let ever = &mut self.ever;
+        let entry = self.clients.entry(client).or_insert_with(|| {
+            *ever += 1;
+            ClientCount {
+                number: *ever,
+                channels: HashSet::new(),
+                messages: 0,
+            }
+        });
+        entry.channels.insert(channel);
+    }
+
+    fn unsubscribe(&mut self, client: &K, channel: ChannelId) {
+        if let Some(c) = self.clients.get_mut(client) {
+            c.channels.remove(&channel);
+        }
+    }
+
+    /// A client disconnected. The server unsubscribes each of its channels
+    /// first but does not say which client went: every client without a
+    /// subscription is taken as gone (one still connected that subscribes
+    /// again is then counted as a new client).
+    fn disconnected(&mut self) {
+        let (mut gone, mut messages) = (0, 0);
+        self.clients.retain(|_, c| {
+            let keep = !c.channels.is_empty();
+            if !keep {
+                gone += 1;
+                messages += c.messages;
+            }
+            keep
+        });
+        self.gone += gone;
+        self.gone_messages += messages;
+    }
+
+    fn count(&mut self, channel: ChannelId) {
+        for c in self.clients.values_mut() {
+            if c.channels.contains(&channel) {
+                c.messages += 1;
+            }
+        }
+    }
+
+    /// The book's entries in the log's stats.
+    fn stats(&self, out: &mut BTreeMap<String, String>) {
+        out.insert("live.clients".into(), self.ever.to_string());
+        out.insert("live.clients_gone".into(), self.gone.to_string());
+        out.insert(
+            "live.clients_gone.messages".into(),
+            self.gone_messages.to_string(),
+        );
+        for c in self.clients.values() {
+            let client = format!("live.client{}", c.number);
+            out.insert(format!("{client}.messages"), c.messages.to_string());
+            out.insert(
+                format!("{client}.subscribed_at_end"),
+                c.channels.len().to_string(),
+            );
+        }
+    }
+}
+
 impl ClientBook {
-    fn book(&self) -> std::sync::MutexGuard<'_, Book> {
+    fn book(&self) -> std::sync::MutexGuard<'_, Book<ClientId>> {
         // A poisoned lock only means a callback panicked mid-count: the
         // counts are still the best there are.
         self.0.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     fn count(&self, channel: ChannelId) {
-        for c in self.book().clients.values_mut() {
-            if c.channels.contains(&channel) {
-                c.messages += 1;
-            }
-        }
+        self.book().count(channel);
     }
 }
 
 impl ServerListener for ClientBook {
     fn on_subscribe(&self, client: Client, channel: ChannelView) {
-        let mut book = self.book();
-        if !book.clients.contains_key(&client.id()) {
-            book.order.push(client.id());
-        }
-        let entry = book.clients.entry(client.id()).or_default();
-        entry.channels.insert(channel.id());
+        self.book().subscribe(client.id(), channel.id());
     }
 
     fn on_unsubscribe(&self, client: Client, channel: ChannelView) {
-        if let Some(c) = self.book().clients.get_mut(&client.id()) {
-            c.channels.remove(&channel.id());
-        }
+        self.book().unsubscribe(&client.id(), channel.id());
+    }
+
+    fn on_client_disconnect(&self) {
+        self.book().disconnected();
     }
 }
 
@@ -169,22 +247,7 @@ impl Live {
             let name = t.name.trim_start_matches('/');
             out.insert(format!("live.{name}.sent"), t.sent.to_string());
         }
-        let book = self.book.book();
-        out.insert("live.clients".into(), book.order.len().to_string());
-        for (k, id) in book.order.iter().enumerate() {
-            let (messages, subscribed) = book
-                .clients
-                .get(id)
-                .map_or((0, 0), |c| (c.messages, c.channels.len()));
-            let client = format!("live.client{}", k + 1);
-            out.insert(format!("{client}.messages"), messages.to_string());
-            // A client that left, or that the server disconnected because
-            // its control queue was full, has no subscription left.
-            out.insert(
-                format!("{client}.subscribed_at_end"),
-                subscribed.to_string(),
-            );
-        }
+        self.book.book().stats(&mut out);
         out
     }
 }
@@ -259,4 +322,40 @@ fn open(ctx: &Arc<Context>, spec: &ChannelSpec) -> Result<LiveTopic, LiveError> 
         next_ns: 0,
         sent: 0,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// #48 item 16: the book drops a client that disconnected (its count
+    /// kept in the totals), so reconnecting viewers do not grow it; the
+    /// clients still there keep their numbers.
+    #[test]
+    fn a_client_that_left_leaves_the_book() {
+        let mut book: Book<u32> = Book::default();
+        let (a, b) = (ChannelId::new(1), ChannelId::new(2));
+        book.subscribe(7, a);
+        book.subscribe(7, b);
+        for round in 0..1000 {
+            book.subscribe(round + 100, a);
+            book.count(a);
+            // The server unsubscribes every channel of a client that
+            // disconnects, then says a client went.
+            book.unsubscribe(&(round + 100), a);
+            book.disconnected();
+            assert_eq!(book.clients.len(), 1, "round {round}");
+        }
+        assert_eq!(
+            (book.ever, book.gone, book.gone_messages),
+            (1001, 1000, 1000)
+        );
+        let mut out = BTreeMap::new();
+        book.stats(&mut out);
+        assert_eq!(out["live.clients"], "1001");
+        assert_eq!(out["live.clients_gone"], "1000");
+        assert_eq!(out["live.client1.messages"], "1000");
+        assert_eq!(out["live.client1.subscribed_at_end"], "2");
+        assert_eq!(out.len(), 5, "{out:?}");
+    }
 }
