@@ -12,6 +12,7 @@ pub(super) struct Folded {
     pub(super) joints: Vec<JointInfo>,
     pub(super) merged: Vec<String>,
     pub(super) merged_links: Vec<MergedLink>,
+    pub(super) tree_parents: std::collections::BTreeMap<String, String>,
 }
 
 /// Folds every fixed joint into its parent: the child's mass joins the
@@ -20,6 +21,21 @@ pub(super) struct Folded {
 pub(super) fn merge_fixed(mut links: Vec<LinkInfo>, mut joints: Vec<JointInfo>) -> Folded {
     let mut merged = Vec::new();
     let mut merged_links: Vec<MergedLink> = Vec::new();
+    let tree_parents = joints
+        .iter()
+        .map(|j| (links[j.child].name.clone(), links[j.parent].name.clone()))
+        .collect();
+    // Each fixed joint's own parent and origin, as the file gives them: the
+    // loop below re-hangs a joint on whatever its parent was folded into
+    // (panda_hand's joint on panda_link7 once panda_link8 is folded there).
+    let in_file: std::collections::HashMap<String, (String, super::Origin)> = joints
+        .iter()
+        .filter(|j| j.kind == JointKind::Fixed)
+        .map(|j| {
+            let child = links[j.child].name.clone();
+            (child, (links[j.parent].name.clone(), j.origin))
+        })
+        .collect();
     while let Some(ji) = joints.iter().position(|j| j.kind == JointKind::Fixed) {
         let j = joints.remove(ji);
         let (parent, child) = (j.parent, j.child);
@@ -55,10 +71,16 @@ pub(super) fn merge_fixed(mut links: Vec<LinkInfo>, mut joints: Vec<JointInfo>) 
                 m.origin = origin_of(&(t * iso(&m.origin)));
             }
         }
+        let (urdf_parent, joint_origin) = in_file
+            .get(&child_link.name)
+            .cloned()
+            .unwrap_or_else(|| (links[parent].name.clone(), j.origin));
         merged_links.push(MergedLink {
             name: child_link.name.clone(),
             into: parent,
             origin: j.origin,
+            parent: urdf_parent,
+            joint_origin,
         });
         // Drop the child link and renumber.
         links.remove(child);
@@ -81,5 +103,6 @@ pub(super) fn merge_fixed(mut links: Vec<LinkInfo>, mut joints: Vec<JointInfo>) 
         joints,
         merged,
         merged_links,
+        tree_parents,
     }
 }

@@ -239,6 +239,11 @@ pub struct ArmModel {
     /// Links folded away by a merge: where each one now sits, so that a
     /// scenario can still name it (a payload at a tool link, say).
     pub merged_links: Vec<MergedLink>,
+    /// Every link's parent link as the file gives it (child → parent, by
+    /// name), before fixed joints are folded: the tree a viewer draws
+    /// (`/tf`), where `joints` hang a joint from the link its parent was
+    /// folded into.
+    pub tree_parents: BTreeMap<String, String>,
     /// The pose the file names as the arm's home, per controlled joint
     /// (MJCF keyframe `home`, or its first key); None from a URDF.
     pub home: Option<Vec<f64>>,
@@ -253,6 +258,13 @@ pub struct MergedLink {
     pub into: usize,
     /// Its frame in that link's frame.
     pub origin: Origin,
+    /// The link its joint hangs it from in the file (a link folded away
+    /// itself, perhaps: panda_hand hangs from panda_link8, which is part of
+    /// panda_link7).
+    pub parent: String,
+    /// Its frame in `parent`'s frame: the joint's origin (with a locked
+    /// joint's held position).
+    pub joint_origin: Origin,
 }
 
 /// Joint name → position at which a scenario holds it.

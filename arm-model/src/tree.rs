@@ -475,6 +475,7 @@ fn finish(
         notes: Vec::new(),
         merged: f.merged,
         merged_links: f.merged_links,
+        tree_parents: f.tree_parents,
         home: None,
     })
 }

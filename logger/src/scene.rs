@@ -1,7 +1,8 @@
 //! The arm in 3D for Foxglove's 3D panel and RViz: every link frame as a
 //! `tf2_msgs/msg/TFMessage` (the `/tf` of ROS 2) in the URDF's tree (each
 //! link in its parent link's frame, the root in `world`; links that fixed
-//! joints folded into another one included, at their fixed place), and a stick figure (a
+//! or locked joints folded into another one included, each under its own
+//! parent in the file at its joint's place), and a stick figure (a
 //! cylinder from each link frame to the next joint, a sphere at each joint)
 //! as a `visualization_msgs/msg/MarkerArray` whose markers ride on those
 //! frames. The poses come from the URDF by the same forward kinematics as
@@ -31,11 +32,16 @@ struct Bone {
 pub struct ArmScene {
     dynamics: Dynamics,
     links: Vec<String>,
-    /// Each model link's parent link (None: the root).
-    parents: Vec<Option<usize>>,
-    /// Links folded into another: (name, the link it is part of, its pose
-    /// there).
-    folded: Vec<(String, usize, Isometry3<f64>)>,
+    /// Each model link's parent frame (None: the root): the URDF parent's
+    /// name, the model link that frame is part of, and the frame's pose in
+    /// that link (identity unless the parent was folded away: panda's
+    /// fingers hang from panda_hand, which is part of panda_link7).
+    parents: Vec<Option<(String, usize, Isometry3<f64>)>>,
+    /// Links folded into another: (name, its parent link in the URDF, its
+    /// pose there). The parent is the URDF's, folded or not, so that /tf is
+    /// the file's tree (panda_hand under panda_link8, not the panda_link7
+    /// both are part of).
+    folded: Vec<(String, String, Isometry3<f64>)>,
     bones: Vec<Bone>,
     radius: f64,
     /// A contact scenario's obstacles, drawn in the world frame.
@@ -72,12 +78,24 @@ impl ArmScene {
         let longest = bones.iter().map(|b| b.to.norm()).fold(0.0, f64::max);
         let mut parents = vec![None; model.links.len()];
         for j in &model.joints {
-            parents[j.child] = Some(j.parent);
+            let folded_parent = model
+                .tree_parents
+                .get(&model.links[j.child].name)
+                .and_then(|p| model.merged_links.iter().find(|m| &m.name == p))
+                .filter(|m| m.into == j.parent);
+            parents[j.child] = Some(match folded_parent {
+                Some(m) => (m.name.clone(), m.into, iso(&m.origin)),
+                None => (
+                    model.links[j.parent].name.clone(),
+                    j.parent,
+                    Isometry3::identity(),
+                ),
+            });
         }
         let folded = model
             .merged_links
             .iter()
-            .map(|m| (m.name.clone(), m.into, iso(&m.origin)))
+            .map(|m| (m.name.clone(), m.parent.clone(), iso(&m.joint_origin)))
             .collect();
         Self {
             dynamics: Dynamics::new(model, 1.0),
@@ -104,15 +122,15 @@ impl ArmScene {
         let poses = self.dynamics.link_poses(q);
         let mut out: Vec<Frame<'_>> = Vec::with_capacity(self.links.len() + self.folded.len());
         for (i, name) in self.links.iter().enumerate() {
-            let (parent, pose) = match self.parents[i] {
-                Some(p) => (self.links[p].as_str(), poses[p].inverse() * poses[i]),
+            let (parent, pose) = match &self.parents[i] {
+                Some((p, k, at)) => (p.as_str(), (poses[*k] * *at).inverse() * poses[i]),
                 None if name == WORLD_FRAME => continue,
                 None => (WORLD_FRAME, poses[i]),
             };
             out.push((parent, name.as_str(), parts(&pose)));
         }
-        for (name, into, pose) in &self.folded {
-            out.push((self.links[*into].as_str(), name.as_str(), parts(pose)));
+        for (name, parent, pose) in &self.folded {
+            out.push((parent.as_str(), name.as_str(), parts(pose)));
         }
         out
     }
@@ -269,5 +287,44 @@ mod tree_tests {
             );
         }
         assert_eq!(frames.iter().filter(|f| f.0 == WORLD_FRAME).count(), 1);
+    }
+
+    /// #48 item 17: each frame hangs from its parent in the URDF, fixed
+    /// and locked joints included (panda_hand, its TCP and fingers were
+    /// all put on panda_link7, the link they are folded into), at its
+    /// joint's own origin.
+    #[test]
+    fn every_frame_hangs_from_its_urdf_parent() {
+        let urdf = include_str!("../../robots/panda.urdf");
+        // Every joint's (child, parent) as the file says.
+        let joints: Vec<(String, String)> = urdf
+            .split("<joint ")
+            .skip(1)
+            .map(|j| {
+                let attr = |tag: &str| {
+                    let at = j.find(&format!("<{tag} link=\"")).unwrap() + tag.len() + 8;
+                    j[at..].split('"').next().unwrap().to_string()
+                };
+                (attr("child"), attr("parent"))
+            })
+            .collect();
+        for locks in [
+            arm_model::Locks::new(),
+            arm_model::Locks::from([("panda_finger_joint1".to_string(), 0.02)]),
+        ] {
+            let model = ArmModel::from_urdf_str_locked(urdf, &locks).unwrap();
+            let mut scene = ArmScene::new(&model);
+            let q = vec![0.3; model.dof()];
+            let frames = scene.frames(&q);
+            for (child, parent) in &joints {
+                let f = frames.iter().find(|f| f.1 == child.as_str()).unwrap();
+                assert_eq!(f.0, parent.as_str(), "{child} ({} locks)", locks.len());
+            }
+            let hand = frames.iter().find(|f| f.1 == "panda_hand").unwrap();
+            // panda_hand_joint: rpy 0 0 -pi/4 on panda_link8, no offset.
+            assert!(hand.2.0.iter().all(|x| x.abs() < 1e-12), "{hand:?}");
+            let tcp = frames.iter().find(|f| f.1 == "panda_hand_tcp").unwrap();
+            assert!((tcp.2.0[2] - 0.1034).abs() < 1e-12, "{tcp:?}");
+        }
     }
 }
