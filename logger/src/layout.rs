@@ -1,6 +1,7 @@
 //! A Foxglove layout for a run's arm: the paper's five figures as plots
 //! (positions with q_d, velocities, errors with ±k_c, actor weight norms,
-//! torques), the loop's timing, and the arm in 3D. Plots use the messages'
+//! torques), the loop's timing, and the arm in 3D (with a contact
+//! scenario's contact point and objects, `/arm/contact`). Plots use the messages'
 //! log time, which is sim time in the log and live alike, so one layout
 //! serves both. `testbed run` writes it into each run's folder; the one in
 //! `foxglove/` is this function's output for the paper's arm (a test keeps
@@ -8,6 +9,7 @@
 
 use serde_json::{Value, json};
 
+use crate::obstacles::CONTACT_MARKER_TOPIC;
 use crate::scene::{SCENE_TOPIC, TRANSFORMS_TOPIC, WORLD_FRAME};
 
 /// One plotted series.
@@ -41,6 +43,9 @@ fn three_d() -> Value {
     let mut topics = serde_json::Map::new();
     topics.insert(SCENE_TOPIC.into(), json!({"visible": true}));
     topics.insert(TRANSFORMS_TOPIC.into(), json!({"visible": true}));
+    // The contact point and free objects of a contact scenario (silent,
+    // and so empty, in any other).
+    topics.insert(CONTACT_MARKER_TOPIC.into(), json!({"visible": true}));
     json!({
         "followTf": WORLD_FRAME,
         "followMode": "follow-pose",

@@ -79,6 +79,14 @@ fn the_layout_names_only_published_topics_and_fields() {
         }
     }
     assert!(series >= 20, "only {series} series");
+    // #48 item 17: the 3D panel draws the arm, its frames and a contact
+    // scenario's contact point and objects.
+    for topic in ["/arm/scene", "/tf", logger::obstacles::CONTACT_MARKER_TOPIC] {
+        assert_eq!(
+            layout["configById"]["3D!arm"]["topics"][topic]["visible"], true,
+            "{topic} is not in the 3D panel"
+        );
+    }
     // The five figures, the timing and the arm.
     for id in [
         "positions",
