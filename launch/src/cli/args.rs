@@ -124,20 +124,15 @@ fn parse_external_law(s: &str) -> Result<(String, String), String> {
     Ok((name.to_string(), cmd.to_string()))
 }
 
-/// A run folder's name: one path component of printable characters.
+/// A run folder's name: one path component of printable characters
+/// (`launcher::run::run_name_problem`).
 fn parse_run_name(s: &str) -> Result<String, String> {
-    let ok = !s.is_empty()
-        && s.len() <= 100
-        && s != "."
-        && s != ".."
-        && !s.contains('/')
-        && !s.chars().any(char::is_control);
-    if ok {
-        Ok(s.to_string())
-    } else {
-        Err(format!(
-            "{s:?} is not a folder name (1 to 100 printable characters, no '/', not . or ..)"
-        ))
+    match launcher::run::run_name_problem(s) {
+        None => Ok(s.to_string()),
+        Some(why) => {
+            let shown: String = s.chars().take(40).collect();
+            Err(format!("{shown:?} is not a run folder name: {why}"))
+        }
     }
 }
 

@@ -21,12 +21,53 @@ pub(super) struct RunFiles {
     pub(super) configs: Vec<(NodeKind, PathBuf)>,
 }
 
+/// The most characters of a run folder's name (`--name`).
+pub const MAX_RUN_NAME_CHARS: usize = 100;
+/// The most bytes of a run folder's name: a file name's limit on Linux.
+const MAX_RUN_NAME_BYTES: usize = 255;
+
+/// Why `name` cannot name a run's folder (`--name`), if it cannot: one
+/// path component of 1 to [`MAX_RUN_NAME_CHARS`] characters (and at most
+/// 255 bytes), no '/', not `.` or `..`, no control or bidirectional
+/// formatting character (U+202E made `run\u{202E}txt.mcap` read as
+/// another name).
+pub fn run_name_problem(name: &str) -> Option<String> {
+    let chars = name.chars().count();
+    if name.is_empty() || name == "." || name == ".." {
+        return Some("1 to 100 characters, not . or ..".into());
+    }
+    if chars > MAX_RUN_NAME_CHARS {
+        return Some(format!("{chars} characters: at most {MAX_RUN_NAME_CHARS}"));
+    }
+    if name.len() > MAX_RUN_NAME_BYTES {
+        return Some(format!(
+            "{} bytes in UTF-8: a file name holds at most {MAX_RUN_NAME_BYTES}",
+            name.len()
+        ));
+    }
+    if name.contains('/') {
+        return Some("one folder name: no '/'".into());
+    }
+    wire::forbidden_name_char(name).map(|c| {
+        format!(
+            "it holds {}: no control or bidirectional formatting character",
+            wire::describe_char(c)
+        )
+    })
+}
+
 /// Makes the run's folder under `runs_dir`: `name`, or a fresh id (with a
 /// suffix when a run of this process made one the same second). A folder
 /// is never reused: an earlier run's files stay as they are.
 fn new_folder(runs_dir: &Path, name: Option<&str>) -> Result<PathBuf, RunError> {
     let fail = |p: &Path, e: std::io::Error| RunError::Output(p.display().to_string(), e);
     let id = run_id();
+    if let Some(why) = name.and_then(run_name_problem) {
+        return Err(fail(
+            runs_dir,
+            std::io::Error::new(std::io::ErrorKind::InvalidInput, format!("--name: {why}")),
+        ));
+    }
     let tries: Vec<String> = match name {
         Some(n) => vec![n.to_string()],
         None => std::iter::once(id.clone())
@@ -121,5 +162,36 @@ impl RunFiles {
             log,
             configs,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// #48 item 16: the limit counts characters (100 of 'é' is 200 bytes
+    /// and a name), and a bidirectional override or a control character
+    /// is refused naming it.
+    #[test]
+    fn a_run_name_is_counted_in_characters_and_plain() {
+        assert_eq!(run_name_problem("my-run"), None);
+        assert_eq!(run_name_problem(&"é".repeat(100)), None);
+        let e = run_name_problem(&"é".repeat(101)).unwrap();
+        assert!(e.contains("101 characters: at most 100"), "{e}");
+        let e = run_name_problem(&"😀".repeat(70)).unwrap();
+        assert!(e.contains("280 bytes"), "{e}");
+        let e = run_name_problem("run\u{202E}lmth.mcap").unwrap();
+        assert!(e.contains("U+202E"), "{e}");
+        let e = run_name_problem("a\tb").unwrap();
+        assert!(e.contains("U+0009"), "{e}");
+        for bad in ["", ".", "..", "a/b"] {
+            assert!(run_name_problem(bad).is_some(), "{bad:?}");
+        }
+        // The library refuses it too (Python's callers, not only the CLI).
+        let dir = tempfile::tempdir().unwrap();
+        let e = new_folder(dir.path(), Some("x\u{2066}"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--name") && e.contains("U+2066"), "{e}");
     }
 }

@@ -11,6 +11,7 @@ mod supervise;
 mod transport;
 
 pub use error::RunError;
+pub use files::{MAX_RUN_NAME_CHARS, run_name_problem};
 
 use std::fs::File;
 use std::io::BufWriter;
