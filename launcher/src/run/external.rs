@@ -228,15 +228,37 @@ fn describe(command: &[String]) -> Result<Option<String>, RunError> {
     };
     let mut out = String::new();
     let stdout = child.stdout.take();
+    // Set once more than MAX_DESCRIPTION bytes came: the command is then
+    // ended at once (its next write would block on the unread pipe).
+    let over = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let over_seen = std::sync::Arc::clone(&over);
     let reader = std::thread::spawn(move || {
         let mut text = Vec::new();
         if let Some(s) = stdout {
-            let _ = s.take(MAX_DESCRIPTION).read_to_end(&mut text);
+            let _ = s.take(MAX_DESCRIPTION + 1).read_to_end(&mut text);
+        }
+        if text.len() as u64 > MAX_DESCRIPTION {
+            over_seen.store(true, std::sync::atomic::Ordering::Relaxed);
         }
         String::from_utf8_lossy(&text).into_owned()
     });
+    let too_long = || {
+        refused(
+            command,
+            format!(
+                "`--describe` printed more than {} KiB ({MAX_DESCRIPTION} bytes), the most a \
+                 description may be",
+                MAX_DESCRIPTION / 1024
+            ),
+        )
+    };
     let start = Instant::now();
     let status = loop {
+        if over.load(std::sync::atomic::Ordering::Relaxed) {
+            end_group(&mut tree);
+            let _ = child.wait();
+            return Err(too_long());
+        }
         if let Some(status) = child
             .try_wait()
             .map_err(|e| refused(command, e.to_string()))?
@@ -267,6 +289,9 @@ fn describe(command: &[String]) -> Result<Option<String>, RunError> {
         && let Ok(text) = reader.join()
     {
         out = text;
+    }
+    if over.load(std::sync::atomic::Ordering::Relaxed) {
+        return Err(too_long());
     }
     Ok(status.success().then_some(out))
 }
@@ -307,5 +332,30 @@ mod tests {
         assert!(e.unwrap_err().contains("at most 32"));
         assert!(same_kind(&Value::from(1), &Value::from(0.5)));
         assert!(!same_kind(&Value::from(true), &Value::from(0.5)));
+    }
+
+    /// #48 item 16: a description over the 64 KiB read is refused naming
+    /// the limit (it was cut there and said "EOF while parsing"), also one
+    /// that never ends (`yes`), which is ended at the limit; one under it
+    /// is read whole.
+    #[test]
+    fn a_description_over_the_limit_is_named() {
+        let sh = |script: String| vec!["sh".to_string(), "-c".to_string(), script, "sh".into()];
+        let padded = |n: usize| {
+            sh(format!(
+                "head -c {n} /dev/zero | tr '\\0' ' '; echo '{{\"name\": \"big\"}}'"
+            ))
+        };
+        let d = declared(&padded(60_000), &toml::Table::new(), 2)
+            .unwrap()
+            .unwrap();
+        assert_eq!(d.name, "big");
+        // `yes` alone would refuse the appended `--describe`.
+        for command in [padded(70_000), sh("yes".into())] {
+            let e = declared(&command, &toml::Table::new(), 2)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("more than 64 KiB (65536 bytes)"), "{e}");
+        }
     }
 }
