@@ -288,6 +288,76 @@ fn compare_refuses_two_rows_of_one_name() {
     assert!(e.contains("nac is a built-in law's name"), "{e}");
 }
 
+/// Item 16: a user's controller (a policy) that raises fails its row
+/// with one line, the exception, not the traceback with its file paths,
+/// which stay in the run's nodes/controller.log.
+#[test]
+fn a_failing_policys_traceback_stays_out_of_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("policy.sh");
+    std::fs::write(
+        &script,
+        "case \"$1\" in --describe) exit 1;; esac\n\
+         printf 'Traceback (most recent call last):\\n' >&2\n\
+         printf '  File \"/home/me/secret/policy.py\", line 3, in <module>\\n' >&2\n\
+         printf 'ValueError: bad weights\\n' >&2\n\
+         exit 1\n",
+    )
+    .unwrap();
+    let cmd = format!("pol=sh {}", script.display());
+    let out = testbed()
+        .args([
+            "compare",
+            "--duration",
+            "0.1",
+            "--seeds",
+            "1",
+            "--laws",
+            "pd",
+        ])
+        .args(["--json", "--controller-cmd", &cmd, "--runs-dir"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let c = crate::util::json(&out);
+    let row = c["laws"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["name"] == "pol")
+        .unwrap_or_else(|| panic!("no row pol: {c}"));
+    let why = row["runs"][0]["failed"].as_str().unwrap_or_default();
+    assert!(why.contains("ValueError: bad weights"), "{why}");
+    assert!(
+        !why.contains("/home/me/secret") && !why.contains("Traceback") && !why.contains('\n'),
+        "{why}"
+    );
+    // The whole text is in the node's log.
+    let logs: Vec<String> = walk(dir.path())
+        .into_iter()
+        .filter(|p| p.ends_with("nodes/controller.log"))
+        .map(|p| std::fs::read_to_string(p).unwrap())
+        .collect();
+    assert!(
+        logs.iter().any(|l| l.contains("/home/me/secret/policy.py")),
+        "{logs:?}"
+    );
+}
+
+/// Every file under `dir`.
+fn walk(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
+}
+
 /// Copies the MCAP log `from` to `to` with every message of `topic`
 /// written after all the others, as a tool that writes one channel at a
 /// time would: the log is whole, only its order changes.

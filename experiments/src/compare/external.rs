@@ -63,7 +63,9 @@ pub(crate) fn external_row(
                 )
             }
             Err(e) => {
-                let why = format!("the run failed: {e}");
+                // One line: a policy's traceback with its paths stays in
+                // the run's nodes/controller.log (#48 item 16).
+                let why = format!("the run failed: {}", e.brief());
                 let names = plan.robot.model.joint_names();
                 let empty = SummaryBuilder::new(names, plan.dt(), plan.scenario.controller.tc);
                 let mut run = scored(

@@ -149,6 +149,40 @@ impl RunError {
     }
 }
 
+/// The most characters of a failed run's reason in a table or JSON.
+pub const BRIEF_CHARS: usize = 200;
+
+impl RunError {
+    /// Why the run failed in one line, for a table's `failed` field: a
+    /// node's end with the last line it wrote (a Python traceback's last
+    /// line is the exception), never the traceback with its file paths;
+    /// the whole text is in the run folder's `nodes/<node>.log`. Other
+    /// failures are their message's first line. Cut to [`BRIEF_CHARS`].
+    pub fn brief(&self) -> String {
+        let text = match self {
+            RunError::NodeFailed { node, how, stderr } => {
+                let last = stderr
+                    .lines()
+                    .map(str::trim)
+                    .rfind(|l| !l.is_empty())
+                    .map(|l| format!(": {l}"))
+                    .unwrap_or_default();
+                format!("the {node} node {how}{last} (whole output: nodes/{node}.log of the run)")
+            }
+            other => other
+                .to_string()
+                .lines()
+                .next()
+                .unwrap_or_default()
+                .to_string(),
+        };
+        match text.char_indices().nth(BRIEF_CHARS) {
+            None => text,
+            Some((at, _)) => format!("{}…", &text[..at]),
+        }
+    }
+}
+
 impl RunError {
     /// A node that reported a failure has usually exited by the time every
     /// node was stopped: its last stderr lines say why.
@@ -164,5 +198,41 @@ impl RunError {
             }
             other => other,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// #48 item 16: a user's policy that raised keeps one line in a
+    /// table, the exception, not the traceback and its paths.
+    #[test]
+    fn a_failed_nodes_brief_is_its_last_line() {
+        let e = RunError::NodeFailed {
+            node: "controller",
+            how: "exited with status 1".into(),
+            stderr: "Traceback (most recent call last):\n  File \"/home/me/secret/policy.py\", \
+                     line 3, in <module>\n    raise ValueError('bad weights')\n\
+                     ValueError: bad weights\n\n"
+                .into(),
+        };
+        let b = e.brief();
+        assert_eq!(
+            b,
+            "the controller node exited with status 1: ValueError: bad weights \
+             (whole output: nodes/controller.log of the run)"
+        );
+        assert!(e.to_string().contains("/home/me/secret"));
+        let long = RunError::NodeFailed {
+            node: "controller",
+            how: "exited".into(),
+            stderr: "x".repeat(10_000),
+        };
+        assert_eq!(long.brief().chars().count(), BRIEF_CHARS + 1);
+        let other = RunError::Scenario {
+            reason: "first\nsecond".into(),
+        };
+        assert_eq!(other.brief(), "first");
     }
 }
