@@ -36,7 +36,13 @@ pub struct SlurmScript {
     pub tasks: usize,
     /// Runs still missing in the folder.
     pub missing: usize,
+    /// What was changed from the options given (more tasks than runs).
+    pub note: Option<String>,
 }
+
+/// The most CPUs a task asks for: more than a node has is a typo, and
+/// Slurm would keep such a job pending for ever.
+pub const MAX_CPUS_PER_TASK: usize = 1024;
 
 /// Writes `DIR/manifest.json` and `DIR/sweep.sbatch`.
 pub fn write(sweep: &Sweep, dir: &Path, opts: &SlurmOptions) -> Result<SlurmScript, SweepError> {
@@ -44,6 +50,12 @@ pub fn write(sweep: &Sweep, dir: &Path, opts: &SlurmOptions) -> Result<SlurmScri
         return Err(SweepError::Options(
             "--tasks, --max-running and --cpus-per-task must be at least 1".into(),
         ));
+    }
+    if opts.cpus_per_task > MAX_CPUS_PER_TASK {
+        return Err(SweepError::Options(format!(
+            "--cpus-per-task {}: at most {MAX_CPUS_PER_TASK} (CPUs of one node)",
+            opts.cpus_per_task
+        )));
     }
     check_values(opts, dir)?;
     open_folder(dir, &Manifest::of(sweep))?;
@@ -53,7 +65,19 @@ pub fn write(sweep: &Sweep, dir: &Path, opts: &SlurmOptions) -> Result<SlurmScri
         .iter()
         .filter(|r| !done.contains_key(&r.key))
         .count();
-    let tasks = opts.tasks.unwrap_or(sweep.runs.len().clamp(1, 1000));
+    let runs = sweep.runs.len().max(1);
+    // A task beyond the runs would run nothing (100 000 tasks for 3 runs
+    // asked Slurm for 99 997 empty jobs).
+    let (tasks, note) = match opts.tasks {
+        None => (runs.min(1000), None),
+        Some(n) if n > runs => (
+            runs,
+            Some(format!(
+                "--tasks {n} is more than the sweep's {runs} runs: {runs} tasks, one run each"
+            )),
+        ),
+        Some(n) => (n, None),
+    };
     let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
     let (file, out, bin) = (abs(&sweep.path), abs(dir), abs(&opts.testbed));
     let mut s = String::from("#!/bin/bash\n");
@@ -93,6 +117,7 @@ pub fn write(sweep: &Sweep, dir: &Path, opts: &SlurmOptions) -> Result<SlurmScri
         path,
         tasks,
         missing,
+        note,
     })
 }
 
@@ -156,5 +181,44 @@ mod tests {
     fn paths_are_quoted_for_the_shell() {
         assert_eq!(quote(Path::new("/a b/it's")), "'/a b/it'\\''s'");
         assert_eq!(sanitize("paper gains!"), "paper_gains_");
+    }
+
+    /// #48 item 16: more tasks than runs are cut to the runs, said in a
+    /// note (100 000 tasks for 3 runs were written as asked), and
+    /// `--cpus-per-task` past [`MAX_CPUS_PER_TASK`] is refused naming the flag.
+    #[test]
+    fn tasks_are_at_most_the_runs_and_cpus_bounded() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("s.toml");
+        std::fs::write(&file, "name = \"three\"\nscenario = \"paper\"\nseeds = 3\n").unwrap();
+        let sweep = scenario::sweep_file::load(&file).unwrap();
+        assert_eq!(sweep.runs.len(), 3);
+        let opts = |tasks: Option<usize>, cpus: usize| SlurmOptions {
+            tasks,
+            max_running: 16,
+            cpus_per_task: cpus,
+            partition: None,
+            time: None,
+            testbed: PathBuf::from("/bin/testbed"),
+        };
+        let out = dir.path().join("out");
+        let w = write(&sweep, &out, &opts(Some(100_000), 1)).unwrap();
+        assert_eq!(w.tasks, 3);
+        assert!(w.note.unwrap().contains("--tasks 100000"));
+        let script = std::fs::read_to_string(&w.path).unwrap();
+        assert!(
+            script.contains("--array=0-2%16") && script.contains("--tasks 3"),
+            "{script}"
+        );
+        let w = write(&sweep, &out, &opts(Some(2), 1)).unwrap();
+        assert_eq!((w.tasks, w.note), (2, None));
+        let e = write(&sweep, &out, &opts(None, 99_999_999_999))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--cpus-per-task 99999999999: at most 1024"),
+            "{e}"
+        );
+        assert!(write(&sweep, &out, &opts(None, MAX_CPUS_PER_TASK)).is_ok());
     }
 }

@@ -65,13 +65,14 @@ pub(crate) struct SweepSlurmArgs {
     /// Results folder, shared by the tasks (default: `runs/sweep-<name>`).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
-    /// Array tasks [default: one per run, at most 1000].
+    /// Array tasks [default: one per run, at most 1000; more than the runs
+    /// are cut to one per run, with a note].
     #[arg(long, value_name = "N")]
     tasks: Option<usize>,
     /// Tasks running at once (the array's %M).
     #[arg(long, value_name = "M", default_value_t = 16)]
     max_running: usize,
-    /// CPUs per task.
+    /// CPUs per task (at most 1024).
     #[arg(long, value_name = "C", default_value_t = 1)]
     cpus_per_task: usize,
     /// Slurm partition.
@@ -176,6 +177,9 @@ fn slurm_cmd(a: SweepSlurmArgs) -> Result<ExitCode> {
         testbed,
     };
     let w = slurm::write(&s, &dir, &opts)?;
+    if let Some(note) = &w.note {
+        eprintln!("testbed: note: {note}");
+    }
     super::write_stdout(&format!("{}\n", w.path.display()))?;
     eprintln!(
         "testbed: {} runs in {} array tasks, {} missing; submit with: sbatch {}",
