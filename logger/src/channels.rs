@@ -42,6 +42,15 @@ impl ChannelSpec {
         }
     }
 
+    /// The robot model's latched channel (`std_msgs/msg/String`).
+    pub fn robot_description() -> Self {
+        Self::standard(
+            ros2::ROBOT_DESCRIPTION_TOPIC,
+            ros2::STRING,
+            ros2::string_schema(),
+        )
+    }
+
     fn standard(topic: &'static str, name: &str, schema: String) -> Self {
         Self {
             topic,
@@ -78,6 +87,7 @@ pub fn channels() -> Vec<ChannelSpec> {
             ros2::MARKER_ARRAY,
             ros2::marker_array_schema(),
         ),
+        ChannelSpec::robot_description(),
     ]);
     all
 }

@@ -298,6 +298,33 @@ impl McapOut {
         });
     }
 
+    /// Every channel as rosbag2 lists it (topic, type, encoding, offered
+    /// QoS, messages so far), and the log times of the messages in closed
+    /// chunks (0, 0 with none).
+    pub(crate) fn bag_topics(&self) -> (Vec<crate::ros2::BagTopic>, (u64, u64)) {
+        let topics = self
+            .channels
+            .iter()
+            .map(|c| crate::ros2::BagTopic {
+                name: c.topic.clone(),
+                type_name: self
+                    .schemas
+                    .iter()
+                    .find(|s| s.0 == c.schema_id)
+                    .map(|s| s.1.clone())
+                    .unwrap_or_default(),
+                serialization_format: c.encoding.clone(),
+                offered_qos_profiles: c
+                    .metadata
+                    .get("offered_qos_profiles")
+                    .cloned()
+                    .unwrap_or_default(),
+                message_count: c.messages,
+            })
+            .collect();
+        (topics, self.bounds_all.unwrap_or((0, 0)))
+    }
+
     /// The open chunk's size, uncompressed.
     pub(crate) fn chunk_len(&self) -> usize {
         self.chunk.len()

@@ -199,7 +199,12 @@ pub fn run(link: &mut NodeLink, config: &LoggerNodeConfig) -> Result<(), LoggerN
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_nanos() as u64);
     let log = LogWriter::create_with(&config.out, &meta, &config.urdf, config.compression)?;
-    let mut out = Outputs::open(log, &model, (&config.obstacles, &config.objects), live)?;
+    let mut out = Outputs::open(
+        log,
+        (&model, &config.urdf),
+        (&config.obstacles, &config.objects),
+        live,
+    )?;
 
     let started = link.ready_and_wait_for_start();
     let result: Result<(), LoggerNodeError> = match started {

@@ -10,6 +10,7 @@ use wire::{Command, ContactState, JointState, Logged};
 use crate::obstacles::{CONTACT_MARKER_TOPIC, DrawnObstacle, DrawnShape, contact_marker};
 
 use crate::live::LiveView;
+use crate::ros2::ROBOT_DESCRIPTION_TOPIC;
 use crate::scene::{ArmScene, SCENE_TOPIC, TRANSFORMS_TOPIC};
 use crate::{JOINT_COMMANDS_TOPIC, JOINT_STATES_TOPIC, LogError, LogMessage, LogWriter, channels};
 
@@ -48,6 +49,11 @@ pub(crate) struct Outputs {
     objects: Vec<DrawnShape>,
     /// A derived message's CDR, reused.
     buf: Vec<u8>,
+    /// The model as a `std_msgs/msg/String` (`/robot_description`): in the
+    /// log once (the writer's), offered live with the figure every second,
+    /// so that a viewer that joins late finds it (the live server has no
+    /// latching).
+    description: Vec<u8>,
 }
 
 impl Outputs {
@@ -55,7 +61,7 @@ impl Outputs {
     /// topic stays silent).
     pub(crate) fn open(
         mut log: LogWriter,
-        model: &ArmModel,
+        (model, urdf): (&ArmModel, &str),
         (obstacles, objects): (&[DrawnObstacle], &[DrawnShape]),
         live: Option<Box<dyn LiveView>>,
     ) -> Result<Self, LogError> {
@@ -86,6 +92,11 @@ impl Outputs {
             next_contact_view_ns: 0,
             objects: objects.to_vec(),
             buf: Vec::with_capacity(4096),
+            description: {
+                let mut d = Vec::with_capacity(urdf.len() + 16);
+                crate::ros2::string_message(&mut d, urdf);
+                d
+            },
         })
     }
 
@@ -154,6 +165,9 @@ impl Outputs {
             self.buf.clear();
             self.arm.scene(&mut self.buf, t);
             self.emit(SCENE_TOPIC, t, wall)?;
+            if let Some(live) = self.live.as_mut() {
+                live.offer(ROBOT_DESCRIPTION_TOPIC, t, &self.description);
+            }
         }
         Ok(())
     }

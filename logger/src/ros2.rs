@@ -14,8 +14,11 @@
 //!
 //! Beside them the log carries standard messages for the tools that know
 //! only those: `sensor_msgs/msg/JointState` for the states and the
-//! commands, `tf2_msgs/msg/TFMessage` for the arm's frames and
-//! `visualization_msgs/msg/MarkerArray` for its stick figure.
+//! commands, `tf2_msgs/msg/TFMessage` for the arm's frames,
+//! `visualization_msgs/msg/MarkerArray` for its stick figure and
+//! `std_msgs/msg/String` for the model (`/robot_description`, latched);
+//! and what rosbag2 reads besides: each channel's offered QoS and the
+//! `rosbag2` metadata record ([`rosbag2_metadata`]).
 
 use wire::FieldRef;
 
@@ -55,10 +58,11 @@ const HEADER_DEPS: [(&str, &str); 2] = [
 ];
 
 /// The QoS a rosbag2 recording gives each topic, as its channel's
-/// `offered_qos_profiles` (YAML, Humble's numeric form, which Jazzy reads
-/// too): reliable, volatile, automatic liveliness, no deadline, lifespan
-/// or lease (the largest durations, rmw's "infinite"). `ros2 bag play`
-/// re-offers each topic with it.
+/// `offered_qos_profiles` (YAML in the numeric form of rosbag2's metadata
+/// version 8, which Humble writes and, with the [`ROSBAG2_METADATA`]
+/// record saying version 8, Jazzy reads): reliable, volatile, automatic
+/// liveliness, no deadline, lifespan or lease (the largest durations,
+/// rmw's "infinite"). `ros2 bag play` re-offers each topic with it.
 pub const OFFERED_QOS_PROFILES: &str = "- history: 3
   depth: 0
   reliability: 1
@@ -76,12 +80,128 @@ pub const OFFERED_QOS_PROFILES: &str = "- history: 3
   avoid_ros_namespace_conventions: false
 ";
 
-/// A channel's metadata as rosbag2 writes it.
-pub fn channel_metadata() -> std::collections::BTreeMap<String, String> {
-    std::collections::BTreeMap::from([(
-        "offered_qos_profiles".to_string(),
-        OFFERED_QOS_PROFILES.to_string(),
-    )])
+/// The QoS of a latched topic ([`ROBOT_DESCRIPTION_TOPIC`]), as
+/// robot_state_publisher offers `/robot_description`: keep last 1,
+/// reliable, transient local (durability 1), so that a subscriber that
+/// joins late (Foxglove's 3D panel, `ros2 bag play`'s listeners) gets it.
+pub const LATCHED_QOS_PROFILES: &str = "- history: 1
+  depth: 1
+  reliability: 1
+  durability: 1
+  deadline:
+    sec: 2147483647
+    nsec: 4294967295
+  lifespan:
+    sec: 2147483647
+    nsec: 4294967295
+  liveliness: 1
+  liveliness_lease_duration:
+    sec: 2147483647
+    nsec: 4294967295
+  avoid_ros_namespace_conventions: false
+";
+
+/// The robot model as ROS 2 publishes it: the URDF text, latched.
+pub const ROBOT_DESCRIPTION_TOPIC: &str = "/robot_description";
+
+/// The channel metadata of `topic` as rosbag2 writes it: its offered QoS
+/// (latched for [`ROBOT_DESCRIPTION_TOPIC`]).
+pub fn channel_metadata(topic: &str) -> std::collections::BTreeMap<String, String> {
+    let qos = if topic == ROBOT_DESCRIPTION_TOPIC {
+        LATCHED_QOS_PROFILES
+    } else {
+        OFFERED_QOS_PROFILES
+    };
+    std::collections::BTreeMap::from([("offered_qos_profiles".to_string(), qos.to_string())])
+}
+
+/// Name of the metadata record rosbag2's MCAP storage plugin reads the
+/// bag's metadata from (`serialized_metadata`, YAML of its `BagMetadata`).
+/// Without it Jazzy took the channels' QoS to be in version 9's text form
+/// and read every one as "unknown".
+pub const ROSBAG2_METADATA: &str = "rosbag2";
+/// The `BagMetadata` version the record declares: 8, whose QoS profiles
+/// are numeric, as [`OFFERED_QOS_PROFILES`] is (9 spells them as words,
+/// which Humble cannot read).
+pub const BAG_METADATA_VERSION: u32 = 8;
+/// The ROS 2 distribution the record names.
+pub const ROS_DISTRO: &str = "jazzy";
+
+/// One channel as the `rosbag2` record lists it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BagTopic {
+    /// The topic.
+    pub name: String,
+    /// Its ROS 2 type (`sensor_msgs/msg/JointState`).
+    pub type_name: String,
+    /// Its message encoding (`cdr`).
+    pub serialization_format: String,
+    /// Its `offered_qos_profiles` (YAML text).
+    pub offered_qos_profiles: String,
+    /// Messages written on it.
+    pub message_count: u64,
+}
+
+/// The `rosbag2` metadata record of a log named `file` (its file name)
+/// whose messages span `start_ns..=end_ns` of log time: every key Jazzy's
+/// `BagMetadata` decoder reads (version, storage_identifier, duration,
+/// starting_time, message_count, topics_with_message_count,
+/// compression_format, compression_mode, relative_file_paths, files,
+/// custom_data, ros_distro) as `serialized_metadata`, and `ROS_DISTRO` as
+/// Iron's plugin wrote it. Strings are YAML double-quoted scalars.
+pub fn rosbag2_metadata(
+    file: &str,
+    topics: &[BagTopic],
+    (start_ns, end_ns): (u64, u64),
+) -> std::collections::BTreeMap<String, String> {
+    let q = |s: &str| serde_json::Value::from(s).to_string();
+    let duration = end_ns.saturating_sub(start_ns);
+    let count: u64 = topics.iter().map(|t| t.message_count).sum();
+    let mut y = format!(
+        "version: {BAG_METADATA_VERSION}\nstorage_identifier: {}\nduration:\n  nanoseconds: {duration}\n\
+         starting_time:\n  nanoseconds_since_epoch: {start_ns}\nmessage_count: {count}\n",
+        q("mcap")
+    );
+    if topics.is_empty() {
+        y.push_str("topics_with_message_count: []\n");
+    } else {
+        y.push_str("topics_with_message_count:\n");
+    }
+    for t in topics {
+        y.push_str(&format!(
+            "  - topic_metadata:\n      name: {}\n      type: {}\n      serialization_format: {}\n\
+             \x20     offered_qos_profiles: {}\n      type_description_hash: \"\"\n    message_count: {}\n",
+            q(&t.name),
+            q(&t.type_name),
+            q(&t.serialization_format),
+            q(&t.offered_qos_profiles),
+            t.message_count
+        ));
+    }
+    y.push_str(&format!(
+        "compression_format: \"\"\ncompression_mode: \"\"\nrelative_file_paths:\n  - {f}\nfiles:\n  - path: {f}\n\
+         \x20   starting_time:\n      nanoseconds_since_epoch: {start_ns}\n    duration:\n      nanoseconds: {duration}\n\
+         \x20   message_count: {count}\ncustom_data: {{}}\nros_distro: {}\n",
+        q(ROS_DISTRO),
+        f = q(file),
+    ));
+    std::collections::BTreeMap::from([
+        ("serialized_metadata".to_string(), y),
+        ("ROS_DISTRO".to_string(), ROS_DISTRO.to_string()),
+    ])
+}
+
+/// `std_msgs/msg/String`.
+pub const STRING: &str = "std_msgs/msg/String";
+
+/// The schema of [`STRING`].
+pub fn string_schema() -> String {
+    "string data\n".to_string()
+}
+
+/// A `std_msgs/msg/String` holding `text`.
+pub fn string_message(out: &mut Vec<u8>, text: &str) {
+    CdrWriter::new(out).string(text);
 }
 
 /// The `testbed_msgs/msg/<Name>` name of a wire message.
@@ -122,6 +242,11 @@ pub fn msg_text<M: LogMessage>() -> String {
         s.push_str(name);
         match f {
             FieldRef::J(_) => s.push_str("  # one entry per joint, in joint order"),
+            // ContactState's values are poses, OwnDiagnostics' the
+            // controller's own diagnostics (#48 item 17).
+            FieldRef::V(_) if name == "objects" => s.push_str(
+                "  # each free object's pose, world frame: x, y, z (m), then the quaternion x, y, z, w; 7 values per object",
+            ),
             FieldRef::V(_) => s.push_str("  # the declared diagnostics' values, in order"),
             _ => {}
         }

@@ -174,13 +174,25 @@ impl LogWriter {
                 urdf.as_bytes(),
             )
             .map_err(io)?;
-        Ok(Self {
+        let mut log = Self {
             writer,
             path: path.to_path_buf(),
             channels: Vec::new(),
             last_flush: Instant::now(),
             scratch: Vec::with_capacity(4096),
-        })
+        };
+        // The model on its latched topic, once, at the run's start: where
+        // Foxglove's 3D panel and robot_state_publisher look for it.
+        log.add_channel_spec(&ChannelSpec::robot_description())?;
+        let mut data = Vec::with_capacity(urdf.len() + 16);
+        crate::ros2::string_message(&mut data, urdf);
+        log.write_raw(
+            crate::ros2::ROBOT_DESCRIPTION_TOPIC,
+            0,
+            meta.start_time_unix_ns,
+            &data,
+        )?;
+        Ok(log)
     }
 
     /// The file being written.
@@ -218,7 +230,7 @@ impl LogWriter {
                 schema_id,
                 spec.topic,
                 MESSAGE_ENCODING,
-                &crate::ros2::channel_metadata(),
+                &crate::ros2::channel_metadata(spec.topic),
             )
             .map_err(self.err())?;
         self.channels.push((spec.topic, id, 0));
@@ -282,11 +294,21 @@ impl LogWriter {
         res.map_err(self.err())
     }
 
-    /// Writes the `testbed.log_stats` record, the summary and the footer.
+    /// Writes the `rosbag2` and `testbed.log_stats` records, the summary
+    /// and the footer.
     pub fn finish(mut self, stats: BTreeMap<String, String>) -> Result<(), LogError> {
+        let res = self.writer.close_chunk();
+        res.map_err(self.err())?;
+        let (topics, span) = self.writer.bag_topics();
+        let file = self
+            .path
+            .file_name()
+            .map(|f| f.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let bag = crate::ros2::rosbag2_metadata(&file, &topics, span);
         let res = self
             .writer
-            .close_chunk()
+            .metadata(crate::ros2::ROSBAG2_METADATA, &bag)
             .and_then(|()| self.writer.metadata(STATS_METADATA, &stats));
         res.map_err(self.err())?;
         let path = self.path.display().to_string();

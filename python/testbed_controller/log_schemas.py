@@ -21,7 +21,7 @@ SCHEMAS = {
   ],
   "/contact": [
     "testbed_msgs/msg/ContactState",
-    "# What contact did over the period that led to the state with the same seq:\n# contact points, the mean contact force on the arm (N) and the deepest point\n# (world frame, m). Only a plant with [plant.contact] publishes it.\n# Generated from the wire's field list (crate wire, data_message!): do not edit.\n\nstd_msgs/Header header  # stamp: the sample's sim time; frame_id empty\nuint64 seq  # sequence number (the control step for step-aligned topics)\nuint64 wall_ns  # CLOCK_MONOTONIC when published, ns\nuint32 points\nuint32 count\nfloat64 force\nfloat64 point_x\nfloat64 point_y\nfloat64 point_z\nfloat64[] objects  # the declared diagnostics' values, in order\n================================================================================\nMSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n================================================================================\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
+    "# What contact did over the period that led to the state with the same seq:\n# contact points, the mean contact force on the arm (N) and the deepest point\n# (world frame, m). Only a plant with [plant.contact] publishes it.\n# Generated from the wire's field list (crate wire, data_message!): do not edit.\n\nstd_msgs/Header header  # stamp: the sample's sim time; frame_id empty\nuint64 seq  # sequence number (the control step for step-aligned topics)\nuint64 wall_ns  # CLOCK_MONOTONIC when published, ns\nuint32 points\nuint32 count\nfloat64 force\nfloat64 point_x\nfloat64 point_y\nfloat64 point_z\nfloat64[] objects  # each free object's pose, world frame: x, y, z (m), then the quaternion x, y, z, w; 7 values per object\n================================================================================\nMSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n================================================================================\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
   ],
   "/controller/diagnostics": [
     "testbed_msgs/msg/ControllerDiagnostics",
@@ -46,6 +46,10 @@ SCHEMAS = {
   "/reference": [
     "testbed_msgs/msg/Reference",
     "# The reference q_d and the constraint envelope k_c at time t.\n# Generated from the wire's field list (crate wire, data_message!): do not edit.\n\nstd_msgs/Header header  # stamp: the sample's sim time; frame_id empty\nuint64 seq  # sequence number (the control step for step-aligned topics)\nuint64 wall_ns  # CLOCK_MONOTONIC when published, ns\nuint32 dof\nfloat64[] q_d  # one entry per joint, in joint order\nfloat64[] qd_d  # one entry per joint, in joint order\nfloat64[] qdd_d  # one entry per joint, in joint order\nfloat64[] kc  # one entry per joint, in joint order\nfloat64[] kc_dot  # one entry per joint, in joint order\n================================================================================\nMSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n================================================================================\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
+  ],
+  "/robot_description": [
+    "std_msgs/msg/String",
+    "string data\n"
   ],
   "/tf": [
     "tf2_msgs/msg/TFMessage",
