@@ -41,10 +41,11 @@ impl Visitor<'_> for SeedVisitor {
 
     fn visit_str<E: de::Error>(self, v: &str) -> Result<u64, E> {
         let t = v.trim();
-        if !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit()) {
-            if let Ok(seed) = t.parse::<u64>() {
-                return Ok(seed);
-            }
+        if !t.is_empty()
+            && t.bytes().all(|b| b.is_ascii_digit())
+            && let Ok(seed) = t.parse::<u64>()
+        {
+            return Ok(seed);
         }
         let shown: String = v.chars().take(40).collect();
         Err(E::custom(format!("seed {shown:?}: expected {EXPECTED}")))
