@@ -601,7 +601,11 @@ mod tests {
             // A standard message (the model on /robot_description) is
             // only checked, so its schema is not kept.
             let own = m.topic != crate::ros2::ROBOT_DESCRIPTION_TOPIC;
-            assert_eq!(m.schema.is_some(), own, "a testbed message's schema is read");
+            assert_eq!(
+                m.schema.is_some(),
+                own,
+                "a testbed message's schema is read"
+            );
             if let Some(wire::Logged::JointState(s)) = crate::decode_logged(m)? {
                 seqs.push(s.header.seq);
             }
