@@ -17,6 +17,20 @@ pub enum ModelError {
     /// No `<link>` at all.
     #[error("the URDF has no links")]
     NoLinks,
+    /// A file that is XML but not a robot description.
+    #[error(
+        "the file's root element is <{root}>, not <robot> (URDF) or <mujoco> (MJCF): not a robot description"
+    )]
+    NotARobot {
+        /// The root element's name (cut to 80 characters).
+        root: String,
+    },
+    /// A file that is not XML at all.
+    #[error("not XML: {what}")]
+    NotXml {
+        /// What its first line is instead.
+        what: String,
+    },
     /// A joint names a link that does not exist.
     #[error("joint '{joint}': {role} link '{link}' does not exist")]
     MissingLink {

@@ -1,6 +1,7 @@
 //! Attributes `urdf-rs` requires that Pinocchio, MuJoCo and ROS do without:
 //! `<texture/>` and `<mesh/>` elements without a `filename` (romeo and icub
-//! in example-robot-data have a bare `<texture />` in their materials), and
+//! in example-robot-data have a bare `<texture />` in their materials), a
+//! visual's `<material>` without a `name` (a color given in place), and
 //! a joint `<limit>` without a `velocity`, an `<axis>` without `xyz`. None
 //! of them moves the arm (the testbed uses no joint velocity limit), so the
 //! missing attribute is filled before parsing (an empty name; a velocity of
@@ -11,8 +12,9 @@ use std::borrow::Cow;
 
 /// The elements whose attribute may be missing, the attribute, and what
 /// it is filled with.
-const FILLS: [(&str, &str, &str); 4] = [
+const FILLS: [(&str, &str, &str); 5] = [
     ("texture", "filename", ""),
+    ("material", "name", ""),
     ("mesh", "filename", ""),
     ("limit", "velocity", "0"),
     ("axis", "xyz", "0 0 0"),

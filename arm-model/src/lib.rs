@@ -36,12 +36,14 @@ mod extra_elements;
 mod file_refs;
 mod fold;
 mod inertia;
+mod link_children;
 mod mjcf;
 mod mjcf_include;
 mod mjcf_inertia;
 mod mjcf_joint_force;
 mod parse;
 mod prefixes;
+mod root_element;
 mod tree;
 mod xml_depth;
 
@@ -293,6 +295,7 @@ impl ArmModel {
                 cap: MAX_ATTRIBUTES,
             });
         }
+        root_element::check(text)?;
         let deepest = xml_depth::depth(text, xml_depth::MAX_XML_DEPTH);
         if deepest > xml_depth::MAX_XML_DEPTH {
             return Err(ModelError::Parse(format!(
@@ -311,6 +314,7 @@ impl ArmModel {
         // What is read past goes first: a removed <axis> needs no xyz.
         let (text, read_past) = extra_elements::remove_extra(&text);
         let (text, unnamed_files) = file_refs::fill_missing(&text);
+        let (text, gathered_links) = link_children::gather(&text);
         let robot = urdf_rs::read_from_string(&text).map_err(|e| {
             let said = e.to_string();
             ModelError::Parse(diagnose::diagnose(&text, &said).unwrap_or(said))
@@ -321,6 +325,11 @@ impl ArmModel {
                 format!(
                     "{n} joint <limit> element(s) without a velocity: read as none given \
                      (the testbed uses no joint velocity limit)"
+                )
+            } else if *element == "material" {
+                format!(
+                    "{n} <material> element(s) without a name: read with an empty name \
+                     (materials do not change the dynamics)"
                 )
             } else if *element == "axis" {
                 format!(
@@ -334,6 +343,15 @@ impl ArmModel {
                 )
             };
             model.notes.insert(0, note);
+        }
+        if gathered_links > 0 {
+            model.notes.insert(
+                0,
+                format!(
+                    "{gathered_links} link(s) list <visual> and <collision> elements interleaved: \
+                     each kind read in its own order, as urdfdom does"
+                ),
+            );
         }
         for note in read_past.into_iter().rev() {
             model.notes.insert(0, note);

@@ -108,7 +108,7 @@ pub enum ScenarioError {
     },
     /// The arm has more controlled joints than the wire carries.
     #[error(
-        "{file}: robot {robot} has {dof} controlled joints; the wire carries at most {max}: lock {excess} of them in [plant.lock] (e.g. {example} = 0.0; the joints past the {max}th are {beyond})",
+        "{file}: robot {robot} has {dof} controlled joints; the wire carries at most {max}: lock {excess} of them in [plant.lock] (e.g. {example} = 0.0; the joints past the first {max} are {beyond})",
         max = wire::MAX_DOF,
         excess = dof - wire::MAX_DOF
     )]

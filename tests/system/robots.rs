@@ -202,8 +202,22 @@ fn malformed_and_unsupported_urdfs_are_clear_errors() {
     let robot = |body: String| format!(r#"<robot name="r"><link name="base"/>{body}</robot>"#);
     let a = link("a", "1", good_i);
     let cases: Vec<(&str, String, &str)> = vec![
-        ("not_xml", "this is not xml".into(), "not a valid URDF"),
-        ("empty", String::new(), "not a valid URDF"),
+        (
+            "not_xml",
+            "this is not xml".into(),
+            "not XML: it starts with",
+        ),
+        ("empty", String::new(), "not XML: the file is empty"),
+        (
+            "merge_conflict",
+            "<<<<<<< HEAD\n<robot name=\"r\"/>\n".into(),
+            "line 1 is a merge-conflict marker",
+        ),
+        (
+            "launch_file",
+            "<launch><node name=\"n\"/></launch>".into(),
+            "root element is <launch>, not <robot>",
+        ),
         (
             "missing_parent",
             robot(format!("{a}{}", joint("j", "revolute", "ghost", "a", ""))),

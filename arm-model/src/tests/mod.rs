@@ -40,7 +40,7 @@ fn the_two_link_arm_reads_as_specified() {
 
 #[test]
 fn malformed_urdfs_are_named_errors() {
-    assert!(err("not xml at all").starts_with("not a valid URDF"));
+    assert!(err("not xml at all").starts_with("not XML: it starts with"));
     let missing = J1.replace("<child link=\"a\"/>", "<child link=\"ghost\"/>");
     assert_eq!(
         err(&arm(&missing, "")),
@@ -262,5 +262,37 @@ fn a_tag_with_too_many_attributes_is_refused_by_name() {
     assert!(
         got.starts_with("line 4: <origin> has 257 attributes or more, over the cap of 256"),
         "{got}"
+    );
+}
+
+/// #47 item 4: what urdfdom and Pinocchio read, found on public files: a
+/// link whose visuals and collisions interleave, and a visual's material
+/// given by colour with no name. Both read, with a note, and give the same
+/// model as the tidy file.
+#[test]
+fn interleaved_visuals_and_a_nameless_material_read_as_urdfdom_reads_them() {
+    let shapes = |order: &str| {
+        let v = r#"<visual><geometry><box size="0.1 0.1 0.1"/></geometry><material><color rgba="1 0 0 1"/></material></visual>"#;
+        let c = r#"<collision><geometry><sphere radius="0.05"/></geometry></collision>"#;
+        let body: String = order
+            .chars()
+            .map(|k| if k == 'v' { v } else { c })
+            .collect();
+        format!(
+            r#"<link name="b"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>{body}</link>"#
+        )
+    };
+    let joints = format!("{J1}{}", J1.replace("j1", "j2").replace("\"a\"", "\"b\""));
+    let messy = ArmModel::from_urdf_str(&arm(&joints, &shapes("vcvc"))).unwrap();
+    let tidy = ArmModel::from_urdf_str(&arm(&joints, &shapes("vvcc"))).unwrap();
+    assert_eq!(messy.links, tidy.links);
+    assert_eq!(messy.joints, tidy.joints);
+    let said = |m: &ArmModel, what: &str| m.notes.iter().any(|n| n.contains(what));
+    assert!(said(&messy, "interleaved"), "{:?}", messy.notes);
+    assert!(!said(&tidy, "interleaved"), "{:?}", tidy.notes);
+    assert!(
+        said(&tidy, "<material> element(s) without a name"),
+        "{:?}",
+        tidy.notes
     );
 }
