@@ -348,8 +348,9 @@ impl ArmModel {
             model.notes.insert(
                 0,
                 format!(
-                    "{gathered_links} link(s) list <visual> and <collision> elements interleaved: \
-                     each kind read in its own order, as urdfdom does"
+                    "{gathered_links} link(s) list children of one kind apart (e.g. <visual> and \
+                     <collision> interleaved): gathered by kind, each in its own order, as \
+                     urdfdom reads them"
                 ),
             );
         }

@@ -402,7 +402,7 @@ fn settings() -> Result<DefaultSettings<f64>, clarabel::solver::DefaultSettingsB
     // The QP is small and well scaled (see `Weights`): iterative
     // refinement would halve the solve rate and change nothing the law
     // uses. The gap tolerances stay at clarabel's defaults (1e-8), which
-    // leave u₀ up to ~1e-4 off where a row is active; `Polish` then makes
+    // leave u₀ up to 6e-4 off where a row is active; `Polish` then makes
     // it exact from the active rows. Closing the gap to 1e-12 instead cost
     // about two more iterations and doubled the step time on the iiwa14
     // (docs/results.md, "MPC solve time").

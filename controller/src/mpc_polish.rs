@@ -1,6 +1,6 @@
 //! Active-set polishing of one joint's MPC solution, as OSQP's `polish`
 //! does: clarabel's interior-point solution at its default duality gap
-//! (1e-8) leaves u₀ up to ~1e-4 off where a row is active; given the rows
+//! (1e-8) leaves u₀ up to 6e-4 off where a row is active; given the rows
 //! it finds active, one small equality-constrained QP over the inputs
 //! gives the exact optimum. Polishing is accepted only when its answer is
 //! feasible on every row and its multipliers are nonnegative (then it is

@@ -21,12 +21,12 @@ fn input<'a>(
     }
 }
 
-/// The nominal QP's shape: no input rows, no tightening.
 /// How close the law's u₀ must be to an exact solution, relative: the
-/// solver stops at its default duality gap (1e-8), ~1e-4 off where a row
-/// is active, and `Polish` makes it exact from the active rows.
+/// solver stops at its default duality gap (1e-8), up to 6e-4 off where a
+/// row is active, and `Polish` makes it exact from the active rows.
 const AGREES: f64 = 1e-9;
 
+/// The nominal QP's shape: no input rows, no tightening.
 fn nominal(horizon: usize, h: f64, tc: f64) -> MpcShape {
     MpcShape {
         horizon,

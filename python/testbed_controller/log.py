@@ -14,11 +14,13 @@ for the messages (CDR with `ros2msg` schemas, log format 3), so every field
 is decoded by the same code ROS 2 tools use; nothing here knows the
 testbed's message layouts beyond checking each channel's stored schema
 against the ones this build writes (`log_schemas.py`) before a message is
-decoded, as the Rust reader checks its own: a schema over 64 KiB, a
-testbed message whose field types differ from this build's (a uint64 where
-it writes a uint32), or that has no header, or that defines types beyond
-the header's, and any other schema that is not this build's text, are
-refused with a ValueError naming the file, the topic and the field.
+decoded. A testbed message's schema is checked as the Rust reader checks
+it: one over 64 KiB, whose field types differ from this build's (a uint64
+where it writes a uint32), that has no header, or that defines types
+beyond the header's, is refused with a ValueError naming the file, the
+topic and the field. A standard message (markers, /tf, sensor_msgs) whose
+schema is not this build's text (an older log's markers) is left out, and
+`Log.skipped` says why: the Rust reader does not read those either.
 
 Each table has a row per message, in log order: `log_time_ns`; `t_ns` and
 `t` (seconds) from `header.stamp` when the message has one; every numeric
@@ -60,6 +62,9 @@ class Log(dict):
         self.stats: Dict[str, str] = {}
         #: ROS 2 type of each topic (`testbed_msgs/msg/JointState`, ...).
         self.types: Dict[str, str] = {}
+        #: Topics left out, and why (a standard message whose stored
+        #: schema is not this build's).
+        self.skipped: Dict[str, str] = {}
 
     @property
     def log_format(self) -> int:
@@ -152,9 +157,10 @@ def _definitions(text: str) -> str:
     return text[at:] if at >= 0 else ""
 
 
-def _check_schema(path: str, topic: str, schema, own: Dict[str, str]) -> None:
-    """Refuses a stored schema this reader cannot trust to decode: see the
-    module's docstring."""
+def _check_schema(path: str, topic: str, schema, own: Dict[str, str]) -> Optional[str]:
+    """Refuses a stored schema this reader cannot trust to decode (see the
+    module's docstring); None if it reads, or why a standard message's
+    channel is left out."""
     name = schema.name if schema is not None else ""
     where = f"{path}: channel {topic} (schema {name[:80] or 'none'})"
     if schema is None or schema.encoding != "ros2msg":
@@ -169,11 +175,11 @@ def _check_schema(path: str, topic: str, schema, own: Dict[str, str]) -> None:
         raise ValueError(f"{where}: the schema is not UTF-8 text") from None
     mine = own.get(name)
     if mine == text:
-        return
-    if mine is None or not name.startswith("testbed_msgs/"):
-        raise ValueError(
-            f"{where}: not a schema this build writes; read the log with the testbed that wrote it"
-        )
+        return None
+    if not name.startswith("testbed_msgs/"):
+        return f"schema {name[:80]} is not the one this build writes: left out"
+    if mine is None:
+        raise ValueError(f"{where}: not a testbed message this build knows")
     # An older or newer testbed message: read by its own fields, as long
     # as each field this build also has keeps its type.
     fields = _fields(where, text)
@@ -186,6 +192,7 @@ def _check_schema(path: str, topic: str, schema, own: Dict[str, str]) -> None:
             raise ValueError(
                 f"{where}, field '{field}': {fields[field]} in the log, {ty} in this build"
             )
+    return None
 
 
 def read_log(path: str, topics: Optional[Iterable[str]] = None) -> Log:
@@ -215,9 +222,14 @@ def read_log(path: str, topics: Optional[Iterable[str]] = None) -> Log:
         factory = DecoderFactory()
         decoders: Dict[int, object] = {}
         for schema, channel, message in reader.iter_messages(topics=wanted, log_time_order=False):
+            if channel.topic in log.skipped:
+                continue
             decode = decoders.get(channel.id)
             if decode is None:
-                _check_schema(path, channel.topic, schema, own)
+                why = _check_schema(path, channel.topic, schema, own)
+                if why is not None:
+                    log.skipped[channel.topic] = why
+                    continue
                 decode = factory.decoder_for(channel.message_encoding, schema)
                 if decode is None:
                     raise ValueError(

@@ -1,8 +1,9 @@
 """The log reader checks each channel's stored schema before it decodes a
 message (#48 item 4): this build's schemas read; a testbed message from an
 older build (a field fewer) reads; a field whose type changed, a schema
-without a header, a 5 MB schema, a deeply nested one and a foreign schema
-are refused, naming the file, the topic and the field."""
+without a header, a 5 MB schema, a deeply nested one and an unknown
+testbed message are refused, naming the file, the topic and the field; a
+standard message whose schema is not this build's is left out and said."""
 
 import os
 import tempfile
@@ -111,9 +112,14 @@ class LogSchemas(unittest.TestCase):
             text += "=" * 80 + f"\nMSG: testbed_msgs/T{k}\n{nxt}"
         self.refused(self.log(NAME, text), "type T0 is not one testbed messages use")
 
-    def test_a_foreign_schema_is_refused(self):
+    def test_a_standard_message_of_another_schema_is_left_out_and_said(self):
         text = "float64 x\n"
-        self.refused(self.log("geometry_msgs/msg/Foo", text), "not a schema this build writes")
+        log = read_log(self.log("geometry_msgs/msg/Foo", text))
+        self.assertNotIn(TOPIC, log)
+        self.assertIn("not the one this build writes", log.skipped[TOPIC])
+
+    def test_an_unknown_testbed_message_is_refused(self):
+        self.refused(self.log("testbed_msgs/msg/Foo", TEXT), "not a testbed message this build knows")
 
 
 if __name__ == "__main__":

@@ -164,10 +164,11 @@ fn to_toml(key: &str, v: &Bound<'_, PyAny>, depth: usize) -> PyResult<toml::Valu
     if let Ok(i) = v.extract::<i64>() {
         return Ok(toml::Value::Integer(i));
     }
+    let key_is_seed = key == "seed" || key.ends_with(".seed");
     // Past TOML's i64: a seed up to 2**64 - 1 is written as its digits,
     // which the scenario's seed takes (it was rounded to a float and
-    // refused).
-    if let Ok(u) = v.extract::<u64>() {
+    // refused). Any other key keeps the float it was.
+    if key_is_seed && let Ok(u) = v.extract::<u64>() {
         return Ok(toml::Value::String(u.to_string()));
     }
     if let Ok(f) = v.extract::<f64>() {
