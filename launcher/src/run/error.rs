@@ -157,7 +157,7 @@ impl RunError {
     /// node's end with the last line it wrote (a Python traceback's last
     /// line is the exception), never the traceback with its file paths;
     /// the whole text is in the run folder's `nodes/<node>.log`. Other
-    /// failures are their message's first line. Cut to [`BRIEF_CHARS`].
+    /// failures are their message's first line. Cut to `BRIEF_CHARS` characters.
     pub fn brief(&self) -> String {
         let text = match self {
             RunError::NodeFailed { node, how, stderr } => {
