@@ -52,8 +52,7 @@ use crate::compare::types::{Comparison, Envelope, Finding, LawRow, Verdict};
 pub const MATTERS: f64 = 0.01;
 /// The family-wise level of the findings' tests (on Holm-corrected p).
 pub const ALPHA: f64 = 0.05;
-/// One law's value this many times the other's on a seed is a blow-up.
-pub const BLOW_UP: f64 = 100.0;
+pub use crate::compare::paired::BLOW_UP;
 
 /// The claims, in the order [`findings`] lists them (3 and 6 once per
 /// law they are tested against, 4 once per law and metric).

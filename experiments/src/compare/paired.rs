@@ -4,9 +4,11 @@
 //! differences, never a ratio of medians), blow-ups, failures and torque
 //! saturation named, and the numbers' printed form.
 
-use crate::compare::findings::BLOW_UP;
 use crate::compare::scores::stats_of;
 use crate::compare::types::{LawRow, LawRun};
+
+/// One law's value this many times the other's on a seed is a blow-up.
+pub const BLOW_UP: f64 = 100.0;
 
 /// The first `runs` values of `metric` of a row (a missing one is the
 /// worst, +∞ or −∞, as in the table).
