@@ -103,5 +103,5 @@ fn a_named_run_folder_is_made_once() {
         before
     );
     let err = fails(&mut run("../escape"));
-    assert!(err.contains("not a folder name"), "{err}");
+    assert!(err.contains("not a run folder name"), "{err}");
 }
