@@ -108,7 +108,9 @@ pub enum ModelError {
         reason: String,
     },
     /// Only fixed joints.
-    #[error("the URDF has no actuated (revolute, continuous or prismatic) joint")]
+    #[error(
+        "the model has no actuated joint (URDF revolute, continuous or prismatic; MJCF hinge or slide)"
+    )]
     NoActuatedJoints,
     /// A NaN or infinite number.
     #[error("{field}: {value} is not a finite number")]

@@ -100,6 +100,14 @@ impl JointKind {
         !matches!(self, JointKind::Fixed)
     }
 
+    /// The unit of this joint's effort (a force for a slide, else a torque).
+    pub fn effort_unit(self) -> &'static str {
+        match self {
+            JointKind::Prismatic => "N",
+            JointKind::Revolute | JointKind::Continuous | JointKind::Fixed => "N m",
+        }
+    }
+
     /// The URDF spelling.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -319,7 +327,7 @@ impl ArmModel {
             let said = e.to_string();
             ModelError::Parse(diagnose::diagnose(&text, &said).unwrap_or(said))
         })?;
-        let mut model = tree::build(&robot, locks)?;
+        let mut model = tree::build(&robot, locks, tree::Masses::Urdf)?;
         for (element, n) in unnamed_files.iter().rev() {
             let note = if *element == "limit" {
                 format!(

@@ -49,9 +49,11 @@ pub(crate) fn is_mjcf(text: &str) -> bool {
 
 /// Reads an MJCF document whose `<include>`s are relative to `base_dir`.
 pub(crate) fn from_str(text: &str, base_dir: &Path, locks: &Locks) -> Result<ArmModel, ModelError> {
-    let m = mjcf_rs::Model::from_str(text, base_dir)
-        .map_err(|e| ModelError::MjcfParse(e.to_string()))?;
+    // Inlined first, so that an include anywhere MuJoCo takes one (inside
+    // a <body>, as Adroit's) reads as MuJoCo reads it.
     let whole = super::mjcf_include::inline(text, base_dir)?;
+    let m = mjcf_rs::Model::from_str(&whole, base_dir)
+        .map_err(|e| ModelError::MjcfParse(e.to_string()))?;
     let joint_force = super::mjcf_joint_force::joint_force_limits(&whole, m.compiler.autolimits)?;
     convert(&m, &joint_force, locks)
 }
@@ -72,7 +74,7 @@ fn convert(
     locks: &Locks,
 ) -> Result<ArmModel, ModelError> {
     let c = tree(m)?;
-    let mut model = super::tree::build(&c.robot, locks)?;
+    let mut model = super::tree::build(&c.robot, locks, super::tree::Masses::AsGiven)?;
     for j in &mut model.joints {
         j.armature = c.armature.get(&j.name).copied().unwrap_or(0.0);
     }
@@ -89,9 +91,41 @@ fn convert(
         }
     }
     model.home = home(m, &model, &c.qpos_order)?;
+    notes.extend(gravity_note(m));
+    notes.extend(gravcomp_note(m));
     notes.append(&mut model.notes);
     model.notes = notes;
     Ok(model)
+}
+
+/// Gravity is the scenario's (`[plant] gravity`), as every other part of
+/// an experiment: a model's own is named so that a user can set it.
+fn gravity_note(m: &mjcf_rs::Model) -> Option<String> {
+    let g = m.option.gravity;
+    (Vector3::from(g) != crate::dynamics::GRAVITY).then(|| {
+        format!(
+            "MJCF <option gravity=\"{} {} {}\"> is not applied: gravity is the scenario's (plant.gravity, default [0, 0, -9.81]); set plant.gravity = [{}, {}, {}] to run with the model's",
+            g[0], g[1], g[2], g[0], g[1], g[2]
+        )
+    })
+}
+
+/// MuJoCo's `gravcomp` is a passive force that cancels gravity on a body,
+/// standing in for a position-controlled arm's own compensation; here the
+/// controller under test meets gravity, so it is named and not applied.
+fn gravcomp_note(m: &mjcf_rs::Model) -> Option<String> {
+    let bodies: Vec<String> = (m.bodies.iter().enumerate())
+        .filter(|(_, e)| e.body.gravcomp != 0.0)
+        .map(|(id, e)| body_name(&e.body, id))
+        .collect();
+    (!bodies.is_empty()).then(|| {
+        format!(
+            "MJCF gravcomp on {} bod{} ({}) is not applied: gravity loads the arm and the controller under test meets it",
+            bodies.len(),
+            if bodies.len() == 1 { "y" } else { "ies" },
+            bodies.join(", ")
+        )
+    })
 }
 
 /// `<body name>`, or its index when unnamed.

@@ -65,18 +65,23 @@ fn refuse(element: &str, reason: &str) -> ModelError {
     ModelError::MjcfParse(format!("{element}: {reason}"))
 }
 
-/// Where the next `<include` tag starts.
+/// Where the next `<include` tag starts, outside comments (a commented
+/// include, as in Meta-World's usage notes, includes nothing).
 fn next_include(text: &str) -> Option<usize> {
     let mut from = 0;
-    while let Some(i) = text[from..].find("<include") {
-        let at = from + i;
-        let next = text[at + "<include".len()..].chars().next();
-        if next.is_some_and(|c| c.is_whitespace() || c == '/' || c == '>') {
-            return Some(at);
+    loop {
+        let i = from + text[from..].find("<include")?;
+        match text[from..i].find("<!--") {
+            Some(c) => from = from + c + text[from + c..].find("-->")? + 3,
+            None => {
+                let next = text[i + "<include".len()..].chars().next();
+                if next.is_some_and(|c| c.is_whitespace() || c == '/' || c == '>') {
+                    return Some(i);
+                }
+                from = i + 1;
+            }
         }
-        from = at + 1;
     }
-    None
 }
 
 /// The value of `name="…"` (or single-quoted) in a tag.
@@ -101,19 +106,50 @@ fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
     None
 }
 
-/// What lies inside the root `<mujoco>` element of an included file.
+/// What lies inside the root element of an included file: `<mujoco>`, or
+/// `<mujocoinclude>` as older models (Adroit, Meta-World) write it.
 fn children(text: &str) -> &str {
-    let Some(open) = text.find("<mujoco") else {
-        return text;
+    let root = prolog_end(text);
+    let Some(body) = text[root..].strip_prefix('<') else {
+        return &text[root..];
     };
-    let Some(open_end) = text[open..].find('>').map(|e| open + e + 1) else {
+    let name_len = body
+        .find(|c: char| c.is_whitespace() || c == '>' || c == '/')
+        .unwrap_or(body.len());
+    let name = &body[..name_len];
+    if name != "mujoco" && name != "mujocoinclude" {
+        return &text[root..];
+    }
+    let Some(open_end) = text[root..].find('>').map(|e| root + e + 1) else {
         return "";
     };
     if text[..open_end].ends_with("/>") {
         return "";
     }
-    let close = text.rfind("</mujoco>").unwrap_or(text.len());
+    let close = text.rfind(&format!("</{name}>")).unwrap_or(text.len());
     text.get(open_end..close).unwrap_or("")
+}
+
+/// Where the root element starts: past the XML declaration, comments and
+/// blank space.
+fn prolog_end(text: &str) -> usize {
+    let mut at = 0;
+    loop {
+        let rest = &text[at..];
+        let trimmed = rest.trim_start_matches(|c: char| c.is_whitespace() || c == '\u{feff}');
+        at += rest.len() - trimmed.len();
+        let close = if trimmed.starts_with("<?") {
+            "?>"
+        } else if trimmed.starts_with("<!--") {
+            "-->"
+        } else {
+            return at;
+        };
+        match trimmed.find(close) {
+            Some(e) => at += e + close.len(),
+            None => return at,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -133,6 +169,18 @@ mod tests {
     fn an_included_root_gives_its_children() {
         assert_eq!(children("<?xml?><mujoco model='x'><a/></mujoco>"), "<a/>");
         assert_eq!(children("<mujoco/>"), "");
+        assert_eq!(
+            children("<!-- <mujoco> --><mujocoinclude>\n<body/>\n</mujocoinclude>\n"),
+            "\n<body/>\n"
+        );
+    }
+
+    #[test]
+    fn a_commented_include_includes_nothing() {
+        let text = r#"<mujoco><!-- <include file="gone.xml"/> --><include file="x.xml"/></mujoco>"#;
+        assert_eq!(next_include(text), text.find(r#"<include file="x"#));
+        assert_eq!(next_include("<!-- <include file='a'/> -->"), None);
+        assert_eq!(next_include("<!-- <include file='a'/>"), None);
     }
 
     #[test]

@@ -16,8 +16,24 @@ use super::{
 };
 use crate::ModelError;
 
+/// How a format's masses are taken.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Masses {
+    /// URDF as written in practice: a link of negligible mass is a frame,
+    /// and a light link's malformed tensor becomes a sphere's.
+    Urdf,
+    /// MJCF, whose compiler already refused malformed tensors: every mass
+    /// and tensor is taken as given, as MuJoCo takes it (a 1e-8 kg body
+    /// still loads the arm there).
+    AsGiven,
+}
+
 /// Parses, checks and simplifies a URDF robot.
-pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, ModelError> {
+pub(super) fn build(
+    robot: &urdf_rs::Robot,
+    locks: &Locks,
+    masses: Masses,
+) -> Result<ArmModel, ModelError> {
     let size = robot.links.len().max(robot.joints.len());
     if size > crate::MAX_LINKS {
         return Err(ModelError::InvalidConfig {
@@ -96,7 +112,7 @@ pub(super) fn build(robot: &urdf_rs::Robot, locks: &Locks) -> Result<ArmModel, M
     depth_first(&links, &joints, root)?;
     let leaders = resolve_mimics(&joints)?;
     let locked = apply_locks(&mut joints, &leaders, locks)?;
-    let (ignored, inertia_notes) = settle_masses(&mut links, &joints, root)?;
+    let (ignored, inertia_notes) = settle_masses(&mut links, &joints, root, masses)?;
     notes.extend(inertia_notes);
     let folded = merge_fixed(links, joints);
     let mut model = finish(robot.name.clone(), folded, &leaders, locked, ignored)?;
@@ -338,6 +354,7 @@ fn settle_masses(
     links: &mut [LinkInfo],
     joints: &[JointInfo],
     root: usize,
+    masses: Masses,
 ) -> Result<(Vec<IgnoredLink>, Vec<String>), ModelError> {
     // Links reached from the root through fixed joints only never move.
     let mut moves = vec![false; links.len()];
@@ -352,7 +369,10 @@ fn settle_masses(
         .filter(|&i| moves[i])
         .map(|i| links[i].mass)
         .fold(0.0, f64::max);
-    let threshold = NEGLIGIBLE_MASS_RATIO * heaviest;
+    let threshold = match masses {
+        Masses::Urdf => NEGLIGIBLE_MASS_RATIO * heaviest,
+        Masses::AsGiven => 0.0,
+    };
     // Only what moves: a 5 m pedestal welded to the world is no part of
     // the arm's motion.
     let size = arm_size(
@@ -402,7 +422,7 @@ fn settle_masses(
             // so they are kept; its tensor, which matters far less, becomes
             // a uniform sphere's of that mass.
             Ok(Tensor::Impossible(reason)) | Err(ModelError::BadInertia { reason, .. })
-                if l.mass < PLACEHOLDER_MASS_RATIO * heaviest =>
+                if masses == Masses::Urdf && l.mass < PLACEHOLDER_MASS_RATIO * heaviest =>
             {
                 let moment = sphere_moment(l.mass);
                 notes.push(format!(

@@ -106,6 +106,37 @@ fn includes_and_default_classes_are_resolved() {
 }
 
 #[test]
+fn an_include_inside_a_body_reads_as_mujoco_reads_it() {
+    let m = load("body_include.xml").unwrap();
+    // The commented include names a file that does not exist: not read.
+    assert_eq!(m.joint_names(), ["shoulder", "elbow", "tag_roll"]);
+    assert_eq!(joint(&m, "elbow").armature, 0.01);
+}
+
+#[test]
+fn a_tiny_mass_is_kept_as_mujoco_keeps_it() {
+    let m = load("body_include.xml").unwrap();
+    let tag = m.links.iter().find(|l| l.name == "tag").unwrap();
+    assert_eq!(tag.mass, 1e-8);
+    assert!(m.ignored.is_empty(), "{:?}", m.ignored);
+}
+
+#[test]
+fn gravcomp_and_the_models_gravity_are_named_not_applied() {
+    let m = load("body_include.xml").unwrap();
+    let said = m.notes.join("\n");
+    assert!(
+        said.contains("gravcomp on 1 body (upper) is not applied"),
+        "{said}"
+    );
+    assert!(
+        said.contains("<option gravity=\"0 0 -9.8\"> is not applied")
+            && said.contains("plant.gravity = [0, 0, -9.8]"),
+        "{said}"
+    );
+}
+
+#[test]
 fn a_floating_base_is_refused_by_name() {
     let e = load("free_joint.xml").unwrap_err().to_string();
     assert!(

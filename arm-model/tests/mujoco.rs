@@ -26,11 +26,12 @@ use serde_json::{Value, json};
 /// repository's root). `TESTBED_MJCF_ARMS` adds more: MJCF files, or
 /// folders searched for them, separated by ':' (a Menagerie checkout's
 /// arms, say; a file that includes others is given, not its includes).
-const ARMS: [&str; 5] = [
+const ARMS: [&str; 6] = [
     "arm-model/tests/data/two_link_hinge.xml",
     "arm-model/tests/data/geom_inertia.xml",
     "arm-model/tests/data/slide_armature.xml",
     "arm-model/tests/data/includes_defaults.xml",
+    "arm-model/tests/data/body_include.xml",
     "robots/menagerie/universal_robots_ur5e/ur5e.xml",
 ];
 

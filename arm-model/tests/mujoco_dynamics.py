@@ -9,7 +9,9 @@ JSON {"M": [...], "bias": [...], "qacc": [...]} per state in that order:
 Mesh geoms are removed first (see without_meshes). M from mj_fullM (armature included; MuJoCo 4 signature), bias = qfrc_bias (C q̇ + G), and the
 accelerations mj_forward gives under tau with joint damping on and every
 constraint (joint limits, dry friction `frictionloss`, contacts) and the
-actuators off.
+actuators off. What the testbed names and does not apply is off here too:
+joint springs (stiffness), body gravcomp and the model's own <option
+gravity> (gravity is the testbed's default, as a scenario's).
 """
 
 import json
@@ -27,10 +29,19 @@ def without_meshes(model_path):
     A body welded to the world may weigh its meshes; it moves nothing."""
     spec = mujoco.MjSpec.from_file(model_path)
     for g in list(spec.geoms):
-        if g.type == mujoco.mjtGeom.mjGEOM_MESH:
+        # A geom naming a mesh is a mesh whatever its written type (MuJoCo
+        # infers the type from `mesh`).
+        if g.type == mujoco.mjtGeom.mjGEOM_MESH or g.meshname:
             spec.delete(g)
     for mesh in list(spec.meshes):
         spec.delete(mesh)
+    # Textures are image files not shipped either; they only colour.
+    for g in spec.geoms:
+        g.material = ""
+    for site in spec.sites:
+        site.material = ""
+    for asset in list(spec.materials) + list(spec.textures):
+        spec.delete(asset)
     return spec.compile()
 
 
@@ -39,6 +50,12 @@ def main(model_path, states_path):
     # frictionloss and limits are constraints in MuJoCo; the comparison is
     # of the smooth dynamics, so they are off (the testbed's are elsewhere).
     m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    # Gravity is the scenario's in the testbed (the model's <option
+    # gravity> is noted, not applied); the comparison is at its default.
+    m.opt.gravity[:] = (0.0, 0.0, -9.81)
+    # gravcomp and joint springs are named by the testbed and not applied.
+    m.body_gravcomp[:] = 0.0
+    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SPRING
     # A position servo pushes even at ctrl 0; the torque is tau alone.
     m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_ACTUATION
     d = mujoco.MjData(m)

@@ -3,7 +3,7 @@
 //! against the joint's effort limit. `testbed robot`, `sim` and `run` say
 //! where it comes close, and where there is no limit at all.
 
-use plant_rapier::{JointKind, PlantError};
+use plant_rapier::PlantError;
 
 use crate::{Plan, Prober};
 
@@ -51,10 +51,7 @@ pub fn effort_warnings(plan: &Plan) -> Result<Vec<String>, PlantError> {
     let (load, gravity) = loads(plan)?;
     for (i, (&ji, limit)) in model.actuated.iter().zip(&limits).enumerate() {
         let j = &model.joints[ji];
-        let unit = match j.kind {
-            JointKind::Prismatic => "N",
-            _ => "N m",
-        };
+        let unit = j.kind.effort_unit();
         if let Some(e) = limit
             && load[i] > EFFORT_WARNING_FRACTION * e
         {

@@ -104,7 +104,10 @@ fn panda_fingers_are_mimic_and_locked_by_default() {
         text.contains("locked panda_finger_joint1 at 0.0200"),
         "{text}"
     );
-    assert!(text.contains("URDF <dynamics>"), "{text}");
+    assert!(
+        text.contains("(URDF <dynamics>, MJCF damping and frictionloss) act in the plant"),
+        "{text}"
+    );
     let dir = tempfile::tempdir().unwrap();
     let s = json(&ok(testbed()
         .args(["run", "--mode", "lockstep", "--json", "--duration", "0.2"])

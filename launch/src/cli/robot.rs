@@ -31,7 +31,7 @@ pub fn describe(path: &Path) -> Result<String> {
         file: robot.label(),
         cause,
     })?;
-    default_scenario(&mut out, &d);
+    default_scenario(&mut out, m, &d);
     let locked = robot.relocked(&d.scenario.plant.lock)?;
     // An arm past the wire's MAX_DOF has no plan (the warnings say so).
     let effort = if locked.model.dof() <= wire::MAX_DOF {
@@ -165,7 +165,7 @@ fn joints(out: &mut String, m: &ArmModel) {
     if m.has_urdf_dynamics() {
         let _ = writeln!(
             out,
-            "  URDF <dynamics> damping and friction act in the plant ([plant] urdf_dynamics = false turns them off)"
+            "  joint damping and friction (URDF <dynamics>, MJCF damping and frictionloss) act in the plant ([plant] urdf_dynamics = false turns them off)"
         );
     }
 }
@@ -225,7 +225,7 @@ fn warnings(out: &mut String, d: &ArmDefault, effort: &[String]) {
     }
 }
 
-fn default_scenario(out: &mut String, d: &ArmDefault) {
+fn default_scenario(out: &mut String, m: &ArmModel, d: &ArmDefault) {
     let s = &d.scenario;
     let g = &d.gains;
     let _ = writeln!(
@@ -247,14 +247,17 @@ fn default_scenario(out: &mut String, d: &ArmDefault) {
     }
     let _ = writeln!(
         out,
-        "  {:>2}  {:<26} {:>9} {:>10} {:>11} {:>9} {:>8}  why K1",
-        "i", "joint", "K1", "K2", "max M⁻¹_ii", "load N m", "effort"
+        "  {:>2}  {:<26} {:>9} {:>10} {:>11} {:>9} {:>8} {:<3}  why K1",
+        "i", "joint", "K1", "K2", "max M⁻¹_ii", "load", "effort", ""
     );
     for (i, j) in g.joints.iter().enumerate() {
         let effort = j.effort.map_or_else(|| "none".into(), |e| format!("{e}"));
+        // Load and effort are forces on a slide, torques on a hinge.
+        let unit = (m.joints.iter().find(|mj| mj.name == j.name))
+            .map_or("N m", |mj| mj.kind.effort_unit());
         let _ = writeln!(
             out,
-            "  {i:>2}  {:<26} {:>9.3} {:>10.4} {:>11.4} {:>9.3} {:>8}  {}",
+            "  {i:>2}  {:<26} {:>9.3} {:>10.4} {:>11.4} {:>9.3} {:>8} {unit:<3}  {}",
             j.name, j.k1, j.k2, j.minv_diag, j.load, effort, j.k1_reason
         );
     }
