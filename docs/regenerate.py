@@ -48,8 +48,11 @@ SCENARIOS = [
     "iiwa_wall",
 ]
 ARMS = ["two_link", "three_link_planar", "ur5", "iiwa14", "panda", "xarm7", "so101", "z1"]
-#: The shipped MJCF arms (robots/menagerie/), by path from the root.
-MJCF_ARMS = ["robots/menagerie/universal_robots_ur5e/ur5e.xml"]
+#: The shipped MJCF arms (robots/menagerie/, one folder each), by path
+#: from the root.
+MJCF_ARMS = sorted(
+    str(p.relative_to(ROOT)) for p in (ROOT / "robots/menagerie").glob("*/*.xml")
+)
 COMPARED = ["paper", "payload_pickup", "actuation_delay", "paper_per_input"]
 
 

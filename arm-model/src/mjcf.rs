@@ -93,6 +93,7 @@ fn convert(
     model.home = home(m, &model, &c.qpos_order)?;
     notes.extend(gravity_note(m));
     notes.extend(gravcomp_note(m));
+    notes.extend(coupling_note(m));
     notes.append(&mut model.notes);
     model.notes = notes;
     Ok(model)
@@ -124,6 +125,32 @@ fn gravcomp_note(m: &mjcf_rs::Model) -> Option<String> {
             bodies.len(),
             if bodies.len() == 1 { "y" } else { "ies" },
             bodies.join(", ")
+        )
+    })
+}
+
+/// Equality constraints and tendons tie joints together (a gripper's
+/// closed linkage); the plant moves the tree as an open chain.
+fn coupling_note(m: &mjcf_rs::Model) -> Option<String> {
+    use mjcf_rs::equality::Equality;
+    let count = |f: fn(&Equality) -> bool| m.equality.iter().filter(|e| f(e)).count();
+    let kinds = [
+        ("connect", count(|e| matches!(e, Equality::Connect(_)))),
+        ("weld", count(|e| matches!(e, Equality::Weld(_)))),
+        ("joint", count(|e| matches!(e, Equality::Joint(_)))),
+        ("tendon", count(|e| matches!(e, Equality::Tendon(_)))),
+    ];
+    let mut parts: Vec<String> = (kinds.iter())
+        .filter(|(_, n)| *n > 0)
+        .map(|(k, n)| format!("{n} <equality><{k}>"))
+        .collect();
+    if !m.tendons.is_empty() {
+        parts.push(format!("{} <tendon>", m.tendons.len()));
+    }
+    (!parts.is_empty()).then(|| {
+        format!(
+            "MJCF {} not simulated: the joints they couple move freely (lock them with [plant] lock, as the default scenario locks a gripper's fingers)",
+            parts.join(", ")
         )
     })
 }
@@ -242,8 +269,9 @@ fn joints(
         let jname = j.name.clone().unwrap_or_else(|| format!("{name}_joint{k}"));
         let element = format!("<joint name='{jname}'> in <body name='{name}'>");
         let pos = Vector3::from(j.pos);
-        let origin =
-            at * Isometry3::translation(pos.x - anchor.x, pos.y - anchor.y, pos.z - anchor.z);
+        let origin = at
+            * Isometry3::translation(pos.x - anchor.x, pos.y - anchor.y, pos.z - anchor.z)
+            * reference_shift(j);
         let to = if k + 1 == b.joints.len() {
             name.to_string()
         } else {
@@ -269,6 +297,25 @@ fn joints(
         from = to;
     }
     Ok(anchor)
+}
+
+/// MuJoCo writes a body at the pose its joint has at q = `ref`: the joint
+/// frame is turned (slid) back by `ref` along the axis, so that q is
+/// MuJoCo's qpos, the range and keyframes as written.
+fn reference_shift(j: &Joint) -> Isometry3<f64> {
+    let Some(axis) = nalgebra::Unit::try_new(Vector3::from(j.axis), 1e-12) else {
+        return Isometry3::identity();
+    };
+    match j.type_ {
+        JointType::Hinge => Isometry3::from_parts(
+            Vector3::zeros().into(),
+            UnitQuaternion::from_axis_angle(&axis, -j.ref_),
+        ),
+        JointType::Slide => {
+            Isometry3::translation(-j.ref_ * axis.x, -j.ref_ * axis.y, -j.ref_ * axis.z)
+        }
+        JointType::Ball | JointType::Free => Isometry3::identity(),
+    }
 }
 
 /// The URDF kind and limits of an MJCF joint; ball and free joints refused.
@@ -310,12 +357,6 @@ fn kind_and_limit(
         (JointType::Hinge, Some(_)) => urdf_rs::JointType::Revolute,
         (JointType::Slide, Some(_)) => urdf_rs::JointType::Prismatic,
     };
-    if j.ref_ != 0.0 {
-        return Err(refuse(format!(
-            "ref = {} moves the joint's zero away from the pose the body is written in; the testbed measures joints from the written pose (set ref to 0)",
-            j.ref_
-        )));
-    }
     let (lower, upper) = range.map_or((0.0, 0.0), |r| (r[0], r[1]));
     Ok((
         kind,

@@ -109,8 +109,17 @@ fn includes_and_default_classes_are_resolved() {
 fn an_include_inside_a_body_reads_as_mujoco_reads_it() {
     let m = load("body_include.xml").unwrap();
     // The commented include names a file that does not exist: not read.
-    assert_eq!(m.joint_names(), ["shoulder", "elbow", "tag_roll"]);
+    assert_eq!(m.joint_names(), ["shoulder", "elbow", "tag_slide"]);
     assert_eq!(joint(&m, "elbow").armature, 0.01);
+    // `ref` turns the frame, not the numbers: q is MuJoCo's qpos.
+    assert_eq!(joint(&m, "elbow").limits, Some((-2.5, 2.5)));
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.contains("1 <equality><joint> not simulated")),
+        "{:?}",
+        m.notes
+    );
 }
 
 #[test]

@@ -21,18 +21,16 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
 
-/// The files compared: every hand-written arm MuJoCo can load (in
-/// tests/data) and every shipped MuJoCo Menagerie arm (from the
-/// repository's root). `TESTBED_MJCF_ARMS` adds more: MJCF files, or
+/// The hand-written arms MuJoCo can load (in tests/data); `arms()` adds
+/// every shipped MuJoCo Menagerie arm. `TESTBED_MJCF_ARMS` adds more: MJCF files, or
 /// folders searched for them, separated by ':' (a Menagerie checkout's
 /// arms, say; a file that includes others is given, not its includes).
-const ARMS: [&str; 6] = [
+const ARMS: [&str; 5] = [
     "arm-model/tests/data/two_link_hinge.xml",
     "arm-model/tests/data/geom_inertia.xml",
     "arm-model/tests/data/slide_armature.xml",
     "arm-model/tests/data/includes_defaults.xml",
     "arm-model/tests/data/body_include.xml",
-    "robots/menagerie/universal_robots_ur5e/ur5e.xml",
 ];
 
 const STATES: usize = 8;
@@ -42,20 +40,33 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
 }
 
-/// The shipped arms, then those `TESTBED_MJCF_ARMS` names.
+/// The `.xml` files in a folder, sorted.
+fn xml_in(dir: &Path) -> Vec<PathBuf> {
+    let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
+        .collect();
+    found.sort();
+    found
+}
+
+/// The hand-written arms, every arm in robots/menagerie/ (one folder
+/// each), then those `TESTBED_MJCF_ARMS` names.
 fn arms() -> Vec<PathBuf> {
     let mut out: Vec<PathBuf> = ARMS.iter().map(|a| root().join("..").join(a)).collect();
+    let mut shipped: Vec<PathBuf> = std::fs::read_dir(root().join("../robots/menagerie"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
+    shipped.sort();
+    out.extend(shipped.iter().flat_map(|d| xml_in(d)));
     let extra = std::env::var("TESTBED_MJCF_ARMS").unwrap_or_default();
     for item in extra.split(':').filter(|s| !s.is_empty()) {
         let path = PathBuf::from(item);
         if path.is_dir() {
-            let mut found: Vec<PathBuf> = std::fs::read_dir(&path)
-                .unwrap()
-                .map(|e| e.unwrap().path())
-                .filter(|p| p.extension().is_some_and(|x| x == "xml"))
-                .collect();
-            found.sort();
-            out.extend(found);
+            out.extend(xml_in(&path));
         } else {
             out.push(path);
         }

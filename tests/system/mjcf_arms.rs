@@ -6,12 +6,28 @@ use std::path::Path;
 
 use crate::util::{json, ok, testbed};
 
-/// The shipped Menagerie arms (robots/menagerie/README.md).
-const MENAGERIE: [&str; 1] = ["robots/menagerie/universal_robots_ur5e/ur5e.xml"];
+/// The shipped Menagerie arms (robots/menagerie/README.md): each folder's
+/// `.xml` files, by path from the repository's root.
+fn menagerie() -> Vec<String> {
+    let root = crate::util::repo_root();
+    let mut arms: Vec<String> = std::fs::read_dir(root.join("robots/menagerie"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .flat_map(|d| std::fs::read_dir(d).unwrap().map(|e| e.unwrap().path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
+        .map(|p| p.strip_prefix(&root).unwrap().display().to_string())
+        .collect();
+    arms.sort();
+    arms
+}
 
 #[test]
 fn every_shipped_menagerie_arm_runs_its_default_scenario_clean() {
-    for arm in MENAGERIE {
+    let arms = menagerie();
+    assert!(arms.len() >= 10, "{arms:?}");
+    for arm in &arms {
+        let arm = arm.as_str();
         let text = String::from_utf8(ok(testbed().args(["robot", arm])).stdout).unwrap();
         assert!(text.contains("default scenario"), "{arm}: {text}");
         let s = json(&ok(testbed().args(["sim", "--json", "--robot", arm])));
