@@ -41,6 +41,7 @@ mod mjcf;
 mod mjcf_include;
 mod mjcf_inertia;
 mod mjcf_joint_force;
+mod mjcf_notes;
 mod parse;
 mod prefixes;
 mod root_element;

@@ -55,7 +55,7 @@ pub(crate) fn from_str(text: &str, base_dir: &Path, locks: &Locks) -> Result<Arm
     let m = mjcf_rs::Model::from_str(&whole, base_dir)
         .map_err(|e| ModelError::MjcfParse(e.to_string()))?;
     let joint_force = super::mjcf_joint_force::joint_force_limits(&whole, m.compiler.autolimits)?;
-    convert(&m, &joint_force, locks)
+    convert(&m, &whole, &joint_force, locks)
 }
 
 /// What the conversion learns beside the URDF tree.
@@ -70,10 +70,11 @@ struct Converted {
 
 fn convert(
     m: &mjcf_rs::Model,
+    whole: &str,
     joint_force: &HashMap<String, f64>,
     locks: &Locks,
 ) -> Result<ArmModel, ModelError> {
-    let c = tree(m)?;
+    let c = tree(m, super::mjcf_inertia::group_range(whole)?)?;
     let mut model = super::tree::build(&c.robot, locks, super::tree::Masses::AsGiven)?;
     for j in &mut model.joints {
         j.armature = c.armature.get(&j.name).copied().unwrap_or(0.0);
@@ -91,72 +92,14 @@ fn convert(
         }
     }
     model.home = home(m, &model, &c.qpos_order)?;
-    notes.extend(gravity_note(m));
-    notes.extend(gravcomp_note(m));
-    notes.extend(coupling_note(m));
+    notes.extend(super::mjcf_notes::unapplied(m, whole));
     notes.append(&mut model.notes);
     model.notes = notes;
     Ok(model)
 }
 
-/// Gravity is the scenario's (`[plant] gravity`), as every other part of
-/// an experiment: a model's own is named so that a user can set it.
-fn gravity_note(m: &mjcf_rs::Model) -> Option<String> {
-    let g = m.option.gravity;
-    (Vector3::from(g) != crate::dynamics::GRAVITY).then(|| {
-        format!(
-            "MJCF <option gravity=\"{} {} {}\"> is not applied: gravity is the scenario's (plant.gravity, default [0, 0, -9.81]); set plant.gravity = [{}, {}, {}] to run with the model's",
-            g[0], g[1], g[2], g[0], g[1], g[2]
-        )
-    })
-}
-
-/// MuJoCo's `gravcomp` is a passive force that cancels gravity on a body,
-/// standing in for a position-controlled arm's own compensation; here the
-/// controller under test meets gravity, so it is named and not applied.
-fn gravcomp_note(m: &mjcf_rs::Model) -> Option<String> {
-    let bodies: Vec<String> = (m.bodies.iter().enumerate())
-        .filter(|(_, e)| e.body.gravcomp != 0.0)
-        .map(|(id, e)| body_name(&e.body, id))
-        .collect();
-    (!bodies.is_empty()).then(|| {
-        format!(
-            "MJCF gravcomp on {} bod{} ({}) is not applied: gravity loads the arm and the controller under test meets it",
-            bodies.len(),
-            if bodies.len() == 1 { "y" } else { "ies" },
-            bodies.join(", ")
-        )
-    })
-}
-
-/// Equality constraints and tendons tie joints together (a gripper's
-/// closed linkage); the plant moves the tree as an open chain.
-fn coupling_note(m: &mjcf_rs::Model) -> Option<String> {
-    use mjcf_rs::equality::Equality;
-    let count = |f: fn(&Equality) -> bool| m.equality.iter().filter(|e| f(e)).count();
-    let kinds = [
-        ("connect", count(|e| matches!(e, Equality::Connect(_)))),
-        ("weld", count(|e| matches!(e, Equality::Weld(_)))),
-        ("joint", count(|e| matches!(e, Equality::Joint(_)))),
-        ("tendon", count(|e| matches!(e, Equality::Tendon(_)))),
-    ];
-    let mut parts: Vec<String> = (kinds.iter())
-        .filter(|(_, n)| *n > 0)
-        .map(|(k, n)| format!("{n} <equality><{k}>"))
-        .collect();
-    if !m.tendons.is_empty() {
-        parts.push(format!("{} <tendon>", m.tendons.len()));
-    }
-    (!parts.is_empty()).then(|| {
-        format!(
-            "MJCF {} not simulated: the joints they couple move freely (lock them with [plant] lock, as the default scenario locks a gripper's fingers)",
-            parts.join(", ")
-        )
-    })
-}
-
 /// `<body name>`, or its index when unnamed.
-fn body_name(b: &Body, id: usize) -> String {
+pub(crate) fn body_name(b: &Body, id: usize) -> String {
     b.name.clone().unwrap_or_else(|| format!("body{id}"))
 }
 
@@ -176,7 +119,7 @@ fn pose(o: Origin) -> urdf_rs::Pose {
 }
 
 /// The body tree as URDF links and joints; the world body is link `world`.
-fn tree(m: &mjcf_rs::Model) -> Result<Converted, ModelError> {
+fn tree(m: &mjcf_rs::Model, groups: [i32; 2]) -> Result<Converted, ModelError> {
     let mut c = Converted {
         robot: urdf_rs::Robot {
             name: m.name.clone().unwrap_or_else(|| "mjcf".into()),
@@ -196,9 +139,13 @@ fn tree(m: &mjcf_rs::Model) -> Result<Converted, ModelError> {
     for (id, entry) in m.bodies.iter().enumerate() {
         let b = &entry.body;
         let Some(parent) = entry.parent else {
-            c.robot
-                .links
-                .push(link(m, "world", b, Vector3::zeros(), Weld::World)?);
+            c.robot.links.push(link(
+                (m, groups),
+                "world",
+                b,
+                Vector3::zeros(),
+                Weld::World,
+            )?);
             link_of.push(("world".into(), Vector3::zeros()));
             moves.push(false);
             continue;
@@ -219,14 +166,14 @@ fn tree(m: &mjcf_rs::Model) -> Result<Converted, ModelError> {
         )?;
         let moving = moves.get(parent).copied().unwrap_or(false) || !b.joints.is_empty();
         let weld = if moving { Weld::Moves } else { Weld::Fixed };
-        let l = match link(m, &name, b, anchor, weld) {
+        let l = match link((m, groups), &name, b, anchor, weld) {
             // A body welded to the world moves nothing: its mass does not
             // matter, so a mesh it would take it from is not needed.
             Err(ModelError::MjcfRefused { element, .. }) if !moving => {
                 c.notes.push(format!(
                     "{element}: its mass would come from a mesh, which is not read; the body is welded to the world, so its mass does not change the dynamics"
                 ));
-                link(m, &name, b, anchor, Weld::World)?
+                link((m, groups), &name, b, anchor, Weld::World)?
             }
             other => other?,
         };
@@ -290,7 +237,7 @@ fn joints(
         joint.limit = limit;
         c.robot.joints.push(joint);
         c.armature.insert(jname.clone(), j.armature);
-        c.notes.extend(joint_notes(j, &element));
+        c.notes.extend(super::mjcf_notes::joint(j, &element));
         c.qpos_order.push(jname);
         at = Isometry3::identity();
         anchor = pos;
@@ -368,21 +315,6 @@ fn kind_and_limit(
     ))
 }
 
-/// What an MJCF joint has that the testbed does not simulate.
-fn joint_notes(j: &Joint, element: &str) -> Vec<String> {
-    let mut notes = Vec::new();
-    if j.stiffness != 0.0 {
-        notes.push(format!(
-            "{element}: stiffness {} (spring to springref {}) is not simulated",
-            j.stiffness, j.springref
-        ));
-    }
-    if j.springdamper.is_some() {
-        notes.push(format!("{element}: springdamper is not simulated"));
-    }
-    notes
-}
-
 fn urdf_joint(
     name: String,
     joint_type: urdf_rs::JointType,
@@ -437,7 +369,7 @@ enum Weld {
 /// link frame (the body frame moved to `anchor`). Meshes are never read:
 /// a body whose mass MuJoCo would take from a mesh is refused by name.
 fn link(
-    m: &mjcf_rs::Model,
+    (m, groups): (&mjcf_rs::Model, [i32; 2]),
     name: &str,
     b: &Body,
     anchor: Vector3<f64>,
@@ -461,7 +393,12 @@ fn link(
         (None, InertiaFromGeom::False) => return Ok(l),
     };
     let (mass, at, tensor) = if from_geoms {
-        let sum = super::mjcf_inertia::from_geoms(name, &b.geoms)?;
+        // Only geoms in <compiler inertiagrouprange> weigh anything.
+        let weighed: Vec<Geom> = (b.geoms.iter())
+            .filter(|g| (groups[0]..=groups[1]).contains(&g.group))
+            .cloned()
+            .collect();
+        let sum = super::mjcf_inertia::from_geoms(name, &weighed)?;
         (
             sum.mass,
             super::inertia::iso(&sum.inertial_origin),

@@ -68,13 +68,19 @@ fn refuse(element: &str, reason: &str) -> ModelError {
 /// Where the next `<include` tag starts, outside comments (a commented
 /// include, as in Meta-World's usage notes, includes nothing).
 fn next_include(text: &str) -> Option<usize> {
+    next_tag(text, "include")
+}
+
+/// Where the next `<name` tag starts, outside comments.
+pub(crate) fn next_tag(text: &str, name: &str) -> Option<usize> {
+    let open = format!("<{name}");
     let mut from = 0;
     loop {
-        let i = from + text[from..].find("<include")?;
+        let i = from + text[from..].find(&open)?;
         match text[from..i].find("<!--") {
             Some(c) => from = from + c + text[from + c..].find("-->")? + 3,
             None => {
-                let next = text[i + "<include".len()..].chars().next();
+                let next = text[i + open.len()..].chars().next();
                 if next.is_some_and(|c| c.is_whitespace() || c == '/' || c == '>') {
                     return Some(i);
                 }
@@ -84,8 +90,20 @@ fn next_include(text: &str) -> Option<usize> {
     }
 }
 
+/// Every `<name …>` tag outside comments, whole.
+pub(crate) fn tags<'a>(text: &'a str, name: &'a str) -> impl Iterator<Item = &'a str> + 'a {
+    let mut rest = text;
+    std::iter::from_fn(move || {
+        let i = next_tag(rest, name)?;
+        let end = rest[i..].find('>').map_or(rest.len(), |e| i + e + 1);
+        let tag = &rest[i..end];
+        rest = &rest[end..];
+        Some(tag)
+    })
+}
+
 /// The value of `name="…"` (or single-quoted) in a tag.
-fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+pub(crate) fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
     let mut from = 0;
     while let Some(i) = tag[from..].find(name) {
         let at = from + i;

@@ -99,6 +99,31 @@ pub(super) fn placed(g: &Geom) -> (Isometry3<f64>, [f64; 3]) {
     (Isometry3::from_parts(mid.coords.into(), rot), size)
 }
 
+/// `<compiler inertiagrouprange>`: the geom groups whose geoms weigh
+/// something when a body's inertia comes from its geoms (MuJoCo's default
+/// 0 5; the last compiler element that gives it wins, as MuJoCo merges them).
+pub(super) fn group_range(whole: &str) -> Result<[i32; 2], ModelError> {
+    let Some(value) = super::mjcf_include::tags(whole, "compiler")
+        .filter_map(|t| super::mjcf_include::attribute(t, "inertiagrouprange"))
+        .last()
+    else {
+        return Ok([0, 5]);
+    };
+    let bad = || {
+        ModelError::MjcfParse(format!(
+            "<compiler inertiagrouprange=\"{value}\">: need two integers, the first not above the second"
+        ))
+    };
+    let parts: Vec<i32> = (value.split_whitespace())
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    match parts[..] {
+        [a, b] if a <= b => Ok([a, b]),
+        _ => Err(bad()),
+    }
+}
+
 /// The name MuJoCo messages would give a geom: its name or its index.
 fn geom_label(g: &Geom, i: usize) -> String {
     match &g.name {
@@ -191,6 +216,17 @@ mod tests {
         let l = from_geoms("b", &[g]).unwrap();
         assert!((l.mass - 2.0).abs() < 1e-12);
         assert!((l.inertia[0] - 2.0 * (0.04 + 0.09) / 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_inertia_group_range_is_the_last_compilers_and_checked() {
+        assert_eq!(group_range("<mujoco/>").unwrap(), [0, 5]);
+        let two = r#"<compiler inertiagrouprange="1 2"/><!-- <compiler inertiagrouprange="0 0"/> --><compiler angle="radian" inertiagrouprange=" 4 5 "/>"#;
+        assert_eq!(group_range(two).unwrap(), [4, 5]);
+        for bad in ["5 4", "1", "a b", "1 2 3"] {
+            let e = group_range(&format!(r#"<compiler inertiagrouprange="{bad}"/>"#)).unwrap_err();
+            assert!(e.to_string().contains("inertiagrouprange"), "{e}");
+        }
     }
 
     #[test]

@@ -53,6 +53,7 @@ def main(model_path, states_path):
     # Gravity is the scenario's in the testbed (the model's <option
     # gravity> is noted, not applied); the comparison is at its default.
     m.opt.gravity[:] = (0.0, 0.0, -9.81)
+    m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_GRAVITY)
     # gravcomp and joint springs are named by the testbed and not applied.
     m.body_gravcomp[:] = 0.0
     m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SPRING
