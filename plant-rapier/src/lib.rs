@@ -41,8 +41,8 @@ mod plant;
 mod rig;
 
 pub use arm_model::{
-    ArmModel, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks, MergedLink,
-    MimicJoint, MimicSpec, ModelError, Origin, TWO_LINK_URDF,
+    ArmModel, Geometry, IgnoredLink, JointInfo, JointKind, LinkInfo, LockedJoint, Locks,
+    MergedLink, MimicJoint, MimicSpec, ModelError, Origin, TWO_LINK_URDF,
 };
 pub use config::{
     ActuationConfig, ActuatorConfig, ContactConfig, ContactObject, DisturbanceConfig,

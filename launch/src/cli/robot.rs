@@ -177,7 +177,13 @@ fn links(out: &mut String, m: &ArmModel) {
         m.links[m.root].name
     );
     for l in &m.links {
-        let _ = writeln!(out, "  {:<26} {:>9.4} kg", l.name, l.mass);
+        let _ = writeln!(
+            out,
+            "  {:<26} {:>9.4} kg{}",
+            l.name,
+            l.mass,
+            collision_summary(l)
+        );
     }
     let _ = writeln!(out, "  moving mass {:.4} kg", m.moving_mass());
     for merged in &m.merged {
@@ -188,6 +194,39 @@ fn links(out: &mut String, m: &ArmModel) {
     }
     for note in &m.notes {
         let _ = writeln!(out, "  note: {note}");
+    }
+}
+
+/// A link's collision geometry, as `[plant.contact]` takes it: primitive
+/// shapes counted by kind, meshes (never contact shapes) named.
+fn collision_summary(l: &plant_rapier::LinkInfo) -> String {
+    use plant_rapier::Geometry;
+    let mut kinds: Vec<(&str, usize)> = Vec::new();
+    for c in &l.collisions {
+        let kind = match c.geometry {
+            Geometry::Box { .. } => "box",
+            Geometry::Cylinder { .. } => "cylinder",
+            Geometry::Sphere { .. } => "sphere",
+            Geometry::Capsule { .. } => "capsule",
+        };
+        match kinds.iter_mut().find(|(k, _)| *k == kind) {
+            Some((_, n)) => *n += 1,
+            None => kinds.push((kind, 1)),
+        }
+    }
+    let mut parts: Vec<String> = kinds.iter().map(|(k, n)| format!("{n} {k}")).collect();
+    if !l.skipped_collisions.is_empty() {
+        // Each reads "link 'l' collision k: mesh 'm'"; the mesh is what
+        // this line is about.
+        let meshes: Vec<&str> = (l.skipped_collisions.iter())
+            .map(|c| c.rsplit(": ").next().unwrap_or(c))
+            .collect();
+        parts.push(format!("{} (not contact shapes)", meshes.join(", ")));
+    }
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!("   collision: {}", parts.join(", "))
     }
 }
 
