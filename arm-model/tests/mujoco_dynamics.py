@@ -45,6 +45,16 @@ def without_meshes(model_path):
     return spec.compile()
 
 
+def joint(m, name):
+    """MuJoCo's joint `name`; an unnamed one by the testbed's name for it,
+    BODY_jointK (the body's K-th joint)."""
+    try:
+        return m.joint(name)
+    except KeyError:
+        body, _, k = name.rpartition("_joint")
+        return m.joint(int(m.body(body).jntadr[0]) + int(k))
+
+
 def main(model_path, states_path):
     m = without_meshes(model_path)
     # frictionloss and limits are constraints in MuJoCo; the comparison is
@@ -62,7 +72,7 @@ def main(model_path, states_path):
     d = mujoco.MjData(m)
     with open(states_path) as f:
         spec = json.load(f)
-    joints = [m.joint(n) for n in spec["names"]]
+    joints = [joint(m, n) for n in spec["names"]]
     qadr = [int(j.qposadr[0]) for j in joints]
     vadr = [int(j.dofadr[0]) for j in joints]
     if len(joints) != m.nv:
