@@ -103,13 +103,14 @@ def main():
     from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.vec_env import VecEnvWrapper, VecMonitor
 
-    from testbed.sb3 import ArmTrackingSB3VecEnv
+    from testbed.sb3 import ArmTrackingSB3VecEnv, silent_logger
 
     venv = ArmTrackingSB3VecEnv(a.n_envs, **KWARGS)
     venv.seed(a.seed)
     penalty = make_penalty_wrapper(VecEnvWrapper)(VecMonitor(venv), lam=0.0)
     dual = make_dual_ascent(BaseCallback)(penalty, a.budget, a.lambda_lr)
     model = PPO("MlpPolicy", penalty, seed=a.seed, n_steps=256, batch_size=512, verbose=0)
+    model.set_logger(silent_logger())
     model.learn(total_timesteps=a.timesteps, callback=dual)
     model.save(a.out)
     seeds = range(HELD_OUT, HELD_OUT + a.eval_seeds)

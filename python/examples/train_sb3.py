@@ -67,12 +67,13 @@ def main():
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecMonitor
 
-    from testbed.sb3 import ArmTrackingSB3VecEnv
+    from testbed.sb3 import ArmTrackingSB3VecEnv, silent_logger
 
     torch.set_num_threads(1)
     venv = ArmTrackingSB3VecEnv(a.n_envs, **KWARGS)
     venv.seed(a.seed)
     model = PPO("MlpPolicy", VecMonitor(venv), seed=a.seed, verbose=0, **HYPER)
+    model.set_logger(silent_logger())
     start = time.perf_counter()
     model.learn(total_timesteps=a.timesteps)
     print(f"trained {a.timesteps} decisions in {time.perf_counter() - start:.0f} s")

@@ -5,7 +5,9 @@
     from stable_baselines3.common.vec_env import VecMonitor
 
     venv = VecMonitor(ArmTrackingSB3VecEnv(64, base_law="pd"))
-    PPO("MlpPolicy", venv).learn(100_000)
+    model = PPO("MlpPolicy", venv)
+    model.set_logger(silent_logger())  # else SB3 leaves /tmp/SB3-<date>/
+    model.learn(100_000)
 
 The arms step in Rust in one call, on every CPU (`num_threads`), as in
 `testbed.ArmTrackingVecEnv`; this class only speaks SB3's protocol:
@@ -34,7 +36,16 @@ except ImportError as e:  # pragma: no cover - the message is the point
 from ._native import VecEnvCore
 from .env import RENDER_MODES, RENDER_SIZE, _real_actions, _render_mode, _spaces
 
-__all__ = ["ArmTrackingSB3VecEnv"]
+__all__ = ["ArmTrackingSB3VecEnv", "silent_logger"]
+
+
+def silent_logger():
+    """An SB3 logger that writes nothing anywhere. Without a logger of its
+    own (or a `tensorboard_log`), every `learn()` makes an empty folder
+    /tmp/SB3-<date>/ that nothing removes."""
+    from stable_baselines3.common.logger import Logger
+
+    return Logger(folder=None, output_formats=[])
 
 
 class _Arm:

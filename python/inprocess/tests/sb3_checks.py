@@ -11,6 +11,7 @@ import tempfile
 import types
 import unittest
 import warnings
+from pathlib import Path
 
 import gymnasium
 import numpy as np
@@ -19,7 +20,7 @@ from stable_baselines3.common.env_checker import check_env
 from stable_baselines3.common.vec_env import VecCheckNan, VecMonitor, VecVideoRecorder
 
 import testbed
-from testbed.sb3 import ArmTrackingSB3VecEnv
+from testbed.sb3 import ArmTrackingSB3VecEnv, silent_logger
 
 #: Ten decisions an episode, the constraint from 20 ms on and a tight
 #: breach factor: a short rollout has both kinds of end.
@@ -130,7 +131,11 @@ class SB3Adapter(unittest.TestCase):
         venv = VecMonitor(ArmTrackingSB3VecEnv(8, scenario="paper", episode_s=0.2, base_law="pd"))
         model = PPO("MlpPolicy", venv, n_steps=32, batch_size=64, n_epochs=2, seed=0, device="cpu",
                     verbose=0)
+        model.set_logger(silent_logger())
+        leftovers = set(Path(tempfile.gettempdir()).glob("SB3-*"))
         model.learn(total_timesteps=512)
+        # SB3's own logger would have left an empty /tmp/SB3-<date>/.
+        self.assertEqual(set(Path(tempfile.gettempdir()).glob("SB3-*")), leftovers)
         self.assertGreaterEqual(model.num_timesteps, 512)
         # Episodes ended (ten decisions each) and VecMonitor counted them.
         self.assertGreater(len(model.ep_info_buffer), 0)
