@@ -30,6 +30,15 @@ fn every_shipped_menagerie_arm_runs_its_default_scenario_clean() {
         let arm = arm.as_str();
         let text = String::from_utf8(ok(testbed().args(["robot", arm])).stdout).unwrap();
         assert!(text.contains("default scenario"), "{arm}: {text}");
+        // An arm with a keyframe starts there (the M1013 has none).
+        let keyed = std::fs::read_to_string(crate::util::repo_root().join(arm))
+            .unwrap()
+            .contains("<key ");
+        assert_eq!(
+            text.contains("(the model's home pose: its MJCF keyframe, inside the limits)"),
+            keyed,
+            "{arm}: {text}"
+        );
         let s = json(&ok(testbed().args(["sim", "--json", "--robot", arm])));
         assert_eq!(s["finite"], true, "{arm}: {s}");
         assert_eq!(s["constraint_satisfied_after_tc"], true, "{arm}: {s}");

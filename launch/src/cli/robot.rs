@@ -313,5 +313,10 @@ fn default_scenario(out: &mut String, m: &ArmModel, d: &ArmDefault) {
             below.join(", ")
         );
     }
-    let _ = writeln!(out, "  initial q = {:?}", s.initial.q);
+    let from = if d.from_home {
+        " (the model's home pose: its MJCF keyframe, inside the limits)"
+    } else {
+        ""
+    };
+    let _ = writeln!(out, "  initial q = {:?}{from}", s.initial.q);
 }

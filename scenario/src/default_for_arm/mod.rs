@@ -231,6 +231,7 @@ impl ArmDefault {
         let gains = choose_gains(&model, &s, &kc_cap(&model))?;
         let (_, envelope, q0) = shape(&model, &offsets, amplitude, Some(&gains.envelope));
         s.envelope.joints = envelope;
+        let from_home = home.is_some();
         s.initial.q = home.unwrap_or(q0);
         s.rate_hz = gains.rate_hz;
         s.controller.k1 = controller::Gain::Each(gains.joints.iter().map(|g| g.k1).collect());
@@ -255,6 +256,7 @@ impl ArmDefault {
                 .collect(),
             gains,
             warnings,
+            from_home,
         };
         Ok((d, model))
     }

@@ -18,4 +18,7 @@ pub struct ArmDefault {
     /// What a user should know: loads beyond effort limits, joints the
     /// scenario could not hold, envelopes it widened.
     pub warnings: Vec<String>,
+    /// The start is the file's home pose (an MJCF keyframe `home`, kept
+    /// 2 % of each range inside the limits), not one chosen for the arm.
+    pub from_home: bool,
 }
