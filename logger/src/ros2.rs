@@ -57,49 +57,26 @@ const HEADER_DEPS: [(&str, &str); 2] = [
     ("builtin_interfaces/Time", TIME),
 ];
 
-/// The QoS a rosbag2 recording gives each topic, as its channel's
+/// The QoS a rosbag2 recording gives a topic, as its channel's
 /// `offered_qos_profiles` (YAML in the numeric form of rosbag2's metadata
 /// version 8, which Humble writes and, with the [`ROSBAG2_METADATA`]
-/// record saying version 8, Jazzy reads): reliable, volatile, automatic
-/// liveliness, no deadline, lifespan or lease (the largest durations,
-/// rmw's "infinite"). `ros2 bag play` re-offers each topic with it.
-pub const OFFERED_QOS_PROFILES: &str = "- history: 3
-  depth: 0
-  reliability: 1
-  durability: 2
-  deadline:
-    sec: 2147483647
-    nsec: 4294967295
-  lifespan:
-    sec: 2147483647
-    nsec: 4294967295
-  liveliness: 1
-  liveliness_lease_duration:
-    sec: 2147483647
-    nsec: 4294967295
-  avoid_ros_namespace_conventions: false
-";
-
-/// The QoS of a latched topic ([`ROBOT_DESCRIPTION_TOPIC`]), as
-/// robot_state_publisher offers `/robot_description`: keep last 1,
-/// reliable, transient local (durability 1), so that a subscriber that
-/// joins late (Foxglove's 3D panel, `ros2 bag play`'s listeners) gets it.
-pub const LATCHED_QOS_PROFILES: &str = "- history: 1
-  depth: 1
-  reliability: 1
-  durability: 1
-  deadline:
-    sec: 2147483647
-    nsec: 4294967295
-  lifespan:
-    sec: 2147483647
-    nsec: 4294967295
-  liveliness: 1
-  liveliness_lease_duration:
-    sec: 2147483647
-    nsec: 4294967295
-  avoid_ros_namespace_conventions: false
-";
+/// record saying version 8, Jazzy reads): reliable, automatic liveliness,
+/// no deadline, lifespan or lease (the largest durations, rmw's
+/// "infinite"). A stream is volatile with the system's default history
+/// (history 3, depth 0); a latched topic ([`ROBOT_DESCRIPTION_TOPIC`]) is
+/// offered as robot_state_publisher offers `/robot_description`: keep last
+/// 1, transient local (durability 1), so that a subscriber that joins late
+/// (Foxglove's 3D panel, `ros2 bag play`'s listeners) gets it. `ros2 bag
+/// play` re-offers each topic with it.
+pub fn qos_profiles(latched: bool) -> String {
+    let (history, depth, durability) = if latched { (1, 1, 1) } else { (3, 0, 2) };
+    let infinite = "\n    sec: 2147483647\n    nsec: 4294967295";
+    format!(
+        "- history: {history}\n  depth: {depth}\n  reliability: 1\n  durability: {durability}\n  \
+         deadline:{infinite}\n  lifespan:{infinite}\n  liveliness: 1\n  \
+         liveliness_lease_duration:{infinite}\n  avoid_ros_namespace_conventions: false\n"
+    )
+}
 
 /// The robot model as ROS 2 publishes it: the URDF text, latched.
 pub const ROBOT_DESCRIPTION_TOPIC: &str = "/robot_description";
@@ -107,12 +84,8 @@ pub const ROBOT_DESCRIPTION_TOPIC: &str = "/robot_description";
 /// The channel metadata of `topic` as rosbag2 writes it: its offered QoS
 /// (latched for [`ROBOT_DESCRIPTION_TOPIC`]).
 pub fn channel_metadata(topic: &str) -> std::collections::BTreeMap<String, String> {
-    let qos = if topic == ROBOT_DESCRIPTION_TOPIC {
-        LATCHED_QOS_PROFILES
-    } else {
-        OFFERED_QOS_PROFILES
-    };
-    std::collections::BTreeMap::from([("offered_qos_profiles".to_string(), qos.to_string())])
+    let qos = qos_profiles(topic == ROBOT_DESCRIPTION_TOPIC);
+    std::collections::BTreeMap::from([("offered_qos_profiles".to_string(), qos)])
 }
 
 /// Name of the metadata record rosbag2's MCAP storage plugin reads the
@@ -121,7 +94,7 @@ pub fn channel_metadata(topic: &str) -> std::collections::BTreeMap<String, Strin
 /// and read every one as "unknown".
 pub const ROSBAG2_METADATA: &str = "rosbag2";
 /// The `BagMetadata` version the record declares: 8, whose QoS profiles
-/// are numeric, as [`OFFERED_QOS_PROFILES`] is (9 spells them as words,
+/// are numeric, as [`qos_profiles`] writes them (9 spells them as words,
 /// which Humble cannot read).
 pub const BAG_METADATA_VERSION: u32 = 8;
 /// The ROS 2 distribution the record names.

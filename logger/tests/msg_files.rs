@@ -99,11 +99,7 @@ fn every_channel_offers_a_qos_profile() {
     assert_eq!(summary.channels.len(), logger::channels().len());
     for c in summary.channels.values() {
         let qos = c.metadata.get("offered_qos_profiles").map(String::as_str);
-        let want = if c.topic == ros2::ROBOT_DESCRIPTION_TOPIC {
-            ros2::LATCHED_QOS_PROFILES
-        } else {
-            ros2::OFFERED_QOS_PROFILES
-        };
-        assert_eq!(qos, Some(want), "{}", c.topic);
+        let want = ros2::qos_profiles(c.topic == ros2::ROBOT_DESCRIPTION_TOPIC);
+        assert_eq!(qos, Some(want.as_str()), "{}", c.topic);
     }
 }

@@ -97,7 +97,7 @@ fn the_log_has_the_rosbag2_record_jazzy_reads() {
     for q in qos_lines {
         let text: String = serde_json::from_str(q).unwrap();
         assert!(
-            text == ros2::OFFERED_QOS_PROFILES || text == ros2::LATCHED_QOS_PROFILES,
+            text == ros2::qos_profiles(false) || text == ros2::qos_profiles(true),
             "{text}"
         );
     }
