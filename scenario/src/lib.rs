@@ -19,6 +19,7 @@ mod effort;
 mod gains;
 mod keys;
 mod motor_bound;
+mod overrides;
 mod plan;
 mod posture;
 mod probe;
