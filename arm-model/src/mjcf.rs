@@ -4,7 +4,11 @@
 //! into URDF links and joints and hands them to the URDF path's checks
 //! (`tree::build`: roots, locks, inertia checks, folding of welded bodies),
 //! so that the two formats cannot drift apart. What URDF cannot say
-//! (armature, the home keyframe, actuator limits) is set on the result.
+//! (armature, the home keyframe, actuator limits) is set on the result;
+//! the files beside this one hold each part: includes (`mjcf_include`),
+//! inertia from geoms (`mjcf_inertia`), actuators (`mjcf_actuators`,
+//! `mjcf_joint_force`), the home keyframe (`mjcf_keyframe`), and what is
+//! named and not applied (`mjcf_notes`).
 //!
 //! A MuJoCo joint turns about an anchor `pos` in its body's frame; a URDF
 //! joint turns about its child link's origin. Each body's link frame is
@@ -16,7 +20,6 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use mjcf_rs::body::{Body, Geom, GeomType, InertiaSpec, Joint, JointType};
-use mjcf_rs::extras::ActuatorKind;
 use nalgebra::{Isometry3, Quaternion, UnitQuaternion, Vector3};
 
 use super::inertia::origin_of;
@@ -80,7 +83,7 @@ fn convert(
         j.armature = c.armature.get(&j.name).copied().unwrap_or(0.0);
     }
     let mut notes = c.notes;
-    notes.extend(actuators(m, &mut model));
+    notes.extend(super::mjcf_actuators::actuators(m, &mut model));
     // A joint's actuatorfrcrange clamps whatever drives it.
     for j in model
         .joints
@@ -91,7 +94,7 @@ fn convert(
             j.effort = Some(j.effort.map_or(f, |e| e.min(f)));
         }
     }
-    model.home = home(m, &model, &c.qpos_order)?;
+    model.home = super::mjcf_keyframe::home(m, &model, &c.qpos_order)?;
     notes.extend(super::mjcf_notes::unapplied(m, whole));
     notes.append(&mut model.notes);
     model.notes = notes;
@@ -460,92 +463,4 @@ fn collision(g: &Geom, shift: &Isometry3<f64>) -> Option<urdf_rs::Collision> {
         origin: pose(origin_of(&(shift * at))),
         geometry,
     })
-}
-
-/// Effort limits from the actuators that drive a joint (a motor's gear ×
-/// its control range, any actuator's force range; the joint's own
-/// `actuatorfrcrange` is applied by the caller), and notes on what is
-/// not used: servo gains (the controller is the testbed's own) and
-/// actuators on tendons or sites.
-fn actuators(m: &mjcf_rs::Model, model: &mut ArmModel) -> Vec<String> {
-    let mut notes = Vec::new();
-    let auto = m.compiler.autolimits;
-    for (i, a) in m.actuators.iter().enumerate() {
-        let label = a.name.clone().unwrap_or_else(|| format!("#{i}"));
-        let Some(joint) = &a.joint else {
-            notes.push(format!(
-                "actuator '{label}' drives no joint (a tendon, site or body): ignored"
-            ));
-            continue;
-        };
-        let bound = |r: Option<[f64; 2]>, limited: mjcf_rs::types::Tristate| {
-            r.filter(|_| limited.resolve(auto, r.is_some()))
-                .map(|r| r[0].abs().max(r[1].abs()))
-        };
-        // forcerange clamps the actuator's force; the joint feels gear × it.
-        let force = bound(a.force_range, a.force_limited).map(|f| f * a.gear[0].abs());
-        let ctrl = match a.kind {
-            ActuatorKind::Motor => bound(a.ctrl_range, a.ctrl_limited).map(|c| c * a.gear[0].abs()),
-            _ => {
-                notes.push(format!(
-                    "actuator '{label}' is a {:?} servo on '{joint}': its gains are ignored (the controller is the testbed's own)",
-                    a.kind
-                ));
-                None
-            }
-        };
-        let effort = match (force, ctrl) {
-            (Some(f), Some(c)) => Some(f.min(c)),
-            (f, c) => f.or(c),
-        };
-        let target = model
-            .joints
-            .iter_mut()
-            .find(|j| &j.name == joint && j.kind != JointKind::Fixed);
-        if let (Some(j), Some(e)) = (target, effort.filter(|e| *e > 0.0)) {
-            j.effort = Some(j.effort.map_or(e, |old| old.min(e)));
-        }
-    }
-    notes
-}
-
-/// The keyframe named `home` (else the first) as a pose of the controlled
-/// joints; None when the file has no key.
-fn home(
-    m: &mjcf_rs::Model,
-    model: &ArmModel,
-    qpos_order: &[String],
-) -> Result<Option<Vec<f64>>, ModelError> {
-    let Some(key) = (m.keyframes.iter())
-        .find(|k| k.name.as_deref() == Some("home"))
-        .or_else(|| m.keyframes.first())
-    else {
-        return Ok(None);
-    };
-    let label = key.name.clone().unwrap_or_else(|| "#0".into());
-    if key.qpos.is_empty() {
-        return Ok(None);
-    }
-    if key.qpos.len() != qpos_order.len() {
-        return Err(ModelError::MjcfRefused {
-            element: format!("<key name='{label}'>"),
-            reason: format!(
-                "qpos has {} values for {} joints",
-                key.qpos.len(),
-                qpos_order.len()
-            ),
-        });
-    }
-    let by_name: HashMap<&str, f64> = qpos_order
-        .iter()
-        .map(String::as_str)
-        .zip(key.qpos.iter().copied())
-        .collect();
-    Ok(Some(
-        model
-            .joint_names()
-            .iter()
-            .map(|n| by_name.get(n.as_str()).copied().unwrap_or(0.0))
-            .collect(),
-    ))
 }
