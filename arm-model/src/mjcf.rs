@@ -101,11 +101,6 @@ fn convert(
     Ok(model)
 }
 
-/// `<body name>`, or its index when unnamed.
-pub(crate) fn body_name(b: &Body, id: usize) -> String {
-    b.name.clone().unwrap_or_else(|| format!("body{id}"))
-}
-
 fn iso_of(p: &mjcf_rs::Pose) -> Isometry3<f64> {
     let (q, t) = (p.rotation, p.translation);
     Isometry3::from_parts(
@@ -153,7 +148,7 @@ fn tree(m: &mjcf_rs::Model, groups: [i32; 2]) -> Result<Converted, ModelError> {
             moves.push(false);
             continue;
         };
-        let name = body_name(b, id);
+        let name = super::mjcf_notes::body_name(b, id);
         let (parent_link, parent_anchor) = link_of
             .get(parent)
             .cloned()

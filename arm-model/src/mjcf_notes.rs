@@ -2,10 +2,16 @@
 //! the model's own gravity, `gravcomp`, equality constraints and tendons,
 //! joint springs. `mjcf.rs` adds these notes to the model it reads.
 
-use mjcf_rs::body::Joint;
+use mjcf_rs::body::{Body, Joint};
 use nalgebra::Vector3;
 
 use super::mjcf_include::{attribute, tags};
+
+/// `<body name>`, or its index when unnamed: how notes and errors name a
+/// body (and the link it becomes).
+pub(crate) fn body_name(b: &Body, id: usize) -> String {
+    b.name.clone().unwrap_or_else(|| format!("body{id}"))
+}
 
 /// The model-wide notes, in the order a reader meets them.
 pub(crate) fn unapplied(m: &mjcf_rs::Model, whole: &str) -> Vec<String> {
@@ -40,7 +46,7 @@ fn gravity(m: &mjcf_rs::Model, whole: &str) -> Option<String> {
 fn gravcomp(m: &mjcf_rs::Model) -> Option<String> {
     let bodies: Vec<String> = (m.bodies.iter().enumerate())
         .filter(|(_, e)| e.body.gravcomp != 0.0)
-        .map(|(id, e)| super::mjcf::body_name(&e.body, id))
+        .map(|(id, e)| body_name(&e.body, id))
         .collect();
     (!bodies.is_empty()).then(|| {
         format!(
