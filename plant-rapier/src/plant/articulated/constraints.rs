@@ -165,6 +165,9 @@ impl Impulses {
         self.friction_dv.iter_mut().for_each(|x| *x = 0.0);
         self.friction_impulse.iter_mut().for_each(|x| *x = 0.0);
         for _ in 0..SWEEPS {
+            // A sweep that moves no multiplier leaves q̇ as it was, so every
+            // later sweep would repeat it: the rest are skipped, exactly.
+            let mut moved = false;
             for (r, row) in self.rows.iter().enumerate() {
                 let (coord, cols) = match *row {
                     Row::Friction { coord, .. } => (coord, &self.friction_response),
@@ -182,6 +185,10 @@ impl Impulses {
                     Row::Stop { upper: false, .. } => free.max(0.0),
                 };
                 self.lambda[r] = new;
+                if new == old {
+                    continue;
+                }
+                moved = true;
                 let push = f.multiplier * (new - old);
                 let friction = matches!(row, Row::Friction { .. });
                 if friction {
@@ -193,6 +200,9 @@ impl Impulses {
                         self.friction_dv[i] += col[i] * push;
                     }
                 }
+            }
+            if !moved {
+                break;
             }
         }
         // Friction acted over the substep as a constant torque: its effect
