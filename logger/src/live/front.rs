@@ -96,7 +96,7 @@ impl Front {
     /// Connections to the server's loopback port that came past the relay
     /// and were cut.
     pub(super) fn bypassed(&self) -> u64 {
-        self.shared.bypassed.load(Ordering::Relaxed)
+        self.shared.bypassed.load(Ordering::SeqCst)
     }
 
     /// Stops accepting and cuts every open connection.

@@ -29,8 +29,11 @@ pub(super) fn guard(inner_port: u16, shared: &Arc<Shared>) {
                 continue;
             }
             if suspects.contains(&inode) {
+                // Counted before the cut: a client that sees its connection
+                // end and stops the run finds the cut in the run's stats
+                // (counted after, a loaded machine lost it once).
+                shared.bypassed.fetch_add(1, Ordering::SeqCst);
                 let _ = nix::sys::socket::shutdown(fd, nix::sys::socket::Shutdown::Both);
-                shared.bypassed.fetch_add(1, Ordering::Relaxed);
             } else {
                 now.insert(inode);
             }
