@@ -20,10 +20,12 @@ if ! cargo fuzz build ${FUZZ_DEV:+--dev} --fuzz-dir fuzz; then
 fi
 scratch="$(mktemp -d)"
 trap 'rm -rf "$scratch"' EXIT
-for target in scenario urdf mjcf log sweep node_config; do
-    mkdir -p "$scratch/$target"
+for target in scenario urdf mjcf mjcf_include log sweep node_config; do
+    mkdir -p "$scratch/$target" "$scratch/tmp"
     status=0
-    cargo fuzz run ${FUZZ_DEV:+--dev} --fuzz-dir fuzz "$target" "$scratch/$target" "fuzz/seeds/$target" -- \
+    # TMPDIR in the scratch folder: the scratch file systems a target
+    # builds (mjcf_include's model folders) go when the run ends.
+    TMPDIR="$scratch/tmp" cargo fuzz run ${FUZZ_DEV:+--dev} --fuzz-dir fuzz "$target" "$scratch/$target" "fuzz/seeds/$target" -- \
         -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
         >"$scratch/$target.log" 2>&1 || status=$?
     # libFuzzer's progress lines stay in the log; the outcome is shown.

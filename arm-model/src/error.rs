@@ -124,6 +124,18 @@ pub enum ModelError {
     /// found, an unknown default class, malformed XML).
     #[error("not a valid MJCF: {0}")]
     MjcfParse(String),
+    /// An MJCF `<include>` that is not read (outside the model's folder,
+    /// not a regular file, not MJCF, over a cap): the include and the path
+    /// are named, never what the file holds.
+    #[error("MJCF {include} ({path}) is not included: {reason}")]
+    MjcfInclude {
+        /// The include tag as written (cut to 200 characters).
+        include: String,
+        /// The file it names, and where a symlink or `..` leads.
+        path: String,
+        /// Why it is not read.
+        reason: String,
+    },
     /// An MJCF element the testbed cannot simulate, named.
     #[error("MJCF {element}: {reason}")]
     MjcfRefused {
@@ -156,7 +168,7 @@ pub enum ModelError {
     /// A tag with more than [`MAX_ATTRIBUTES`](crate::MAX_ATTRIBUTES) attributes.
     #[error(
         "line {line}: <{element}> has {count} attributes or more, over the cap of {cap} \
-         (a URDF element has a handful)"
+         (a URDF or MJCF element has a handful)"
     )]
     TooManyAttributes {
         /// The element's name (cut to 80 characters).

@@ -32,7 +32,7 @@ pub(super) fn origin_of(t: &Isometry3<f64>) -> Origin {
     }
 }
 
-fn tensor(i: &[f64; 6]) -> Matrix3<f64> {
+pub(super) fn tensor(i: &[f64; 6]) -> Matrix3<f64> {
     let [ixx, ixy, ixz, iyy, iyz, izz] = *i;
     Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz)
 }

@@ -28,6 +28,7 @@
 //! assert!(g[0] > 0.0); // holding the arm level takes a positive shoulder torque
 //! ```
 
+mod bounded_read;
 mod collision;
 mod diagnose;
 pub mod dynamics;
@@ -40,10 +41,12 @@ mod link_children;
 mod mjcf;
 mod mjcf_actuators;
 mod mjcf_include;
+mod mjcf_include_file;
 mod mjcf_inertia;
 mod mjcf_joint_force;
 mod mjcf_keyframe;
 mod mjcf_notes;
+mod mjcf_scan;
 mod parse;
 mod prefixes;
 mod root_element;
@@ -55,6 +58,8 @@ use std::collections::BTreeMap;
 pub use collision::{CollisionShape, Geometry};
 pub use error::ModelError;
 pub use inertia::iso;
+pub use mjcf_actuators::MAX_MJCF_EFFORT;
+pub use mjcf_include::MAX_INCLUDED_FILES;
 
 /// The most links (and joints) a URDF may have: real arms have tens.
 pub const MAX_LINKS: usize = 1000;
@@ -307,17 +312,14 @@ impl ArmModel {
             });
         }
         root_element::check(text)?;
-        let deepest = xml_depth::depth(text, xml_depth::MAX_XML_DEPTH);
-        if deepest > xml_depth::MAX_XML_DEPTH {
-            return Err(ModelError::Parse(format!(
-                "elements are nested more than {} deep: not a URDF (a robot's elements \
-                 nest a few levels)",
-                xml_depth::MAX_XML_DEPTH
-            )));
-        }
         // Chosen by content, so every place that takes a robot file takes
         // MJCF too; text names no other file (see `self_contained`).
-        if mjcf::is_mjcf(text) {
+        let is_mjcf = mjcf::is_mjcf(text);
+        let deepest = xml_depth::depth(text, xml_depth::MAX_XML_DEPTH);
+        if deepest > xml_depth::MAX_XML_DEPTH {
+            return Err(too_deep(is_mjcf));
+        }
+        if is_mjcf {
             mjcf_include::refuse_includes(text)?;
             return mjcf::from_str(text, std::path::Path::new("."), locks);
         }
@@ -396,12 +398,14 @@ impl ArmModel {
     }
 
     /// Reads an MJCF file (its `<include>`s relative to its folder) with
-    /// the joints in `locks` held; errors name the file.
+    /// the joints in `locks` held; errors name the file. The file and its
+    /// includes are read as a scenario reads a robot file: a regular file
+    /// of at most [`MAX_URDF_BYTES`], through the same checks as text.
     pub fn from_mjcf_file(path: &std::path::Path, locks: &Locks) -> Result<Self, ModelError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ModelError::MjcfParse(format!("cannot read {}: {e}", path.display())))?;
+        let text = bounded_read::read(path, MAX_URDF_BYTES as u64)
+            .map_err(|e| ModelError::MjcfParse(format!("{}: {e}", path.display())))?;
         let dir = path.parent().unwrap_or(std::path::Path::new("."));
-        mjcf::from_str(&text, dir, locks).map_err(|e| match e {
+        Self::mjcf_text_of_file(&text, dir, locks).map_err(|e| match e {
             ModelError::MjcfParse(why) => {
                 ModelError::MjcfParse(format!("{}: {why}", path.display()))
             }
@@ -411,6 +415,21 @@ impl ArmModel {
             },
             other => other,
         })
+    }
+
+    /// An MJCF file's text, its includes inlined from `dir`, read as text.
+    fn mjcf_text_of_file(
+        text: &str,
+        dir: &std::path::Path,
+        locks: &Locks,
+    ) -> Result<Self, ModelError> {
+        if !mjcf::is_mjcf(text) {
+            root_element::check(text)?;
+            return Err(ModelError::MjcfParse(
+                "the root element is not <mujoco>: not an MJCF file".into(),
+            ));
+        }
+        Self::from_urdf_str_locked(&mjcf_include::inline(text, dir)?, locks)
     }
 
     /// The link called `name` (a merged one too): the index of the body it
@@ -488,6 +507,20 @@ impl ArmModel {
             .iter()
             .copied()
             .chain(self.mimic.iter().map(|m| m.joint))
+    }
+}
+
+/// Nesting past [`xml_depth::MAX_XML_DEPTH`], named in the file's format.
+fn too_deep(is_mjcf: bool) -> ModelError {
+    let max = xml_depth::MAX_XML_DEPTH;
+    match is_mjcf {
+        true => ModelError::MjcfParse(format!(
+            "elements are nested more than {max} deep (a model's elements nest a few levels)"
+        )),
+        false => ModelError::Parse(format!(
+            "elements are nested more than {max} deep: not a URDF (a robot's elements nest a \
+             few levels)"
+        )),
     }
 }
 

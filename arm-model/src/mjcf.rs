@@ -5,10 +5,11 @@
 //! (`tree::build`: roots, locks, inertia checks, folding of welded bodies),
 //! so that the two formats cannot drift apart. What URDF cannot say
 //! (armature, the home keyframe, actuator limits) is set on the result;
-//! the files beside this one hold each part: includes (`mjcf_include`),
-//! inertia from geoms (`mjcf_inertia`), actuators (`mjcf_actuators`,
-//! `mjcf_joint_force`), the home keyframe (`mjcf_keyframe`), and what is
-//! named and not applied (`mjcf_notes`).
+//! the files beside this one hold each part: includes (`mjcf_include`,
+//! and which files they may read, `mjcf_include_file`), what the parser
+//! must not meet (`mjcf_scan`), inertia from geoms (`mjcf_inertia`),
+//! actuators (`mjcf_actuators`, `mjcf_joint_force`), the home keyframe
+//! (`mjcf_keyframe`), and what is named and not applied (`mjcf_notes`).
 //!
 //! A MuJoCo joint turns about an anchor `pos` in its body's frame; a URDF
 //! joint turns about its child link's origin. Each body's link frame is
@@ -36,7 +37,7 @@ pub(crate) fn is_mjcf(text: &str) -> bool {
         } else if rest.starts_with("<!--") {
             rest.find("-->").map(|i| i + 3)
         } else if rest.starts_with("<!") {
-            rest.find('>').map(|i| i + 1)
+            declaration_end(rest)
         } else {
             break;
         };
@@ -50,11 +51,31 @@ pub(crate) fn is_mjcf(text: &str) -> bool {
         .is_some_and(|c| c.is_whitespace() || c == '>' || c == '/')
 }
 
+/// Where a `<!…>` declaration ends, past a doctype's internal subset
+/// (`<!DOCTYPE mujoco [<!ENTITY …>]>`): an entity bomb in MJCF is then
+/// told as MJCF, and refused as one, instead of "not a valid URDF".
+fn declaration_end(rest: &str) -> Option<usize> {
+    let close = rest.find('>')?;
+    match rest[..close].find('[') {
+        Some(open) => {
+            let subset_end = open + rest[open..].find(']')?;
+            rest[subset_end..].find('>').map(|i| subset_end + i + 1)
+        }
+        None => Some(close + 1),
+    }
+}
+
 /// Reads an MJCF document whose `<include>`s are relative to `base_dir`.
 pub(crate) fn from_str(text: &str, base_dir: &Path, locks: &Locks) -> Result<ArmModel, ModelError> {
     // Inlined first, so that an include anywhere MuJoCo takes one (inside
     // a <body>, as Adroit's) reads as MuJoCo reads it.
     let whole = super::mjcf_include::inline(text, base_dir)?;
+    // An included file's body may hold what the main file may not.
+    super::mjcf_include::refuse_doctype(&whole)?;
+    // mjcf-rs reads an <include> or an <asset><model file> itself,
+    // unbounded and from anywhere: none may be left for it.
+    super::mjcf_scan::refuse_parser_reads(&whole)?;
+    super::mjcf_scan::check_orientations(&whole)?;
     let m = mjcf_rs::Model::from_str(&whole, base_dir)
         .map_err(|e| ModelError::MjcfParse(e.to_string()))?;
     let joint_force = super::mjcf_joint_force::joint_force_limits(&whole, m.compiler.autolimits)?;
@@ -83,14 +104,24 @@ fn convert(
         j.armature = c.armature.get(&j.name).copied().unwrap_or(0.0);
     }
     let mut notes = c.notes;
-    notes.extend(super::mjcf_actuators::actuators(m, &mut model));
+    notes.extend(super::mjcf_actuators::actuators(m, &mut model)?);
     // A joint's actuatorfrcrange clamps whatever drives it.
     for j in model
         .joints
         .iter_mut()
         .filter(|j| j.kind != JointKind::Fixed)
     {
-        if let Some(&f) = joint_force.get(&j.name).filter(|f| **f > 0.0) {
+        if let Some(&f) = joint_force.get(&j.name) {
+            let what = format!(
+                "actuatorfrcrange (its larger end in size {})",
+                super::mjcf_actuators::number(f)
+            );
+            let f = super::mjcf_actuators::usable_limit(f, &what).map_err(|reason| {
+                ModelError::MjcfRefused {
+                    element: format!("<joint name='{}'>", j.name),
+                    reason,
+                }
+            })?;
             j.effort = Some(j.effort.map_or(f, |e| e.min(f)));
         }
     }
@@ -143,6 +174,7 @@ fn tree(m: &mjcf_rs::Model, groups: [i32; 2]) -> Result<Converted, ModelError> {
                 b,
                 Vector3::zeros(),
                 Weld::World,
+                &mut c.notes,
             )?);
             link_of.push(("world".into(), Vector3::zeros()));
             moves.push(false);
@@ -164,14 +196,14 @@ fn tree(m: &mjcf_rs::Model, groups: [i32; 2]) -> Result<Converted, ModelError> {
         )?;
         let moving = moves.get(parent).copied().unwrap_or(false) || !b.joints.is_empty();
         let weld = if moving { Weld::Moves } else { Weld::Fixed };
-        let l = match link((m, groups), &name, b, anchor, weld) {
+        let l = match link((m, groups), &name, b, anchor, weld, &mut c.notes) {
             // A body welded to the world moves nothing: its mass does not
             // matter, so a mesh it would take it from is not needed.
             Err(ModelError::MjcfRefused { element, .. }) if !moving => {
                 c.notes.push(format!(
                     "{element}: its mass would come from a mesh, which is not read; the body is welded to the world, so its mass does not change the dynamics"
                 ));
-                link((m, groups), &name, b, anchor, Weld::World)?
+                link((m, groups), &name, b, anchor, Weld::World, &mut c.notes)?
             }
             other => other?,
         };
@@ -372,6 +404,7 @@ fn link(
     b: &Body,
     anchor: Vector3<f64>,
     weld: Weld,
+    notes: &mut Vec<String>,
 ) -> Result<urdf_rs::Link, ModelError> {
     use mjcf_rs::compiler::InertiaFromGeom;
     let shift = Isometry3::translation(-anchor.x, -anchor.y, -anchor.z);
@@ -410,6 +443,15 @@ fn link(
             InertiaSpec::Diagonal([a, b, c]) => [a, 0.0, 0.0, b, 0.0, c],
             // MJCF orders fullinertia ixx iyy izz ixy ixz iyz.
             InertiaSpec::Full([xx, yy, zz, xy, xz, yz]) => [xx, xy, xz, yy, yz, zz],
+        };
+        // A body welded to the world moves nothing: its tensor is not used.
+        let t = match weld {
+            Weld::Moves => {
+                let (t, note) = super::mjcf_inertia::balanced(name, t, m.compiler.balance_inertia)?;
+                notes.extend(note);
+                t
+            }
+            Weld::Fixed | Weld::World => t,
         };
         (i.mass, iso_of(&i.pose), t)
     };

@@ -124,6 +124,49 @@ pub(super) fn group_range(whole: &str) -> Result<[i32; 2], ModelError> {
     }
 }
 
+/// How far past equality (relative to the largest moment) a tensor may
+/// break the triangle inequality and still be taken: rounding of its
+/// principal moments, not a tensor MuJoCo would refuse.
+const TRIANGLE_ROUNDING: f64 = 1e-9;
+
+/// An `<inertial>`'s tensor as MuJoCo's compiler takes it (#60 item 9):
+/// its principal moments satisfy the triangle inequality A + B ≥ C, as
+/// every rigid body's do, or the model is refused; with `<compiler
+/// balanceinertia="true">` such a tensor becomes its mean moment about
+/// every axis, as MuJoCo makes it, and a note says so. A tensor with a
+/// negative moment is left to the common check, which names it as such.
+pub(super) fn balanced(
+    body: &str,
+    t: [f64; 6],
+    balance: bool,
+) -> Result<([f64; 6], Option<String>), ModelError> {
+    let mut ev: Vec<f64> = (super::inertia::tensor(&t).symmetric_eigenvalues().iter())
+        .copied()
+        .collect();
+    ev.sort_by(f64::total_cmp);
+    let broken = ev[0] >= 0.0 && ev[2] - ev[0] - ev[1] > TRIANGLE_ROUNDING * ev[2];
+    if !broken {
+        return Ok((t, None));
+    }
+    let moments = format!(
+        "principal moments {:.3e}, {:.3e}, {:.3e}",
+        ev[0], ev[1], ev[2]
+    );
+    if !balance {
+        return Err(ModelError::MjcfRefused {
+            element: format!("<inertial> in <body name='{body}'>"),
+            reason: format!(
+                "{moments} break the triangle inequality (A + B ≥ C): no rigid body has them, and MuJoCo refuses them (correct the tensor, or set <compiler balanceinertia=\"true\"> to have them averaged, as MuJoCo does)"
+            ),
+        });
+    }
+    let mean = (ev[0] + ev[1] + ev[2]) / 3.0;
+    let note = format!(
+        "<inertial> in <body name='{body}'>: {moments} break the triangle inequality; balanceinertia sets each to their mean {mean:.3e}, as MuJoCo does"
+    );
+    Ok(([mean, 0.0, 0.0, mean, 0.0, mean], Some(note)))
+}
+
 /// The name MuJoCo messages would give a geom: its name or its index.
 fn geom_label(g: &Geom, i: usize) -> String {
     match &g.name {

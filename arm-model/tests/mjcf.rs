@@ -180,7 +180,7 @@ fn a_missing_include_names_the_file() {
     std::fs::write(&path, r#"<mujoco><include file="nowhere.xml"/></mujoco>"#).unwrap();
     let e = ArmModel::from_mjcf_file(&path, &Locks::new()).unwrap_err();
     std::fs::remove_file(&path).ok();
-    assert!(matches!(e, ModelError::MjcfParse(_)), "{e}");
+    assert!(matches!(e, ModelError::MjcfInclude { .. }), "{e}");
     assert!(e.to_string().contains("nowhere.xml"), "{e}");
 }
 
