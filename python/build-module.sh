@@ -15,10 +15,11 @@ python="$(bash "$root/python/setup-venv.sh" "$@")"
 venv="$(dirname "$(dirname "$python")")"
 exec 8>"$venv.module.lock"
 flock 8
-# onnx: testbed.onnx_export writes policies for the Rust node (its tests).
-if ! "$python" -c "import gymnasium, maturin, onnx" 2>/dev/null; then
+# onnx: testbed.onnx_export writes policies for the Rust node (its tests);
+# optuna and tqdm: testbed.tune (`testbed tune`, the wheel's `tune` extra).
+if ! "$python" -c "import gymnasium, maturin, onnx, optuna, tqdm" 2>/dev/null; then
     "$python" -m pip install --quiet --disable-pip-version-check \
-        "maturin>=1.9,<2" "gymnasium==1.4.0" "onnx>=1.16,<2" >&2
+        "maturin>=1.9,<2" "gymnasium==1.4.0" "onnx>=1.16,<2" "optuna>=4,<6" "tqdm>=4" >&2
 fi
 # maturin finds the environment through VIRTUAL_ENV; cargo's own output
 # goes to stderr, so stdout carries only the python's path.

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::search_space::{GAIN_SCALE, Range, Role, SearchDim};
 use crate::{ControllerError, Gain, LawName};
 
 /// How the weight ODEs are advanced over one control period (SPEC §9).
@@ -60,14 +61,16 @@ fn is_default<T: Default + PartialEq>(x: &T) -> bool {
 }
 
 /// Declares every parameter once: its documentation, serde attributes,
-/// type, default and check. The struct, its `Default`, the range checks,
-/// [`ControllerParams::KEYS`], [`ControllerParams::changed_keys`] and what
+/// type, default, check and, for a key a tuner may search, its range and
+/// role (`search (RANGE, ROLE)`, [`crate::search_space`]). The struct, its `Default`, the range checks,
+/// [`ControllerParams::KEYS`], [`ControllerParams::changed_keys`],
+/// [`ControllerParams::SEARCH`] and what
 /// [`ControllerParams::for_law`] carries are all made from this one list.
 macro_rules! parameters {
     ($(
         $(#[doc = $doc:literal])*
         $(#[serde($($serde:tt)*)])*
-        $field:ident : $ty:ty = $default:expr, $check:path;
+        $field:ident : $ty:ty = $default:expr, $check:path $(, search $search:expr)?;
     )*) => {
         /// Every parameter of the law. Unset keys take the paper's values.
         #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -117,6 +120,14 @@ macro_rules! parameters {
                 need: $check.need,
             }),*];
 
+            /// Every key a tuner may search, with its range (`search` in the
+            /// declaration): [`crate::search_space`] picks a law's from it.
+            pub const SEARCH: &'static [SearchDim] = &[$($(SearchDim {
+                key: stringify!($field),
+                range: $search.0,
+                role: $search.1,
+            },)?)*];
+
             /// Copies from `other` every key `keep` accepts.
             fn carry(&mut self, other: &Self, keep: impl Fn(&str) -> bool) {
                 $( if keep(stringify!($field)) { self.$field = other.$field.clone(); } )*
@@ -134,41 +145,42 @@ parameters! {
     tc: f64 = 2.0, TIME_CONSTANT;
     /// Position-error gain K1 = diag(K1_i), 1/s: one number or one per
     /// joint (SPEC §7 needs K1_i > 0).
-    k1: Gain = Gain::All(15.0), POSITIVE_GAIN;
+    k1: Gain = Gain::All(15.0), POSITIVE_GAIN, search (GAIN_SCALE, Role::Gain);
     /// Velocity-error gain K2 = diag(K2_i), N m s/rad: one number or one
     /// per joint (the analysis asks K2_i > 1/2, SPEC §7 allows less on very
     /// light joints and the testbed reports them).
-    k2: Gain = Gain::All(15.0), POSITIVE_GAIN;
+    k2: Gain = Gain::All(15.0), POSITIVE_GAIN, search (GAIN_SCALE, Role::Gain);
     /// Barrier steepness β.
-    beta: f64 = 10.0, POSITIVE;
+    beta: f64 = 10.0, POSITIVE, search (Range::log(0.5, 100.0), Role::Law);
     /// Actor learning rate σ_a.
-    sigma_a: f64 = 50.0, POSITIVE;
+    sigma_a: f64 = 50.0, POSITIVE, search (Range::log(0.01, 1e4), Role::Actor);
     /// Critic learning rate σ_c.
-    sigma_c: f64 = 50.0, POSITIVE;
+    sigma_c: f64 = 50.0, POSITIVE, search (Range::log(0.01, 1e4), Role::Critic);
     /// Actor regularisation η_a.
-    eta_a: f64 = 0.01, POSITIVE;
+    eta_a: f64 = 0.01, POSITIVE, search (Range::log(1e-5, 10.0), Role::Actor);
     /// Critic regularisation η_c.
-    eta_c: f64 = 0.5, POSITIVE;
+    eta_c: f64 = 0.5, POSITIVE, search (Range::log(1e-5, 10.0), Role::Critic);
     /// RBF neurons N in each network (at most [`MAX_NEURONS`]).
-    neurons: usize = 10, NEURON_COUNT;
+    neurons: usize = 10, NEURON_COUNT, search (Range::int_log(2, 40), Role::Actor);
     /// Smallest RBF centre c_min (≤ `center_max`).
-    center_min: f64 = -5.0, FINITE;
+    center_min: f64 = -5.0, FINITE, search (Range::linear(-20.0, -0.1), Role::Actor);
     /// Largest RBF centre c_max.
-    center_max: f64 = 5.0, FINITE;
+    center_max: f64 = 5.0, FINITE, search (Range::linear(0.1, 20.0), Role::Actor);
     /// RBF width η.
-    width: f64 = 1.0, POSITIVE;
+    width: f64 = 1.0, POSITIVE, search (Range::log(0.05, 20.0), Role::Actor);
     /// Where the centres lie: "diagonal" (the paper's) or "per-input".
-    rbf_layout: RbfLayout = RbfLayout::Diagonal, ANY_NAME;
+    rbf_layout: RbfLayout = RbfLayout::Diagonal, ANY_NAME,
+        search (Range::choice(&["diagonal", "per-input"]), Role::Actor);
     /// Young's-inequality weight a in α.
-    a: f64 = 1.0, POSITIVE;
+    a: f64 = 1.0, POSITIVE, search (Range::log(0.1, 10.0), Role::Law);
     /// Critic discount time constant ψ, s.
-    psi: f64 = 1.0, POSITIVE;
+    psi: f64 = 1.0, POSITIVE, search (Range::log(0.05, 20.0), Role::Critic);
     /// Critic-to-actor gain k_a.
-    k_a: f64 = 0.1, NON_NEGATIVE;
+    k_a: f64 = 0.1, NON_NEGATIVE, search (Range::log(1e-4, 10.0), Role::Critic);
     /// Q = q_weight · I on Z_c = [Z1; Z2].
-    q_weight: f64 = 1.0, NON_NEGATIVE;
+    q_weight: f64 = 1.0, NON_NEGATIVE, search (Range::log(1e-3, 100.0), Role::Critic);
     /// R = r_weight · I on τ.
-    r_weight: f64 = 0.01, NON_NEGATIVE;
+    r_weight: f64 = 0.01, NON_NEGATIVE, search (Range::log(1e-4, 1.0), Role::Critic);
     /// Weight integrator: "exact" or "euler" (SPEC §9).
     integrator: Integrator = Integrator::Exact, ANY_NAME;
     /// Barrier mode: "per-joint" or "norm" (SPEC §5).
@@ -182,22 +194,22 @@ parameters! {
     /// the smallest power of two that keeps every shipped two-link scenario
     /// inside both funnels; half of it breaches under the 3 ms actuation
     /// delay).
-    rho2_inf: f64 = 4.0, POSITIVE;
+    rho2_inf: f64 = 4.0, POSITIVE, search (Range::log(0.25, 64.0), Role::Law);
     /// `smc`: the switching gain k_s, N m: the size of an unmodelled torque
     /// the law rejects inside its boundary layer (the default covers the
     /// paper arm's payload and friction).
-    smc_gain: f64 = 2.0, NON_NEGATIVE;
+    smc_gain: f64 = 2.0, NON_NEGATIVE, search (Range::linear(0.0, 50.0), Role::Law);
     /// `smc`: the boundary layer's width φ on s = ė + K1 e, rad/s: the
     /// switch is linear for |s| < φ, which keeps it from chattering at a
     /// 1 ms period.
-    smc_boundary: f64 = 0.05, POSITIVE;
+    smc_boundary: f64 = 0.05, POSITIVE, search (Range::log(1e-3, 1.0), Role::Law);
     /// `cbf-ctc`: the filter's rate λ, 1/s: h = k_c² − e² obeys
     /// ḧ + 2λ ḣ + λ² h ≥ 0, a double pole at −λ.
-    cbf_rate: f64 = 20.0, POSITIVE;
+    cbf_rate: f64 = 20.0, POSITIVE, search (Range::log(1.0, 200.0), Role::Law);
     /// `cbf-ctc`: the robust margin δ, rad/s²: the bound on an unmodelled
     /// error acceleration |ë − u| ≤ δ the filter holds the envelope against
     /// (the condition is met for the worst such disturbance; 0: nominal).
-    cbf_margin: f64 = 0.0, NON_NEGATIVE;
+    cbf_margin: f64 = 0.0, NON_NEGATIVE, search (Range::linear(0.0, 50.0), Role::Law);
     /// `cbf-ctc`, `mpc`: bound the torque by the URDF's effort limits
     /// (when every controlled joint has one), through the law's model:
     /// the error acceleration u is kept in a per-joint box whose every
@@ -211,20 +223,21 @@ parameters! {
     /// constants of the default gains' error dynamics; beyond it the
     /// terminal cost is the infinite horizon's, so N sets only how far
     /// ahead the envelope is seen.
-    mpc_horizon: usize = 10, HORIZON_STEPS;
+    mpc_horizon: usize = 10, HORIZON_STEPS, search (Range::int_log(1, 50), Role::Law);
     /// `mpc`: the prediction step h, s (the default is ten control periods
     /// at 1 kHz; the QP is still solved every period).
-    mpc_step: f64 = 0.01, MPC_STEP;
+    mpc_step: f64 = 0.01, MPC_STEP, search (Range::log(1e-3, 0.05), Role::Law);
     /// `mpc`: the disturbance bound w, rad/s², on the error dynamics
     /// ë = u + d, |d| ≤ w: the envelope and torque rows are tightened over
     /// the horizon by what such a d can do under the ancillary LQR
     /// feedback (tube MPC); 0: the nominal MPC.
-    mpc_disturbance: f64 = 0.0, NON_NEGATIVE;
+    mpc_disturbance: f64 = 0.0, NON_NEGATIVE, search (Range::linear(0.0, 50.0), Role::Law);
     /// `ctc`, `cbf-ctc`, `mpc`, `ppc`: how K1, K2 become the law's gains:
     /// "as-given", or "matched" to `pd`'s error dynamics. Unwritten at its
     /// default so that existing scenarios keep their identity.
     #[serde(skip_serializing_if = "is_default")]
-    tuning: Tuning = Tuning::AsGiven, ANY_NAME;
+    tuning: Tuning = Tuning::AsGiven, ANY_NAME,
+        search (Range::choice(&["as-given", "matched"]), Role::Law);
 }
 
 /// The longest prescribed time T_c, s ([`ControllerParams::tc`]).

@@ -36,6 +36,7 @@ pub const SHIPPED: &[Shipped] = shipped![
     "iiwa_csv",
     "paper_randomised",
     "ur5_randomised",
+    "iiwa14_randomised",
     "iiwa_actuators",
     "paper_obstacle",
     "paper_pick_place",

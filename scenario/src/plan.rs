@@ -56,6 +56,27 @@ impl Plan {
         })
     }
 
+    /// The scenario as its author wrote it, with `--set` applied (draws
+    /// and `--duration` not: another seed draws again), to be written as a
+    /// file in `dir`: its robot path is made relative to `dir` (absolute
+    /// where no relative path leads there, as across file systems' roots).
+    pub fn authored_toml_in(&self, dir: &Path) -> Result<String, ScenarioError> {
+        let err = |message: String| ScenarioError::Toml {
+            file: self.source.clone(),
+            message,
+        };
+        let mut root: toml::Table = toml::from_str(&self.toml).map_err(|e| err(e.to_string()))?;
+        if let Some(robot) = &self.robot.path {
+            let at = relative_path(robot, dir)
+                .ok_or_else(|| err(format!("{}: no path to it", robot.display())))?;
+            root.insert(
+                "robot".into(),
+                toml::Value::String(at.display().to_string()),
+            );
+        }
+        toml::to_string(&root).map_err(|e| err(format!("cannot write the scenario: {e}")))
+    }
+
     /// What the plant's step machine is built from.
     pub fn plant_config(&self) -> plant_rapier::PlantMachineConfig {
         let s = &self.scenario;
@@ -216,6 +237,34 @@ pub fn load(path: Option<&Path>, overrides: &Overrides) -> Result<Plan, Scenario
     let mut plan = plan(scenario, source, toml_text, robot)?;
     plan.changes.extend(default_changes);
     Ok(plan)
+}
+
+/// `target` as a path from `dir` (both made absolute first).
+fn relative_path(target: &Path, dir: &Path) -> Option<PathBuf> {
+    use std::path::Component;
+    let clean = |p: &Path| -> Option<Vec<std::ffi::OsString>> {
+        let mut out = Vec::new();
+        for c in std::path::absolute(p).ok()?.components() {
+            match c {
+                Component::ParentDir => {
+                    out.pop();
+                }
+                Component::Normal(x) => out.push(x.to_os_string()),
+                Component::RootDir | Component::Prefix(_) | Component::CurDir => {}
+            }
+        }
+        Some(out)
+    };
+    let (t, d) = (clean(target)?, clean(dir)?);
+    let common = t.iter().zip(&d).take_while(|(a, b)| a == b).count();
+    let mut out = PathBuf::new();
+    for _ in common..d.len() {
+        out.push("..");
+    }
+    for part in &t[common..] {
+        out.push(part);
+    }
+    Some(out)
 }
 
 /// A scenario argument as `--scenario` takes it: a file, or else the name
@@ -624,6 +673,17 @@ mod tests {
     /// #48 item 16: a file that opens with a UTF-8 byte-order mark (a
     /// Windows editor's) reads as without it: the CSV's first column is
     /// `t`, not `'\u{feff}t'`, and the scenario's first key its own.
+    #[test]
+    fn a_path_from_a_folder_climbs_to_the_common_part() {
+        let p = relative_path(
+            Path::new("/a/b/robots/x.urdf"),
+            Path::new("/a/b/scenarios/tuned"),
+        );
+        assert_eq!(p.unwrap(), Path::new("../../robots/x.urdf"));
+        let p = relative_path(Path::new("/a/b/../c/x.urdf"), Path::new("/a/c"));
+        assert_eq!(p.unwrap(), Path::new("x.urdf"));
+    }
+
     #[test]
     fn a_byte_order_mark_opens_no_name() {
         let dir = tempfile::tempdir().unwrap();

@@ -236,13 +236,14 @@ fn euler_integrator_shows_the_instability_of_spec_9() {
 /// gives today: `docs/regenerate.py --check` regenerates them with this
 /// build and compares (#28: regenerated, not copied by hand). The
 /// robustness page (40 comparisons of 10 seeds, about 10 minutes of a
-/// release build) is checked by hand: `python3 docs/regenerate.py --check
-/// robustness.md`.
+/// release build) and the tuning page (16 studies of 200 trials, about 20)
+/// are checked by hand: `python3 docs/regenerate.py --check robustness.md
+/// tuned.md`.
 #[test]
 fn the_docs_generated_numbers_are_current() {
     let out = std::process::Command::new("python3")
         .arg("docs/regenerate.py")
-        .args(["--check", "--skip", "robustness.md"])
+        .args(["--check", "--skip", "robustness.md", "--skip", "tuned.md"])
         .env("TESTBED", env!("CARGO_BIN_EXE_testbed"))
         // learnt.md runs the shipped ONNX policy as a compare row.
         .env("TESTBED_POLICY", env!("CARGO_BIN_EXE_testbed-policy"))

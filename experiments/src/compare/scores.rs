@@ -9,7 +9,7 @@
 //! else the first law) against each other law, Holm-corrected.
 
 use analysis::law_info::LawInfo;
-use analysis::stats::{median_interval, quantile, signed_rank};
+use analysis::stats::{iqm, iqm_interval, median_interval, quantile, signed_rank};
 use analysis::summary::Summary;
 
 use crate::compare::types::{Envelope, IntervalRanks, LawRow, LawRun, Paired, Stats};
@@ -154,8 +154,11 @@ pub fn scored(
     }
 }
 
+/// The bootstrap's seed for every row's IQM interval.
+const IQM_BOOTSTRAP_SEED: u64 = 0;
+
 pub(crate) fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
-    let mut rows: [Vec<(&'static str, f64)>; 6] = Default::default();
+    let mut rows: [Vec<(&'static str, f64)>; 9] = Default::default();
     let mut ci95 = None;
     for metric in METRICS {
         let mut v: Vec<f64> = runs.iter().map(|r| value(metric, r)).collect();
@@ -168,6 +171,10 @@ pub(crate) fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
         let interval = median_interval(&v);
         ci95 = interval.map(|i| IntervalRanks::from((i, v.len())));
         let (lo, hi) = interval.map_or((f64::NAN, f64::NAN), |c| (c.low, c.high));
+        // One bootstrap seed for every row: the intervals of two laws on
+        // the same seeds resample alike.
+        let (iqm_lo, iqm_hi) =
+            iqm_interval(&[&v], IQM_BOOTSTRAP_SEED).unwrap_or((f64::NAN, f64::NAN));
         let values = [
             median_of(&v),
             quantile(&v, 0.25),
@@ -175,6 +182,9 @@ pub(crate) fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
             lo,
             hi,
             w,
+            iqm(&v),
+            iqm_lo,
+            iqm_hi,
         ];
         for (r, x) in rows.iter_mut().zip(values) {
             r.push((metric.name, x));
@@ -187,7 +197,17 @@ pub(crate) fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
         count(Envelope::NotJudged),
     );
     let failed = runs.iter().filter(|r| r.failed.is_some()).count() as u64;
-    let [median, q1, q3, ci95_low, ci95_high, worst] = rows.map(Stats);
+    let [
+        median,
+        q1,
+        q3,
+        ci95_low,
+        ci95_high,
+        worst,
+        iqm,
+        iqm_ci95_low,
+        iqm_ci95_high,
+    ] = rows.map(Stats);
     LawRow {
         name: law.law.to_string(),
         law,
@@ -200,6 +220,9 @@ pub(crate) fn row(law: LawInfo, runs: Vec<LawRun>) -> LawRow {
         ci95_high,
         ci95,
         worst,
+        iqm,
+        iqm_ci95_low,
+        iqm_ci95_high,
         kept_envelope: kept,
         left_envelope: left,
         not_judged,

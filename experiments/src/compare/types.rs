@@ -106,6 +106,34 @@ pub struct LawSet {
     pub value: toml::Value,
 }
 
+impl std::str::FromStr for LawSet {
+    type Err = String;
+
+    /// `LAW:controller.KEY=VALUE`: the law by name, a key it takes, a TOML
+    /// value (as `--set` reads it).
+    fn from_str(arg: &str) -> Result<Self, String> {
+        let Some((law, set)) = arg.split_once(':') else {
+            return Err(format!("{arg:?} is not LAW:controller.KEY=VALUE"));
+        };
+        let law: LawName = law.trim().parse()?;
+        let (key, value) = scenario::parse_set(set).map_err(|e| e.to_string())?;
+        let Some(key) = key.strip_prefix("controller.") else {
+            return Err(format!("{key}: only controller keys are set per law"));
+        };
+        if !law.takes(key) {
+            return Err(format!(
+                "{law} does not take controller.{key} (it takes {})",
+                law.keys().join(", ")
+            ));
+        }
+        Ok(Self {
+            law,
+            key: key.to_string(),
+            value,
+        })
+    }
+}
+
 /// The first seed's curves of one law, for the overlay figures.
 #[derive(Debug, Clone, Default)]
 pub struct LawSeries {
@@ -167,6 +195,14 @@ pub struct LawRow {
     pub ci95: Option<IntervalRanks>,
     /// Per metric, the worst seed's value.
     pub worst: Stats,
+    /// Per metric, the interquartile mean over seeds
+    /// ([`analysis::stats::iqm`]).
+    pub iqm: Stats,
+    /// Per metric, the low end of the IQM's bootstrap 95 % interval
+    /// ([`analysis::stats::iqm_interval`], seeded).
+    pub iqm_ci95_low: Stats,
+    /// Per metric, its high end.
+    pub iqm_ci95_high: Stats,
     /// Seeds whose run kept |e| < k_c for every t ≥ T_c ([`Envelope`]).
     pub kept_envelope: u64,
     /// Seeds whose run left it after T_c.

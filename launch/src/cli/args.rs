@@ -309,28 +309,10 @@ pub(crate) struct CompareArgs {
     pub(crate) findings: bool,
 }
 
-/// `--law-set LAW:controller.KEY=VALUE`: the law by name, a key it takes,
-/// a TOML value.
+/// `--law-set LAW:controller.KEY=VALUE` ([`experiments::compare::LawSet`]'s
+/// reader, which `testbed.compare(law_sets=…)` shares).
 fn parse_law_set(arg: &str) -> Result<experiments::compare::LawSet, String> {
-    let Some((law, set)) = arg.split_once(':') else {
-        return Err(format!("{arg:?} is not LAW:controller.KEY=VALUE"));
-    };
-    let law: controller::LawName = law.trim().parse()?;
-    let (key, value) = scenario::parse_set(set).map_err(|e| e.to_string())?;
-    let Some(key) = key.strip_prefix("controller.") else {
-        return Err(format!("{key}: only controller keys are set per law"));
-    };
-    if !law.takes(key) {
-        return Err(format!(
-            "{law} does not take controller.{key} (it takes {})",
-            law.keys().join(", ")
-        ));
-    }
-    Ok(experiments::compare::LawSet {
-        law,
-        key: key.to_string(),
-        value,
-    })
+    arg.parse()
 }
 
 /// `--law` and `--laws`: the names come from the law table, and `--help`
@@ -339,4 +321,31 @@ fn law_parser() -> impl clap::builder::TypedValueParser<Value = controller::LawN
     use clap::builder::TypedValueParser;
     clap::builder::PossibleValuesParser::new(controller::LawName::ALL.iter().map(|l| l.as_str()))
         .try_map(|s| s.parse::<controller::LawName>())
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct TuneArgs {
+    /// Print LAW's search space (every key a tuner searches, its range and
+    /// scale, from the parameter table) and exit; needs no Python.
+    #[arg(long, value_name = "LAW", value_parser = law_parser())]
+    pub(crate) print_space: Option<controller::LawName>,
+    /// Print what a study file found (the same as `testbed tune report FILE`).
+    #[arg(long, value_name = "STUDY", conflicts_with = "print_space")]
+    pub(crate) report: Option<PathBuf>,
+    /// The Python that has the `testbed` module and Optuna (`bash
+    /// python/build-module.sh` makes one; or the wheel's `tune` extra)
+    /// [default: $TESTBED_PYTHON, else target/python-venv/bin/python3].
+    #[arg(long, value_name = "CMD")]
+    pub(crate) python: Option<String>,
+    /// Everything else goes to `python -m testbed.tune` (its `run`,
+    /// `report`, `best`, `evaluate`; `testbed tune run --help` lists the
+    /// options), e.g. `testbed tune run --law nac --scenario
+    /// paper_randomised --trials 200`.
+    #[arg(
+        trailing_var_arg = true,
+        allow_hyphen_values = true,
+        value_name = "ARGS",
+        conflicts_with_all = ["print_space", "report"]
+    )]
+    pub(crate) args: Vec<String>,
 }

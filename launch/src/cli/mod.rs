@@ -10,6 +10,7 @@ mod run;
 mod scenarios;
 mod sim;
 mod sweep;
+mod tune;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -22,7 +23,7 @@ use scenario::Overrides;
 use wire::NodeKind;
 
 use analysis::report::{self, Report};
-use args::{BenchArgs, CompareArgs, ReplayArgs, RunArgs, ScenarioArgs, SimArgs};
+use args::{BenchArgs, CompareArgs, ReplayArgs, RunArgs, ScenarioArgs, SimArgs, TuneArgs};
 
 /// Run the paper's RL neuroadaptive controller under deferred constraints on
 /// a simulated arm.
@@ -110,6 +111,13 @@ enum Command {
     /// one JSON line per run; `sweep report` prints on standard output.
     #[command(subcommand)]
     Sweep(sweep::SweepCommand),
+    /// Tune a law's parameters: Optuna's TPE over the in-process core, the
+    /// same budget and search space rules for every law (docs/tuning.md).
+    ///
+    /// `--print-space LAW` prints a law's search space; everything else is
+    /// `python -m testbed.tune` (run, report, best, evaluate), whose
+    /// studies are Optuna journal files several processes may share.
+    Tune(TuneArgs),
     /// List the shipped scenarios and what each one demonstrates (on
     /// standard output).
     Scenarios,
@@ -210,6 +218,7 @@ pub fn run() -> Result<ExitCode> {
         }
         Command::Compare(args) => compare::compare(args),
         Command::Sweep(cmd) => sweep::sweep(cmd),
+        Command::Tune(args) => tune::tune(args),
         Command::Bindings { lang, out } => {
             let BindingsLang::Python = lang;
             let text = wire::bindings::python();

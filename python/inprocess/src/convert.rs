@@ -109,6 +109,7 @@ pub fn overrides_set(set: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, to
                     cut(&k.to_string(), QUOTED)
                 ))
             })?;
+            check_dotted(&key)?;
             let value = to_toml(&key, &v, 0)?;
             // Through `--set`'s own reader: the same key checks.
             let parsed = scenario::parse_set(&format!("{key}={value}")).map_err(|e| {
@@ -131,6 +132,56 @@ pub fn overrides_set(set: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<(String, to
             })
         })
         .collect()
+}
+
+/// A `set=` key is a dotted name (`controller.k1`), nothing else: it is
+/// joined to its value as `--set`'s text, so a key holding `=`, `#` or a
+/// newline would write a value of its own (`'controller.k1=20 #'` set k1
+/// to 20, #60 item 6).
+fn check_dotted(key: &str) -> PyResult<()> {
+    let part_ok = |p: &str| {
+        !p.is_empty()
+            && p.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+    };
+    if key.split('.').all(part_ok) {
+        return Ok(());
+    }
+    Err(PyValueError::new_err(format!(
+        "set: key {:?} is not a dotted name like \"controller.k1\" (letters, digits, _ and - \
+         between dots)",
+        cut(key, QUOTED)
+    )))
+}
+
+/// `law_sets=`: `["pd:controller.k1=20"]` or `{"pd": {"controller.k1": 20}}`.
+pub fn law_sets(x: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<experiments::compare::LawSet>> {
+    let Some(x) = x else {
+        return Ok(Vec::new());
+    };
+    let parse = |s: &str| {
+        s.parse::<experiments::compare::LawSet>()
+            .map_err(|e| PyValueError::new_err(format!("law_sets: {}", cut(&e, 2 * QUOTED))))
+    };
+    if let Ok(d) = x.cast::<PyDict>() {
+        let mut out = Vec::new();
+        for (law, keys) in d.iter() {
+            let law: String = law
+                .extract()
+                .map_err(|_| PyTypeError::new_err("law_sets: a law's name is a string"))?;
+            for (key, value) in overrides_set(Some(&keys))? {
+                out.push(parse(&format!("{law}:{key}={value}"))?);
+            }
+        }
+        return Ok(out);
+    }
+    let items: Vec<String> = x.extract().map_err(|_| {
+        PyTypeError::new_err(
+            "law_sets: expected a dict {\"pd\": {\"controller.k1\": 20.0}} or a list of \
+             \"LAW:controller.KEY=VALUE\" strings",
+        )
+    })?;
+    items.iter().map(|s| parse(s)).collect()
 }
 
 /// The most characters of a user's value a refusal quotes: a 2 M-entry

@@ -63,5 +63,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(runs::sim, m)?)?;
     m.add_function(wrap_pyfunction!(runs::compare, m)?)?;
     m.add_function(wrap_pyfunction!(runs::scenario_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(runs::search_space, m)?)?;
+    m.add_function(wrap_pyfunction!(runs::scenario_file, m)?)?;
     Ok(())
 }

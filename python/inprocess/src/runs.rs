@@ -149,8 +149,13 @@ pub fn sim<'py>(
 
 /// The laws on one scenario and its seeds, scored, as `testbed compare
 /// --json` prints them (a dict; `laws` holds each law's row).
+///
+/// `law_sets`: keys set on one law's runs only, as `--law-set` takes them: a
+/// list of `"LAW:controller.KEY=VALUE"` strings, or a dict
+/// `{"pd": {"controller.k1": 20.0}}`.
 #[pyfunction]
-#[pyo3(signature = (scenario=None, *, laws=None, seeds=1, robot=None, set=None, duration=None, threads=None))]
+#[pyo3(signature = (scenario=None, *, laws=None, seeds=1, robot=None, set=None, duration=None, threads=None, law_sets=None))]
+#[allow(clippy::too_many_arguments)] // Python's keywords, one each
 pub fn compare(
     scenario: Option<PathBuf>,
     laws: Option<Vec<String>>,
@@ -159,7 +164,9 @@ pub fn compare(
     set: Option<&Bound<'_, PyAny>>,
     duration: Option<f64>,
     threads: Option<usize>,
+    law_sets: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<PyAny>> {
+    let law_sets = crate::convert::law_sets(law_sets)?;
     // The interpreter is attached already (a Python call): this takes its
     // token without one more argument.
     let args = ScenarioArgs {
@@ -169,7 +176,7 @@ pub fn compare(
         duration,
         law: None,
     };
-    Python::attach(|py| compare_in(py, &args, laws, seeds, threads))
+    Python::attach(|py| compare_in(py, &args, laws, seeds, threads, law_sets))
 }
 
 /// [`compare`] with the interpreter's token.
@@ -179,6 +186,7 @@ fn compare_in(
     laws: Option<Vec<String>>,
     seeds: u64,
     threads: Option<usize>,
+    law_sets: Vec<experiments::compare::LawSet>,
 ) -> PyResult<Py<PyAny>> {
     let plan = args.load()?;
     no_external(&plan)?;
@@ -202,7 +210,7 @@ fn compare_in(
     let cap = 4 * launcher::node::placement::cpu_count();
     let threads = threads.map(|t| t.min(cap));
     let opts = CompareOptions {
-        law_sets: Vec::new(),
+        law_sets,
         laws,
         seeds,
         threads,
@@ -237,6 +245,40 @@ pub fn scenario_toml<'py>(
     }
     .load()?;
     plan.effective_toml().map_err(err)
+}
+
+/// The keys a tuner searches for `law` (`testbed tune --print-space LAW`):
+/// a list of dicts, each with `key`, `role` (gain, law, actor, critic) and
+/// `range` (`kind`: float, int, scale or choice, and its bounds).
+#[pyfunction]
+pub fn search_space(py: Python<'_>, law: &str) -> PyResult<Py<PyAny>> {
+    let law: controller::LawName = law.parse().map_err(err)?;
+    let space = serde_json::to_value(controller::search_space(law)).map_err(err)?;
+    json_to_py(py, &space).map(Bound::unbind)
+}
+
+/// The scenario as its author wrote it with `set` applied, as the text of
+/// a file to write in folder `dir` (its robot path made relative to
+/// `dir`): not the drawn scenario of one seed (`scenario_toml`), so a
+/// randomised scenario stays randomised. `testbed tune best
+/// --write-scenario` writes its files with it.
+#[pyfunction]
+#[pyo3(signature = (scenario=None, *, dir, robot=None, set=None))]
+pub fn scenario_file<'py>(
+    scenario: Option<PathBuf>,
+    dir: PathBuf,
+    robot: Option<PathBuf>,
+    set: Option<&Bound<'py, PyAny>>,
+) -> PyResult<String> {
+    let plan = ScenarioArgs {
+        scenario,
+        robot,
+        set,
+        duration: None,
+        law: None,
+    }
+    .load()?;
+    plan.authored_toml_in(&dir).map_err(err)
 }
 
 /// The most memory `sim` may hold in rows, bytes.

@@ -21,7 +21,9 @@ from ._native import (  # noqa: F401  (the public interface)
     TestbedError,
     VecEnvCore,
     compare,
+    scenario_file,
     scenario_toml,
+    search_space,
     sim,
 )
 from .env import ArmTrackingEnv, ArmTrackingVecEnv, observation_names  # noqa: F401
