@@ -62,7 +62,7 @@ fn is_default<T: Default + PartialEq>(x: &T) -> bool {
 
 /// Declares every parameter once: its documentation, serde attributes,
 /// type, default, check and, for a key a tuner may search, its range and
-/// role (`search (RANGE, ROLE)`, [`crate::search_space`]). The struct, its `Default`, the range checks,
+/// role (`search (RANGE, ROLE)`, [`crate::search_space()`]). The struct, its `Default`, the range checks,
 /// [`ControllerParams::KEYS`], [`ControllerParams::changed_keys`],
 /// [`ControllerParams::SEARCH`] and what
 /// [`ControllerParams::for_law`] carries are all made from this one list.
@@ -121,7 +121,7 @@ macro_rules! parameters {
             }),*];
 
             /// Every key a tuner may search, with its range (`search` in the
-            /// declaration): [`crate::search_space`] picks a law's from it.
+            /// declaration): [`crate::search_space()`] picks a law's from it.
             pub const SEARCH: &'static [SearchDim] = &[$($(SearchDim {
                 key: stringify!($field),
                 range: $search.0,
