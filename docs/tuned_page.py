@@ -406,7 +406,9 @@ def inert(T: Tuned, rep: dict) -> list[str]:
     best = {k: v for k, v in rep["best"]["set"].items() if _learning_key(k)}
     given = rep["as_given"]["set"]
     base = {k: v for k, v in rep["best"]["set"].items() if not _learning_key(k)}
-    paper = _paper_values(given, best)
+    # The first trial is the law as given: every knob the search set, at
+    # the scenario's (the paper's) value.
+    paper = {k: given[k] for k in best}
 
     def iae(knobs: dict) -> float:
         sets = [f"{k}={_toml(v)}" for k, v in {**base, **knobs}.items() if k != "duration_s"]
@@ -442,32 +444,3 @@ def inert(T: Tuned, rep: dict) -> list[str]:
                 + (": the knobs act together, none wakes the actor by itself." if wake[w] < 0.1
                    else ".")]
     return out + [""]
-
-
-def _paper_values(given: dict, best: dict) -> dict:
-    """The paper's value of each learning knob the search set (the
-    parameter table's defaults, which `testbed tune --print-space` ranges
-    include)."""
-    import tomllib
-
-    text = (ROOT / "scenarios" / "paper.toml").read_text()
-    ctrl = tomllib.loads(text).get("controller", {})
-    defaults = _defaults()
-    out = {}
-    for k in best:
-        key = k.removeprefix("controller.")
-        out[k] = given.get(k, ctrl.get(key, defaults[key]))
-    return out
-
-
-def _defaults() -> dict:
-    """Every controller key's default, from the parameter reference page
-    (written from the table itself)."""
-    import re
-
-    text = (ROOT / "docs" / "generated" / "controller-parameters.md").read_text()
-    out = {}
-    for m in re.finditer(r"^\| `(\w+)` \| `([^`]*)` \|", text, re.M):
-        v = m.group(2)
-        out[m.group(1)] = json.loads(v) if v[:1] in '"-0123456789' else v
-    return out
