@@ -669,7 +669,7 @@ def main() -> int:
     p.add_argument("pages", nargs="*", metavar="PAGE", help=f"only these pages (of {', '.join(PAGES)})")
     p.add_argument("--skip", action="append", default=[], metavar="PAGE",
                    help="leave this page out (repeatable; the test suite skips robustness.md, "
-                        "about 10 minutes of runs, and tuned.md, about 20)")
+                        "about 10 minutes of runs, and tuned.md, about 12)")
     args = p.parse_args()
     unknown = [n for n in args.pages + args.skip if n not in PAGES]
     if unknown:

@@ -236,8 +236,8 @@ fn euler_integrator_shows_the_instability_of_spec_9() {
 /// gives today: `docs/regenerate.py --check` regenerates them with this
 /// build and compares (#28: regenerated, not copied by hand). The
 /// robustness page (40 comparisons of 10 seeds, about 10 minutes of a
-/// release build) and the tuning page (16 studies of 200 trials, about 20)
-/// are checked by hand: `python3 docs/regenerate.py --check robustness.md
+/// release build) and the tuning page (16 studies of 200 trials, about
+/// 12 minutes) are checked by hand: `python3 docs/regenerate.py --check robustness.md
 /// tuned.md`.
 #[test]
 fn the_docs_generated_numbers_are_current() {
