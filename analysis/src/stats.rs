@@ -39,6 +39,27 @@ pub fn iqm(v: &[f64]) -> f64 {
     mid.iter().sum::<f64>() / mid.len() as f64
 }
 
+/// The median over seeds of (a_i − b_i) / |b_i|, the paired effect of a
+/// against b (never a ratio of medians of different seeds): −∞ where only
+/// b failed (a failed run is the worst, +∞), +∞ where only a did, 0 where
+/// both did or the two are equal.
+pub fn median_relative_difference(a: &[f64], b: &[f64]) -> f64 {
+    let mut d: Vec<f64> = a
+        .iter()
+        .zip(b)
+        .map(|(&x, &y)| match (x.is_finite(), y.is_finite()) {
+            _ if x == y => 0.0,
+            (true, true) if y != 0.0 => (x - y) / y.abs(),
+            (true, true) => (x - y).signum() * f64::INFINITY,
+            (true, false) => f64::NEG_INFINITY,
+            (false, true) => f64::INFINITY,
+            (false, false) => 0.0,
+        })
+        .collect();
+    d.sort_by(f64::total_cmp);
+    quantile(&d, 0.5)
+}
+
 /// How many resamples [`iqm_interval`] draws.
 pub const BOOTSTRAP_RESAMPLES: usize = 2000;
 

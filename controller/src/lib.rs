@@ -46,6 +46,7 @@ mod params;
 mod params_reference;
 mod ppc;
 mod rbf;
+mod search_range;
 mod search_space;
 mod shifting;
 mod torque_box;
@@ -64,7 +65,8 @@ pub use params::{
 pub use params_reference::reference_markdown;
 pub use ppc::{Ppc, XI_LIMIT};
 pub use rbf::Rbf;
-pub use search_space::{GAIN_SCALE, Range, Role, SearchDim, search_space};
+pub use search_range::{GAIN_SCALE, Range, Role, SearchDim};
+pub use search_space::search_space;
 pub use shifting::shifting;
 pub use weight_update::{advance_euler, advance_exact};
 

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::search_space::{GAIN_SCALE, Range, Role, SearchDim};
+use crate::search_range::{GAIN_SCALE, Range, Role, SearchDim};
 use crate::{ControllerError, Gain, LawName};
 
 /// How the weight ODEs are advanced over one control period (SPEC §9).

@@ -20,25 +20,6 @@ fn value(run: &LawRun, metric: &str) -> f64 {
     stats_of(run).get(metric).unwrap_or(f64::NAN)
 }
 
-/// The median over seeds of (a_i − b_i) / |b_i|: −∞ where only b failed
-/// (a failed run is the worst), +∞ where only a did, 0 where both did.
-pub(crate) fn paired_relative(a: &[f64], b: &[f64]) -> f64 {
-    let mut d: Vec<f64> = a
-        .iter()
-        .zip(b)
-        .map(|(&x, &y)| match (x.is_finite(), y.is_finite()) {
-            _ if x == y => 0.0,
-            (true, true) if y != 0.0 => (x - y) / y.abs(),
-            (true, true) => (x - y).signum() * f64::INFINITY,
-            (true, false) => f64::NEG_INFINITY,
-            (false, true) => f64::INFINITY,
-            (false, false) => 0.0,
-        })
-        .collect();
-    d.sort_by(f64::total_cmp);
-    analysis::stats::quantile(&d, 0.5)
-}
-
 /// Blow-ups and torque saturation of either law, named.
 pub(crate) fn extremes(nac: &LawRow, o: &LawRow, a: &[f64], b: &[f64]) -> String {
     let mut out = String::new();

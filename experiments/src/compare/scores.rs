@@ -9,10 +9,14 @@
 //! else the first law) against each other law, Holm-corrected.
 
 use analysis::law_info::LawInfo;
-use analysis::stats::{iqm, iqm_interval, median_interval, quantile, signed_rank};
+use analysis::stats::{
+    iqm, iqm_interval, median_interval, median_relative_difference, quantile, signed_rank,
+};
 use analysis::summary::Summary;
 
-use crate::compare::types::{Envelope, IntervalRanks, LawRow, LawRun, Paired, Stats};
+use crate::compare::types::{
+    ALPHA, Envelope, IntervalRanks, LawRow, LawRun, MATTERS, Paired, Stats, Verdict,
+};
 
 /// The metrics of the paired tests: error, peak error, effort beyond the
 /// gravity hold, energy.
@@ -262,12 +266,21 @@ pub(crate) fn paired(laws: &[LawRow]) -> Vec<Paired> {
         .filter(|(k, _)| *k != b)
         .flat_map(|(_, other)| {
             PAIRED_METRICS.iter().map(move |&metric| {
-                let test = signed_rank(&values(first, metric), &values(other, metric));
+                let (a, b) = (values(first, metric), values(other, metric));
+                let test = signed_rank(&a, &b);
+                let identical = a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits());
                 Paired {
                     law: first.name.clone(),
                     versus: other.name.clone(),
                     metric,
                     p_holm: test.p_value,
+                    median_relative_difference: median_relative_difference(&a, &b),
+                    // Set once Holm has corrected every p below.
+                    verdict: if identical {
+                        Verdict::NotTested
+                    } else {
+                        Verdict::NotShown
+                    },
                     test,
                 }
             })
@@ -276,6 +289,14 @@ pub(crate) fn paired(laws: &[LawRow]) -> Vec<Paired> {
     let adjusted = holm(&tests.iter().map(|t| t.test.p_value).collect::<Vec<_>>());
     for (t, p) in tests.iter_mut().zip(adjusted) {
         t.p_holm = p;
+        if t.verdict != Verdict::NotTested {
+            let rel = t.median_relative_difference;
+            t.verdict = Verdict::of_paired(
+                p < ALPHA,
+                t.test.a_smaller > t.test.b_smaller && rel <= -MATTERS,
+                t.test.b_smaller > t.test.a_smaller && rel >= MATTERS,
+            );
+        }
     }
     tests
 }

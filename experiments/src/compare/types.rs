@@ -262,6 +262,14 @@ pub struct Paired {
     /// The test's p-value Holm-corrected over every paired test of the
     /// comparison (what the findings use).
     pub p_holm: f64,
+    /// The median over seeds of (law − versus) / |versus|
+    /// ([`analysis::stats::median_relative_difference`]; JSON null where
+    /// infinite: a failed run on one side).
+    pub median_relative_difference: f64,
+    /// "law is lower than versus" by the findings' rule
+    /// ([`Verdict::of_paired`]) at this p_holm; `not-tested` where the two
+    /// gave the same value bit for bit on every seed.
+    pub verdict: Verdict,
 }
 
 /// Which order statistics bound the 95 % interval of the median, and its
@@ -343,6 +351,12 @@ impl Envelope {
     }
 }
 
+/// A paired median relative difference smaller than this is "no
+/// difference".
+pub const MATTERS: f64 = 0.01;
+/// The family-wise level of the findings' tests (on Holm-corrected p).
+pub const ALPHA: f64 = 0.05;
+
 /// A claim's verdict.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -360,6 +374,20 @@ pub enum Verdict {
     NotTested,
     /// Every run ended before T_c: the constraint was never in force.
     NotJudged,
+}
+
+impl Verdict {
+    /// The findings' rule for "a is lower than b", one definition for the
+    /// claims and for every paired test of a comparison: significant after
+    /// Holm and ahead by at least [`MATTERS`] holds; significant and behind
+    /// by as much does not hold; anything else is not shown.
+    pub fn of_paired(significant: bool, ahead_by_enough: bool, behind_by_enough: bool) -> Self {
+        match (significant, ahead_by_enough, behind_by_enough) {
+            (true, true, _) => Verdict::Holds,
+            (true, _, true) => Verdict::DoesNotHold,
+            _ => Verdict::NotShown,
+        }
+    }
 }
 
 impl std::fmt::Display for Verdict {
