@@ -36,6 +36,10 @@ pub struct ResetOptions {
     pub initial_qd: Option<Vec<f64>>,
 }
 
+/// The largest |q(0)| or |q̇(0)| a reset takes: a thousand radians is 159
+/// turns, beyond any joint's range and any arm's speed.
+pub const MAX_START: f64 = 1e3;
+
 /// One arm's episodes.
 pub struct ArmEnv {
     plan: Plan,
@@ -121,6 +125,17 @@ impl ArmEnv {
                         &format!("{name}[{i}]"),
                         v[i],
                         "must be a finite number",
+                    ));
+                }
+                // 1e300 rad is finite but no posture: sin and cos of it are
+                // noise, and the plant's first step overflows (#60 item 11).
+                if let Some(i) = v.iter().position(|x| x.abs() > MAX_START) {
+                    return Err(EnvError::option(
+                        &format!("{name}[{i}]"),
+                        v[i],
+                        format!(
+                            "must be within ±{MAX_START} (rad or m; per second for initial_qd)"
+                        ),
                     ));
                 }
                 *into = v.clone();

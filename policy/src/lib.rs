@@ -47,6 +47,10 @@ pub use check::{ESSENTIAL, check_run};
 pub use law::PolicyLaw;
 pub use record::EnvRecord;
 
+/// The largest policy file read, bytes: a policy MLP is kilobytes, the
+/// largest network a 1 kHz loop can run is a few megabytes.
+pub const MAX_POLICY_BYTES: u64 = 256 << 20;
+
 /// The `metadata_props` key holding the environment record (JSON).
 pub const ENV_KEY: &str = "testbed.env";
 
@@ -137,9 +141,13 @@ pub struct Policy {
 impl Policy {
     /// Loads the ONNX file at `path`.
     pub fn load(path: &Path) -> Result<Self, PolicyError> {
-        let bytes = std::fs::read(path).map_err(|source| PolicyError::Read {
-            path: path.to_path_buf(),
-            source,
+        // A regular file of at most MAX_POLICY_BYTES: a FIFO hung the run
+        // (and left this node behind it), /dev/zero filled memory (#60 item 5).
+        let bytes = wire::read_regular_file(path, Some(MAX_POLICY_BYTES)).map_err(|source| {
+            PolicyError::Read {
+                path: path.to_path_buf(),
+                source,
+            }
         })?;
         Self::from_bytes(&bytes, path)
     }

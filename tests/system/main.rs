@@ -12,6 +12,7 @@ mod false_success;
 mod hardening;
 mod hardening3;
 mod hardening4;
+mod hostile_runs;
 mod leftovers;
 mod light_arms;
 mod live;

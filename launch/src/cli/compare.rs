@@ -148,6 +148,22 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
     for w in &result.warnings {
         eprintln!("testbed: warning: {w}");
     }
+    // A row with no scored run is no result: say which, last, and fail
+    // (#60 item 4: a user's controller that dies on every seed exited 0).
+    let none: Vec<&str> = result
+        .laws
+        .iter()
+        .filter(|l| !l.runs.is_empty() && l.failed as usize == l.runs.len())
+        .map(|l| l.name.as_str())
+        .collect();
+    if !none.is_empty() {
+        eprintln!(
+            "testbed: every run of {} failed: the table has no result for {}",
+            none.join(", "),
+            if none.len() == 1 { "it" } else { "them" }
+        );
+        return Ok(ExitCode::FAILURE);
+    }
     Ok(ExitCode::SUCCESS)
 }
 

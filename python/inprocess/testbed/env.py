@@ -71,6 +71,29 @@ def _render_mode(render_mode):
     return render_mode
 
 
+def _check_open(env, what: str) -> None:
+    if env._closed:
+        raise RuntimeError(f"{what}() after close(): make a new environment")
+
+
+def _close(env) -> None:
+    env._closed = True
+
+
+def _one_at_a_time(call, *args):
+    """A core call, with PyO3's bare "Already borrowed" (another thread is
+    inside a call of this environment) said as what to do instead."""
+    try:
+        return call(*args)
+    except RuntimeError as e:
+        if "borrow" not in str(e).lower():
+            raise
+        raise RuntimeError(
+            "this environment is inside a call from another thread: an environment takes one "
+            "call at a time; give each thread its own environment (or hold a lock around "
+            "reset/step)") from None
+
+
 class ArmTrackingEnv(gymnasium.Env):
     """Track a scenario's reference with an arm under its deferred constraint.
 
@@ -109,6 +132,8 @@ class ArmTrackingEnv(gymnasium.Env):
         self.observation_space, self.action_space = _spaces(self._core)
         self.metadata = dict(self.metadata, render_fps=max(1, int(round(1.0 / self._core.dt))))
         self._ended = True
+        self._fresh = True
+        self._closed = False
 
     @property
     def core(self) -> EnvCore:
@@ -116,18 +141,23 @@ class ArmTrackingEnv(gymnasium.Env):
         return self._core
 
     def reset(self, *, seed=None, options=None):
+        _check_open(self, "reset")
         super().reset(seed=seed)
         if options is not None and not isinstance(options, dict):
             raise TypeError(f"reset: options must be a dict, got {type(options).__name__}")
         episode_seed = seed if seed is not None else _seed_from(self.np_random)
-        obs = self._core.reset(int(episode_seed), options or None)
+        obs = _one_at_a_time(self._core.reset, int(episode_seed), options or None)
         self._ended = False
+        self._fresh = False
         return obs, {"seed": int(episode_seed)}
 
     def step(self, action):
+        _check_open(self, "step")
+        if self._fresh:
+            raise RuntimeError("step() before reset(): call reset() first (Gymnasium's order)")
         if self._ended:
             raise RuntimeError("step() after the episode ended: call reset() first")
-        out = self._core.step(_real_actions(action))
+        out = _one_at_a_time(self._core.step, _real_actions(action))
         self._ended = out[2] or out[3]
         return out
 
@@ -137,6 +167,11 @@ class ArmTrackingEnv(gymnasium.Env):
         if self.render_mode == "rgb_array":
             return self._core.render(RENDER_SIZE, RENDER_SIZE)
         return None
+
+    def close(self):
+        """Ends the environment: a later step or reset raises."""
+        _close(self)
+        super().close()
 
 
 class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
@@ -167,6 +202,8 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.metadata = dict(self.metadata, render_fps=max(1, int(round(1.0 / self._core.dt))))
         self._all = np.ones(self.num_envs, dtype=bool)
+        self._fresh = True
+        self._closed = False
 
     @property
     def core(self) -> VecEnvCore:
@@ -174,6 +211,7 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         return self._core
 
     def reset(self, *, seed=None, options=None):
+        _check_open(self, "reset")
         if options is not None and not isinstance(options, dict):
             raise TypeError(f"reset: options must be a dict, got {type(options).__name__}")
         if seed is not None and not isinstance(seed, (int, np.integer)):
@@ -184,12 +222,16 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         super().reset(seed=seed)
         if seed is None:
             seed = _seed_from(self.np_random)
-        obs = self._core.reset(int(seed), options or None)
+        obs = _one_at_a_time(self._core.reset, int(seed), options or None)
+        self._fresh = False
         return obs, {}
 
     def step(self, actions):
+        _check_open(self, "step")
+        if self._fresh:
+            raise RuntimeError("step() before reset(): call reset() first (Gymnasium's order)")
         actions = np.asarray(_real_actions(actions, "step: actions"), dtype=np.float64)
-        obs, rewards, terminated, truncated, costs = self._core.step(actions)
+        obs, rewards, terminated, truncated, costs = _one_at_a_time(self._core.step, actions)
         return obs, rewards, terminated, truncated, {"cost": costs, "_cost": self._all}
 
     def render(self):
@@ -197,3 +239,8 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
         if self.render_mode != "rgb_array":
             return None
         return tuple(self._core.render(i, RENDER_SIZE, RENDER_SIZE) for i in range(self.num_envs))
+
+    def close(self, **kwargs):
+        """Ends the environment: a later step or reset raises."""
+        _close(self)
+        super().close(**kwargs)

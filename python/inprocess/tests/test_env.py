@@ -287,5 +287,19 @@ class RlReady(unittest.TestCase):
         self.assertTrue(np.array_equal(q, [0.3, -0.2]) and np.array_equal(qd, [0.0, 0.1]))
 
 
+class ModuleQualifiedId(unittest.TestCase):
+    def test_a_process_that_never_imported_testbed_makes_the_env_by_module_id(self):
+        import subprocess
+        import sys
+
+        code = ("import gymnasium, sys\n"
+                "env = gymnasium.make('testbed:testbed/ArmTracking-v0', duration=0.05)\n"
+                "env.reset(seed=0)\n"
+                "assert 'testbed' in sys.modules\n"
+                "print('ok')\n")
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertIn("ok", out.stdout)
+
 if __name__ == "__main__":
     unittest.main()

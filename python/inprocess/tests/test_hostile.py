@@ -202,5 +202,68 @@ class PolicyFiles(unittest.TestCase):
         self.assertIn('"name": "policy"', out.stdout)
 
 
+class HostileUse(unittest.TestCase):
+    """#60 items 6 and 11: a set= key that is TOML text, a start far past
+    any posture, steps out of Gymnasium's order, threads on one env."""
+
+    def test_a_set_key_is_a_dotted_name_never_toml_text(self):
+        for key in ("controller.k1=20 #", "controller.k1\nduration_s", "controller..k1", ""):
+            with self.assertRaises(ValueError) as e:
+                testbed.sim(set={key: 5.0}, duration=0.01)
+            self.assertIn("not a dotted name", str(e.exception))
+        # A good key still works, with its typed value.
+        _, s = testbed.sim(set={"controller.k1": 20.0}, duration=0.01)
+        self.assertTrue(s["finite"])
+
+    def test_a_start_beyond_any_posture_is_refused_by_name(self):
+        env = gymnasium.make(ENV, duration=0.01)
+        for opts in ({"initial_q": [1e300, 0]}, {"initial_qd": [0, -2e3]}):
+            with self.assertRaises(testbed.TestbedError) as e:
+                env.reset(seed=0, options=opts)
+            self.assertIn("within ±1000", str(e.exception))
+        env.reset(seed=0, options={"initial_q": [0.5, 1.0]})
+
+    def test_step_before_reset_and_after_close_are_refused(self):
+        for env, action in ((testbed.ArmTrackingEnv(duration=0.01), np.zeros(2)),
+                            (testbed.ArmTrackingVecEnv(2, duration=0.01), np.zeros((2, 2)))):
+            with self.assertRaises(RuntimeError) as e:
+                env.step(action)
+            self.assertIn("before reset()", str(e.exception))
+            env.reset(seed=0)
+            env.step(action)
+            env.close()
+            for call in (lambda: env.step(action), lambda: env.reset(seed=1)):
+                with self.assertRaises(RuntimeError) as e:
+                    call()
+                self.assertIn("after close()", str(e.exception))
+        core = testbed.EnvCore(duration=0.01)
+        with self.assertRaises(RuntimeError) as e:
+            core.step(np.zeros(2))
+        self.assertIn("before reset()", str(e.exception))
+
+    def test_threads_sharing_one_vector_env_are_told_what_to_do(self):
+        env = testbed.ArmTrackingVecEnv(64, duration=5.0)
+        env.reset(seed=0)
+        errors, ok = [], []
+
+        def work():
+            for _ in range(200):
+                try:
+                    env.step(np.zeros((64, 2)))
+                    ok.append(1)
+                except RuntimeError as e:
+                    errors.append(str(e))
+
+        threads = [threading.Thread(target=work) for _ in range(8)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        self.assertTrue(ok)
+        for e in errors:
+            self.assertNotIn("Already borrowed", e)
+            self.assertIn("give each thread its own environment", e)
+
+
 if __name__ == "__main__":
     unittest.main()

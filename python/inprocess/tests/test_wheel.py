@@ -73,7 +73,7 @@ class StandaloneWheel(unittest.TestCase):
             env = dict(os.environ, VIRTUAL_ENV=str(Path(sys.executable).parents[1]))
             run([maturin, "build", "--quiet", "--profile", "dev", "--strip", "-i", sys.executable,
                  "-o", tmp / "wheels"], cwd=PROJECT, env=env)
-            wheels = list((tmp / "wheels").glob("testbed-*.whl"))
+            wheels = list((tmp / "wheels").glob("rl_deferred_testbed-*.whl"))
             self.assertEqual(len(wheels), 1, wheels)
             size = wheels[0].stat().st_size
             self.assertLess(size, 30 * 2**20, f"{wheels[0].name}: {size / 2**20:.1f} MB")

@@ -30,6 +30,9 @@ pub struct EnvCore {
     obs: Vec<f64>,
     /// The episode ended (terminated or truncated): step refuses until reset.
     ended: bool,
+    /// No reset yet: Gymnasium's contract is reset before the first step
+    /// (#60 item 11: a step before it ran an episode nobody started).
+    fresh: bool,
 }
 
 #[pymethods]
@@ -44,6 +47,7 @@ impl EnvCore {
             obs: vec![0.0; env.obs_dim()],
             env,
             ended: false,
+            fresh: true,
         })
     }
 
@@ -61,6 +65,7 @@ impl EnvCore {
             .reset_with(seed, &opts, &mut self.obs)
             .map_err(err)?;
         self.ended = false;
+        self.fresh = false;
         Ok(array(py, &self.obs))
     }
 
@@ -70,6 +75,11 @@ impl EnvCore {
         py: Python<'py>,
         action: &Bound<'py, PyAny>,
     ) -> PyResult<StepReturn<'py>> {
+        if self.fresh {
+            return Err(PyRuntimeError::new_err(
+                "step() before reset(): call reset() first (Gymnasium's order)",
+            ));
+        }
         if self.ended {
             return Err(PyRuntimeError::new_err(
                 "step() after the episode ended: call reset() first",
