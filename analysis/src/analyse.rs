@@ -3,7 +3,7 @@
 //! `testbed run` and `testbed replay` both call [`analyse`], so a summary
 //! never depends on how it is produced: the log alone decides it.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::io::Write;
 use std::path::Path;
 
@@ -238,6 +238,11 @@ struct Analyser<'a, 'o> {
     own: OwnStats,
     /// Messages read per topic, to tell whether the log is the whole run.
     topics: HashMap<String, u64>,
+    /// Messages nothing is computed from (the arm's frames and figure, the
+    /// standard views) that do not decode, by topic: how many, and the
+    /// first one's fault. They are skipped: one bad `/robot_description`
+    /// once discarded every step of a log (#60 item 8).
+    skipped: BTreeMap<String, (u64, String)>,
 }
 
 impl Analyser<'_, '_> {
@@ -293,7 +298,15 @@ impl Analyser<'_, '_> {
             // The arm's frames and figure, the standard views: not
             // analysed, but a log whose message is not JSON (formats 1 and
             // 2) or CDR (format 3) is damaged there.
-            None => logger::check_message(m.encoding, m.data)?,
+            None => {
+                if let Err(e) = logger::check_message(m.encoding, m.data) {
+                    let entry = self
+                        .skipped
+                        .entry(m.topic.to_string())
+                        .or_insert_with(|| (0, e.to_string()));
+                    entry.0 += 1;
+                }
+            }
         }
         let (summary, series, csv) = (&mut self.summary, &mut self.series, &mut self.csv);
         let own = &mut self.own;
@@ -374,6 +387,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
         own_len,
         own: OwnStats::new(own, n),
         topics: HashMap::new(),
+        skipped: BTreeMap::new(),
     };
     let contents = match read_log(path, Some(&mut |m| a.on_message(m))) {
         Err(LogError::Sink { cause, .. }) => return Err(out_err(cause)),
@@ -396,6 +410,12 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
     // A log of format 1 has no data-path stamps to recount from.
     let data_path = (contents.log_format().unwrap_or(0) >= 2).then(|| a.data_path.finish());
     let mut timing = a.timing.finish(mode, plan.scenario.rate_hz, data_path);
+    let mut damaged_aside: Vec<String> = a
+        .skipped
+        .iter()
+        .map(|(topic, (n, why))| format!("{n} {topic} message(s) skipped: malformed ({why})"))
+        .collect();
+    damaged_aside.extend(contents.end_damaged.clone());
     // A log read only in part says so already.
     let not_whole = match contents.cut_short {
         Some(_) => Vec::new(),
@@ -410,6 +430,7 @@ pub fn analyse(path: &Path, opts: AnalyseOptions<'_>) -> Result<LogAnalysis, Ana
             cut_short: contents.cut_short.as_deref(),
             not_whole: &not_whole,
             unchecked: contents.unchecked.as_deref(),
+            damaged_aside: &damaged_aside,
             first_non_finite_s: summary.first_non_finite_s,
             period_ns: plan.period_ns,
         },

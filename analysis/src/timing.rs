@@ -191,6 +191,9 @@ pub struct RunFacts<'a> {
     pub not_whole: &'a [String],
     /// Why the log's integrity cannot be checked, if it cannot.
     pub unchecked: Option<&'a str>,
+    /// Damage no step depends on: messages skipped as malformed on topics
+    /// nothing is computed from, a cut or changed closing magic.
+    pub damaged_aside: &'a [String],
     /// Sim time of the first non-finite or faulted step.
     pub first_non_finite_s: Option<f64>,
     /// Control period, ns.
@@ -212,6 +215,12 @@ pub fn judge(t: &mut TimingSummary, facts: &RunFacts<'_>) {
     }
     if let Some(why) = facts.unchecked {
         invalid.push(format!("the log cannot be checked: {why}"));
+    }
+    if !facts.damaged_aside.is_empty() {
+        degraded.push(format!(
+            "the log is damaged where no step is read from: {}",
+            facts.damaged_aside.join("; ")
+        ));
     }
     match facts.run_end {
         Some("finished") => {}
@@ -497,6 +506,25 @@ mod verdict_tests {
             assert_eq!(t.verdict, Verdict::Invalid, "{said}");
             assert_eq!(t.reasons, [said]);
         }
+    }
+
+    /// #60 item 8: damage no step depends on degrades, and is named.
+    #[test]
+    fn damage_aside_from_the_steps_is_degraded() {
+        let aside = ["the file is cut".to_string()];
+        let mut t = summary(0, 0, 10);
+        judge(
+            &mut t,
+            &RunFacts {
+                damaged_aside: &aside,
+                ..finished()
+            },
+        );
+        assert_eq!(t.verdict, Verdict::Degraded);
+        assert_eq!(
+            t.reasons,
+            ["the log is damaged where no step is read from: the file is cut"]
+        );
     }
 
     #[test]

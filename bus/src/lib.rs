@@ -18,6 +18,7 @@ mod domain;
 mod leftovers;
 mod node;
 mod reference;
+mod shm_space;
 mod topics;
 
 pub use config::{ConfigError, read_config, write_config};
@@ -25,6 +26,7 @@ pub use connections::{CONNECTION_FAILED, connection_failures};
 pub use domain::DomainNodes;
 pub use node::{NodeError, NodeLink};
 pub use reference::ReferenceWindow;
+pub use shm_space::{SHM_DIR, SHM_NEEDED_BYTES, shm_free_bytes, shm_too_small};
 pub use topics::{Bus, BusError, RunPrefix, TopicPublisher, TopicSubscriber, monotonic_ns};
 
 /// iceoryx2's own messages on stderr: only its errors unless `verbose`

@@ -40,6 +40,10 @@ pub struct ControllerNodeConfig {
     /// the order it publishes their values in.
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub own_diagnostics: String,
+    /// The run's scenario, by its file's stem ("paper_randomised"; empty:
+    /// not said): a policy trained on another is warned about.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub scenario: String,
 }
 
 /// The URDF a model-based law evaluates, with the run's locked joints.

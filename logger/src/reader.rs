@@ -31,6 +31,10 @@ pub struct LogContents {
     /// leave) or it has no DataEnd record. A record changed after writing
     /// would then go unseen, so such a log is never judged clean.
     pub unchecked: Option<String>,
+    /// What is wrong after the footer, if anything: the closing magic cut
+    /// or changed. Every record was read, so the run's data are whole;
+    /// the file is still not as the logger left it (#60 item 8).
+    pub end_damaged: Option<String>,
 }
 
 impl LogContents {
@@ -223,10 +227,40 @@ fn stream(
         }
         at += 9 + body_len;
         if op == crate::scan::OP_FOOTER {
+            let mut tail = Vec::new();
+            // At most the magic and a byte more: the rest is not read.
+            (&mut file)
+                .take(mcap::MAGIC.len() as u64 + 1)
+                .read_to_end(&mut tail)
+                .map_err(io)?;
+            walk.out.end_damaged = end_damage(&tail, len - at);
             break;
         }
     }
     walk.finish(head_only)
+}
+
+/// What is wrong with the `tail` of a file after its footer (`left`
+/// bytes in all): None when it is exactly MCAP's closing magic.
+fn end_damage(tail: &[u8], left: u64) -> Option<String> {
+    let magic = mcap::MAGIC;
+    if tail == magic && left == magic.len() as u64 {
+        return None;
+    }
+    Some(if left < magic.len() as u64 {
+        format!(
+            "the file is cut: it ends {left} bytes after the footer, inside the closing magic \
+             ({} bytes)",
+            magic.len()
+        )
+    } else if !tail.starts_with(magic) {
+        "the closing magic after the footer is wrong: the file's last bytes were changed".into()
+    } else {
+        format!(
+            "{} bytes follow the closing magic: something was appended",
+            left - magic.len() as u64
+        )
+    })
 }
 
 /// The DataEnd record's opcode.
@@ -287,6 +321,10 @@ fn read(
         &mut on_message,
         head_only,
     )?;
+    if let Some((_, after)) = crate::scan::locate(&buf[..end], crate::scan::OP_FOOTER) {
+        let tail = &buf[after..buf.len().min(after + mcap::MAGIC.len() + 1)];
+        walk.out.end_damaged = end_damage(tail, (buf.len() - after) as u64);
+    }
     walk.finish(head_only)
 }
 

@@ -55,14 +55,21 @@ pub fn sound_prefix(buf: &[u8]) -> (usize, Option<String>) {
 /// The body of the first top-level record of opcode `op` in `buf` (a
 /// soundly framed MCAP file, as [`sound_prefix`] cuts it).
 pub(crate) fn find_record(buf: &[u8], op: u8) -> Option<&[u8]> {
+    locate(buf, op).map(|(start, end)| &buf[start..end])
+}
+
+/// Where the first top-level record of opcode `op` in `buf` has its body:
+/// (start, end) offsets.
+pub(crate) fn locate(buf: &[u8], op: u8) -> Option<(usize, usize)> {
     let mut at = mcap::MAGIC.len();
     while at + 9 <= buf.len() {
         let len = usize::try_from(u64::from_le_bytes(le8(&buf[at + 1..at + 9]))).ok()?;
-        let body = buf.get(at + 9..(at + 9).checked_add(len)?)?;
+        let end = (at + 9).checked_add(len)?;
+        buf.get(at + 9..end)?;
         if buf[at] == op {
-            return Some(body);
+            return Some((at + 9, end));
         }
-        at += 9 + len;
+        at = end;
     }
     None
 }

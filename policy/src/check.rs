@@ -39,6 +39,9 @@ pub fn check_run(
         }
         Some(_) => {}
     }
+    if let Some(note) = other_scenario(record, &config.scenario) {
+        notes.push(note);
+    }
     let run = serde_json::to_value(&config.params).unwrap_or(Value::Null);
     let Some(trained) = &record.controller else {
         notes.push(
@@ -66,7 +69,11 @@ pub fn check_run(
     let mut keys: Vec<&String> = trained.keys().collect();
     keys.sort();
     for key in keys {
-        if ESSENTIAL.contains(&key.as_str()) || key == "law" {
+        // Only what the base law reads can change the torque the policy's
+        // residual is added to (a pd base takes no torque_bounds, #60
+        // item 15); a raw-torque policy has no base law at all.
+        let read = record.base_law.is_some_and(|base| base.takes(key));
+        if ESSENTIAL.contains(&key.as_str()) || key == "law" || !read {
             continue;
         }
         if let (Some(t), Some(r)) = (trained.get(key), run.get(key))
@@ -79,6 +86,21 @@ pub fn check_run(
         notes.push(format!("this run's {}", other.join(", ")));
     }
     Ok(notes)
+}
+
+/// A warning when the record names another scenario than the run's (both
+/// by name or file stem; nothing when either is not said).
+fn other_scenario(record: &EnvRecord, run: &str) -> Option<String> {
+    let trained = record.rest.get("scenario")?.as_str()?;
+    let stem = |s: &str| {
+        std::path::Path::new(s)
+            .file_stem()
+            .map_or_else(String::new, |x| x.to_string_lossy().into_owned())
+    };
+    let trained = stem(trained);
+    (!run.is_empty() && !trained.is_empty() && trained != run).then(|| {
+        format!("the policy was trained on scenario {trained} (env.scenario); this run's is {run}")
+    })
 }
 
 /// A per-joint setting (one number, or one per joint) as n numbers.
@@ -132,6 +154,7 @@ mod tests {
             model: None,
             own_params: Default::default(),
             own_diagnostics: String::new(),
+            scenario: String::new(),
         }
     }
 
@@ -167,11 +190,43 @@ mod tests {
     }
 
     #[test]
-    fn other_settings_are_warned_about() {
-        let notes = check_run(&record(r#"{"k1": 3.75, "beta": 123.0}"#), &config(3.75)).unwrap();
+    fn another_scenario_is_warned_about() {
+        let mut r = record(r#"{"k1": 3.75}"#);
+        r.rest
+            .insert("scenario".into(), "scenarios/paper_randomised.toml".into());
+        let mut c = config(3.75);
+        c.scenario = "paper_randomised".into();
+        assert!(check_run(&r, &c).unwrap().is_empty());
+        c.scenario = "iiwa14_randomised".into();
+        let notes = check_run(&r, &c).unwrap();
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.contains("scenario paper_randomised") && n.contains("iiwa14")),
+            "{notes:?}"
+        );
+    }
+
+    #[test]
+    fn other_settings_the_base_law_reads_are_warned_about() {
+        let with_base = |base: &str| {
+            let mut r = record(r#"{"k1": 3.75, "beta": 123.0, "torque_bounds": true}"#);
+            r.base_law = Some(base.parse().unwrap());
+            r
+        };
+        let notes = check_run(&with_base("nac"), &config(3.75)).unwrap();
         assert!(
             notes.iter().any(|n| n.contains("controller.beta")),
             "{notes:?}"
         );
+        // pd reads neither beta nor torque_bounds; a raw-torque policy
+        // has no base law to read them.
+        assert!(
+            check_run(&with_base("pd"), &config(3.75))
+                .unwrap()
+                .is_empty()
+        );
+        let raw = record(r#"{"k1": 3.75, "beta": 123.0}"#);
+        assert!(check_run(&raw, &config(3.75)).unwrap().is_empty());
     }
 }

@@ -104,6 +104,16 @@ pub enum PolicyError {
         /// The shape needed.
         need: String,
     },
+    /// The network's output is not real numbers.
+    #[error(
+        "{path}: the network's output is of type {found}, not float or double (an integer torque would be rounded)"
+    )]
+    OutputType {
+        /// The policy file.
+        path: PathBuf,
+        /// The type found (tract's name: an ONNX int64 reads as TDim).
+        found: String,
+    },
     /// The network gave a value that is not finite.
     #[error("{path}: the network's output {index} is {value}, not a finite number")]
     NotFinite {
@@ -354,6 +364,13 @@ fn runnable(
                 need: format!("{} numbers (dof)", record.dof),
             });
         }
+    }
+    // An integer output would be a rounded torque (#60 item 10).
+    if out.datum_type != f32::datum_type() && out.datum_type != f64::datum_type() {
+        return Err(PolicyError::OutputType {
+            path: path.to_path_buf(),
+            found: format!("{:?}", out.datum_type),
+        });
     }
     let plan = typed.into_runnable().map_err(|e| not_onnx(&e))?;
     Ok((plan, datum, shape))

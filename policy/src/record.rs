@@ -105,13 +105,24 @@ impl EnvRecord {
         };
         let torque_scale = match take("torque_scale") {
             None => return Err(bad("torque_scale", "missing".into())),
-            Some(v) => numbers("torque_scale", v, false)?,
+            // Zero or negative: an action that does nothing, or pushes the
+            // other way from the one the policy learnt (#60 item 10).
+            Some(v) => numbers("torque_scale", v, true)?,
         };
         let decimation = match take("decimation") {
             None => 1,
             Some(v) => u32::try_from(count("decimation", Some(v))?)
                 .map_err(|_| bad("decimation", "too large".into()))?,
         };
+        // Held longer than an episode: one decision for the whole run.
+        if u64::from(decimation) > steps {
+            return Err(bad(
+                "decimation",
+                format!(
+                    "{decimation} periods per decision is longer than the episode's {steps} (steps)"
+                ),
+            ));
+        }
         let scale_obs = match take("scale_obs") {
             None => false,
             Some(Value::Bool(b)) => b,
@@ -230,6 +241,13 @@ mod tests {
         );
         assert_eq!(field_of(&with("base_law", "\"nope\"")), "base_law");
         assert_eq!(field_of(&with("decimation", "1.5")), "decimation");
+        // #60 item 10: a torque scale that does nothing or pushes the other
+        // way, one decision for the whole episode.
+        for bad in ["[0.0, 25.0]", "[-50.0, 25.0]"] {
+            assert_eq!(field_of(&with("torque_scale", bad)), "torque_scale");
+        }
+        assert_eq!(field_of(&with("decimation", "4294967295")), "decimation");
+        assert_eq!(field_of(&with("decimation", "4001")), "decimation");
         assert_eq!(field_of(&with("scale_obs", "1")), "scale_obs");
         assert_eq!(field_of(r#"{"obs_dim": 8}"#), "dof");
         assert_eq!(field_of("[1]"), "");

@@ -71,6 +71,13 @@ fn a_network_whose_input_is_not_the_records_obs_dim_is_refused() {
 }
 
 #[test]
+fn an_integer_output_is_refused() {
+    let e = Policy::load(&fixture("int_output.onnx")).unwrap_err();
+    assert!(matches!(e, PolicyError::OutputType { .. }), "{e:?}");
+    assert!(e.to_string().contains("int_output.onnx"), "{e}");
+}
+
+#[test]
 fn a_file_that_is_not_onnx_is_refused_naming_it() {
     let e = Policy::load(&fixture("make.py")).unwrap_err();
     assert!(matches!(e, PolicyError::NotOnnx { .. }), "{e:?}");
@@ -104,6 +111,7 @@ fn pd_config() -> controller::node::ControllerNodeConfig {
         model: None,
         own_params: Default::default(),
         own_diagnostics: String::new(),
+        scenario: String::new(),
     }
 }
 

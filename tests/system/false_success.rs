@@ -13,7 +13,8 @@ use crate::util::{lockstep_log, testbed};
 /// writer, as a tool that edits logs does: only the messages of topics
 /// `keep` accepts, the logger's counts of the others left out too when
 /// `drop_counts`, every `thin`-th message of topic `thin.0` dropped, and
-/// the data section's checksum computed only when `data_crc`.
+/// the data section's checksum computed only when `data_crc`, and every
+/// message of topic `replace.0` holding `replace.1` instead of its data.
 fn rewrite(
     from: &Path,
     to: &Path,
@@ -21,6 +22,7 @@ fn rewrite(
     drop_counts: bool,
     thin: Option<(&str, u32)>,
     data_crc: bool,
+    replace: Option<(&str, &[u8])>,
 ) {
     let bytes = std::fs::read(from).unwrap();
     let mut w = mcap::WriteOptions::new()
@@ -60,6 +62,10 @@ fn rewrite(
                     }
                 }
                 header.channel_id = *id;
+                let data = match replace {
+                    Some((t, with)) if t == topic => with.to_vec().into(),
+                    _ => data,
+                };
                 w.write_to_known_channel(&header, &data).unwrap();
             }
             Record::Metadata(mut m) => {
@@ -114,7 +120,7 @@ fn a_log_without_whole_topics_replays_invalid() {
     let dir = tempfile::tempdir().unwrap();
     let log = lockstep_log(dir.path());
     let copy = dir.path().join("copy.mcap");
-    rewrite(&log, &copy, &|_| true, true, None, true);
+    rewrite(&log, &copy, &|_| true, true, None, true, None);
     let (code, s, err) = replay(&["--json", "--verify"], &copy);
     assert_eq!(code, Some(0), "{err}");
     assert_eq!(s.unwrap()["timing"]["verdict"], "clean");
@@ -132,7 +138,7 @@ fn a_log_without_whole_topics_replays_invalid() {
     ];
     for (keep, missing) in cases {
         let cut = dir.path().join("cut.mcap");
-        rewrite(&log, &cut, keep, true, None, true);
+        rewrite(&log, &cut, keep, true, None, true, None);
         for args in [&["--json"][..], &["--json", "--verify"]] {
             let (code, s, err) = replay(args, &cut);
             assert_ne!(code, Some(0), "{missing:?} {args:?}: {err}");
@@ -153,7 +159,15 @@ fn a_log_without_whole_topics_replays_invalid() {
     }
     // Every 7th /timing message gone, the logger's counts kept.
     let thin = dir.path().join("thin.mcap");
-    rewrite(&log, &thin, &|_| true, false, Some(("/timing", 7)), true);
+    rewrite(
+        &log,
+        &thin,
+        &|_| true,
+        false,
+        Some(("/timing", 7)),
+        true,
+        None,
+    );
     let (code, s, err) = replay(&["--json"], &thin);
     assert_eq!(code, Some(4), "{err}");
     let reasons = s.unwrap()["timing"]["reasons"].to_string();
@@ -161,6 +175,47 @@ fn a_log_without_whole_topics_replays_invalid() {
         reasons.contains("/timing messages where the logger received 300"),
         "{reasons}"
     );
+}
+
+/// #60 item 8: a malformed message on a topic no step is read from
+/// (`/robot_description`) is skipped and named, every step recovered; a
+/// log whose last byte is cut, or whose closing magic was changed, says
+/// so. Each is `degraded` (exit 3), never clean and never a lost log.
+#[test]
+fn damage_no_step_depends_on_is_named_and_the_steps_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = lockstep_log(dir.path());
+    let bad = dir.path().join("bad.mcap");
+    let garbage: &[u8] = b"\x07garbag";
+    rewrite(
+        &log,
+        &bad,
+        &|_| true,
+        true,
+        None,
+        true,
+        Some(("/robot_description", garbage)),
+    );
+    let bytes = std::fs::read(&log).unwrap();
+    let cut = dir.path().join("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() - 1]).unwrap();
+    let mut changed = bytes.clone();
+    *changed.last_mut().unwrap() ^= 0xff;
+    let magic = dir.path().join("magic.mcap");
+    std::fs::write(&magic, &changed).unwrap();
+    for (file, said) in [
+        (&bad, "1 /robot_description message(s) skipped: malformed"),
+        (&cut, "the file is cut"),
+        (&magic, "the closing magic after the footer is wrong"),
+    ] {
+        let (code, s, err) = replay(&["--json", "--verify"], file);
+        let s = s.unwrap_or_else(|| panic!("{}: no summary: {err}", file.display()));
+        assert_eq!(s["timing"]["verdict"], "degraded", "{s}");
+        assert_eq!(code, Some(3), "{err}");
+        assert_eq!(s["missing_rows"], 0, "{s}");
+        let reasons = s["timing"]["reasons"].to_string();
+        assert!(reasons.contains(said), "{said}: {reasons}");
+    }
 }
 
 /// Item 1: a data section whose checksum is 0 (MCAP's "not computed", as
@@ -171,7 +226,7 @@ fn a_log_without_a_data_checksum_cannot_be_checked() {
     let dir = tempfile::tempdir().unwrap();
     let log = lockstep_log(dir.path());
     let copy = dir.path().join("no-crc.mcap");
-    rewrite(&log, &copy, &|_| true, false, None, false);
+    rewrite(&log, &copy, &|_| true, false, None, false, None);
     let (code, s, err) = replay(&["--json"], &copy);
     assert_eq!(code, Some(4), "{err}");
     let s = s.unwrap();

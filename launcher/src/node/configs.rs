@@ -47,7 +47,21 @@ pub fn controller(plan: &Plan) -> ControllerNodeConfig {
         }),
         own_params: serde_json::Map::new(),
         own_diagnostics: String::new(),
+        scenario: scenario_name(&plan.source),
     }
+}
+
+/// A scenario's name as a policy's record writes it: the file's stem of a
+/// path, the name of a shipped one ("built-in paper scenario": "paper").
+fn scenario_name(source: &str) -> String {
+    if source.starts_with("built-in") {
+        return "paper".into();
+    }
+    // The label goes on with what changed it ("x.toml with --set …").
+    let path = source.split(" with ").next().unwrap_or(source);
+    std::path::Path::new(path)
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned())
 }
 
 /// The trajectory's part.

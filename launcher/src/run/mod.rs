@@ -145,6 +145,10 @@ fn run_once(opts: &RunOptions) -> Result<RunOutcome, RunError> {
     }
     // And the files of nodes killed while they were being created.
     prefix.remove_leftover_files(false);
+    // Before any service is made: a full /dev/shm kills a node with SIGBUS.
+    if let Some(reason) = bus::shm_too_small() {
+        return Err(RunError::Scenario { reason });
+    }
     let bus = Bus::new(&prefix, "launcher")?;
     let status = bus.subscriber::<NodeStatus>()?;
     let control = bus.publisher::<Control>(Delivery::DropWhenFull)?;

@@ -280,6 +280,14 @@ pub fn describe(status: ExitStatus) -> String {
     match (status.code(), status.signal()) {
         (Some(code), _) => format!("exited with status {code}"),
         (None, Some(sig)) => match Signal::try_from(sig) {
+            // The one way a full /dev/shm shows itself to a node.
+            Ok(s @ Signal::SIGBUS) => format!(
+                "was killed by signal {sig} ({}: a shared-memory page could not be had; \
+                 {} had {} bytes free)",
+                s.as_str(),
+                bus::SHM_DIR,
+                bus::shm_free_bytes().map_or("?".into(), |b| b.to_string())
+            ),
             Ok(s) => format!("was killed by signal {sig} ({})", s.as_str()),
             Err(_) => format!("was killed by signal {sig}"),
         },

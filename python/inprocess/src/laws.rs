@@ -85,6 +85,17 @@ impl PyLaw {
         self.dt
     }
 
+    /// The `[controller]` keys the law reads (the common ones and its own),
+    /// in the scenario file's order.
+    #[getter]
+    fn keys(&self) -> Vec<&'static str> {
+        controller::ControllerParams::KEYS
+            .iter()
+            .copied()
+            .filter(|k| self.name.takes(k))
+            .collect()
+    }
+
     /// The law's parameters as the scenario resolved them.
     #[getter]
     fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {

@@ -28,7 +28,7 @@ from .policy import LinearPolicy, quote
 #: Settings of the run's `[controller]` table a policy is refused on when
 #: they differ from its training scenario's: the prescribed time and the
 #: gains shape the torque it learnt a residual on and the error it saw.
-#: The others (and `law`, the run's own) are warned about.
+#: The others the base law reads (not `law`, the run's own) are warned about.
 ESSENTIAL = ("tc", "k1", "k2")
 
 
@@ -119,7 +119,10 @@ class PolicyController(tc.Controller):
                 if key in trained and key in run.params and _differs(trained[key], run.params[key], self.n):
                     raise ValueError(f"the policy was trained with controller.{key} = {quote(trained[key])}; "
                                      f"this run's controller.{key} is {quote(run.params[key])}")
-            other = [k for k in sorted(set(trained) & set(run.params))
+            # Only what the base law reads changes the torque the residual is
+            # added to; a raw-torque policy has no base law (as the Rust node).
+            reads = set(self.law.keys) if self.law is not None else set()
+            other = [k for k in sorted(set(trained) & set(run.params) & reads)
                      if k not in ESSENTIAL and k != "law" and _differs(trained[k], run.params[k], self.n)]
             if other:
                 notes.append("this run's " + ", ".join(

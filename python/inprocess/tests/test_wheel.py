@@ -52,6 +52,16 @@ for name in testbed.SCENARIOS:
     testbed.scenario_toml(name)
 for name in testbed.ROBOTS:
     testbed.Robot(name)
+# The controller package comes with the wheel (testbed.policy_node imports
+# it); reading a log needs no iceoryx2, and `run` without it says what to install.
+import testbed_controller, testbed_controller.log, testbed.policy_node
+assert inside(testbed_controller.log.__file__), testbed_controller.log.__file__
+assert "iceoryx2" not in sys.modules
+try:
+    testbed_controller.run
+    raise AssertionError("run imported without iceoryx2")
+except ModuleNotFoundError as e:
+    assert "rl-deferred-testbed[bus]" in str(e), e
 print(json.dumps({"scenarios": len(testbed.SCENARIOS), "robots": len(testbed.ROBOTS)}))
 """
 
