@@ -14,6 +14,11 @@
 //! and the summary are made from. Other arguments the launcher adds (CPU
 //! placement) are ignored.
 //!
+//! Its loop is written out on purpose: it shows an author outside the
+//! workspace the whole protocol (the timing stamps, the stale-reference
+//! count, checking in every 256 states). Inside the workspace a law
+//! serves through `controller::node::serve`, which owns that loop.
+//!
 //! It is also a law of its own for `testbed run --controller-cmd`: asked
 //! `--describe`, it declares its name, its parameters (`kp`, `kd`), which
 //! the scenario's `[external]` table may set, and a diagnostic of its own,

@@ -26,7 +26,7 @@ const JOINT_COLUMNS: [Column; 12] = [
 
 /// Column names: `t`, then per joint i `q{i} qd{i} qdd{i} tau{i} qref{i}
 /// kc{i} z1_{i} z2_{i} wa{i} qm{i} qdm{i} d{i}`, then `effects` (bits of
-/// `plant_rapier::Effects`).
+/// `wire::Effects`).
 pub fn header(dof: usize) -> String {
     header_with_own(dof, &[])
 }

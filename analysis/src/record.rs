@@ -20,7 +20,7 @@ pub struct StepRecord<'a> {
     pub tau: &'a [f64],
     /// Disturbance d applied over the step.
     pub disturbance: &'a [f64],
-    /// Plant effects over the step (bits of `plant_rapier::Effects`).
+    /// Plant effects over the step (bits of `wire::Effects`).
     pub effects: u32,
     /// Desired position q_d(t_k).
     pub q_d: &'a [f64],

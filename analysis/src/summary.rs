@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use plant_rapier::Effects;
+use wire::Effects;
 
 use crate::record::StepRecord;
 
@@ -130,7 +130,7 @@ pub struct ArmMetrics {
 /// The plant effects of a run, as its logged states flag them.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EffectsSummary {
-    /// Every effect that acted at some step (names of `plant_rapier::Effects`).
+    /// Every effect that acted at some step (names of `wire::Effects`).
     pub active: Vec<&'static str>,
     /// Steps whose torque was clipped at an effort limit.
     pub saturated_steps: u64,
@@ -233,7 +233,7 @@ impl SummaryBuilder {
     /// Also integrates the effort beyond the static gravity load of
     /// `model` (the URDF's, as the controller's designer knows it: no
     /// payload, standard gravity) after T_c.
-    pub fn with_gravity(mut self, model: &plant_rapier::ArmModel) -> Self {
+    pub fn with_gravity(mut self, model: &arm_model::ArmModel) -> Self {
         self.gravity = Some(Box::new(arm_model::dynamics::Dynamics::new(model, 1.0)));
         self
     }

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use bus::{NodeError, NodeLink, ReferenceWindow, monotonic_ns};
 use serde::{Deserialize, Serialize};
-use wire::{Command, ControllerDiagnostics, JointState, Mode, STATE_FINAL};
+use wire::{Command, ControllerDiagnostics, JointState, Mode, ReferenceSample, STATE_FINAL};
 
 use arm_model::{ArmModel, Locks};
 
@@ -114,12 +114,58 @@ pub fn run(
     mode: Mode,
 ) -> Result<(), ControllerNodeError> {
     let mut m = config.machine()?;
+    let stepped = serve(link, mode, config.reference_period(), |s, r| {
+        let (cmd, diag) = m.step(s, r);
+        (cmd, diag, None::<std::convert::Infallible>)
+    });
+    match stepped {
+        Ok(()) => Ok(()),
+        Err(ServeError::Node(e)) => Err(e.into()),
+        Err(ServeError::Step(never)) => match never {},
+    }
+}
+
+/// Why [`serve`] stopped before the run's end.
+#[derive(Debug, thiserror::Error)]
+pub enum ServeError<E> {
+    /// The node protocol or the bus.
+    #[error(transparent)]
+    Node(#[from] NodeError),
+    /// The step said the run cannot go on (its command went out first).
+    #[error("{0}")]
+    Step(E),
+}
+
+impl<E> From<bus::BusError> for ServeError<E> {
+    fn from(e: bus::BusError) -> Self {
+        Self::Node(e.into())
+    }
+}
+
+/// The controller side of the node protocol, for any law: READY, then on
+/// each joint state the reference sample due at its time, `step`, and the
+/// command and diagnostics published with their timing stamps and the
+/// stale-reference count; the launcher is checked in with every 256 states
+/// and on a quiet 100 ms; DONE at the final state. A step that returns an
+/// error has its command published, then ends the run with it (a policy
+/// whose network gave NaN: zero torque with the fault flag, then the
+/// reason). `testbed node controller` and `testbed-policy` both serve
+/// through it.
+pub fn serve<E>(
+    link: &mut NodeLink,
+    mode: Mode,
+    reference_period_ns: u64,
+    mut step: impl FnMut(
+        &JointState,
+        Option<&ReferenceSample>,
+    ) -> (Command, ControllerDiagnostics, Option<E>),
+) -> Result<(), ServeError<E>> {
     let states = link.bus.subscriber::<JointState>()?;
     let commands = link.bus.publisher::<Command>(mode.delivery())?;
     let diagnostics = link
         .bus
         .publisher::<ControllerDiagnostics>(mode.delivery())?;
-    let mut reference = ReferenceWindow::new(link, mode, config.reference_period())?;
+    let mut reference = ReferenceWindow::new(link, mode, reference_period_ns)?;
     link.ready_and_wait_for_start()?;
 
     let mut handled = 0u64;
@@ -133,7 +179,7 @@ pub fn run(
             let started_wall_ns = monotonic_ns();
             let started = Instant::now();
             let r = reference.take(link, s.header.t_ns)?;
-            let (mut cmd, mut diag) = m.step(&s, r.as_ref());
+            let (mut cmd, mut diag, failed) = step(&s, r.as_ref());
             let compute_ns = started.elapsed().as_nanos() as u64;
             let wall_ns = monotonic_ns();
             cmd.header.wall_ns = wall_ns;
@@ -144,6 +190,9 @@ pub fn run(
             diag.compute_ns = compute_ns;
             commands.send(cmd)?;
             diagnostics.send(diag)?;
+            if let Some(e) = failed {
+                return Err(ServeError::Step(e));
+            }
             handled += 1;
             // Checked every 256 states (and on a timeout), not on every
             // wake-up; here, so that a loop that always finds the next

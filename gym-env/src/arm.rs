@@ -4,8 +4,8 @@
 //! episode ended.
 
 use controller::ControllerMachine;
-use launcher::stepper::Stepper;
 use scenario::Plan;
+use scenario::stepper::Stepper;
 
 use crate::options::{self, ActionMode, ERROR_CAP, EnvError, EnvOptions};
 use crate::render::{Picture, Projection};

@@ -5,7 +5,7 @@
 //! reward, safety cost, end of an episode and a picture of the arm.
 //!
 //! Where it sits in the data flow: a [`scenario::Plan`] comes in (loaded by
-//! the caller); each step drives [`launcher::stepper::Stepper`], the loop
+//! the caller); each step drives [`scenario::stepper::Stepper`], the loop
 //! body `testbed sim` uses, for `decimation` plant periods with the action
 //! held; the PyO3 module (`python/inprocess`, `testbed._native`) only
 //! converts Python values to and from these types, and `testbed/env.py`

@@ -16,4 +16,3 @@ pub mod mode;
 pub mod node;
 pub mod run;
 pub mod sim;
-pub mod stepper;

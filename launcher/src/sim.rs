@@ -7,7 +7,7 @@ use controller::ControllerError;
 use plant_rapier::PlantError;
 use scenario::Plan;
 
-use crate::stepper::Stepper;
+use scenario::stepper::Stepper;
 
 use analysis::assemble::RecordAssembler;
 use analysis::record::StepRecord;

@@ -17,14 +17,13 @@
 
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
-use bus::{NodeLink, ReferenceWindow, RunPrefix, monotonic_ns, read_config};
-use controller::node::ControllerNodeConfig;
+use bus::{NodeLink, RunPrefix, read_config};
+use controller::node::{ControllerNodeConfig, ServeError, serve};
 use launcher::node::placement::Placement;
 use policy::{Policy, PolicyLaw, check_run};
-use wire::{Command, ControllerDiagnostics, JointState, Mode, NodeKind, STATE_FINAL};
+use wire::{Mode, NodeKind};
 
 /// The law's name in the log, the summary and `replay`.
 const NAME: &str = "onnx-policy";
@@ -133,60 +132,21 @@ fn run() -> anyhow::Result<()> {
     let mut law = PolicyLaw::new(policy, &config).context("the policy's base law")?;
 
     let mut link = NodeLink::connect(NodeKind::Controller, &prefix, a.parent, mode)?;
-    let states = link.bus.subscriber::<JointState>()?;
-    let mut references = ReferenceWindow::new(&link, mode, config.reference_period())?;
-    let commands = link.bus.publisher::<Command>(mode.delivery())?;
-    let diagnostics = link
-        .bus
-        .publisher::<ControllerDiagnostics>(mode.delivery())?;
-    link.ready_and_wait_for_start()?;
-    let mut handled = 0u64;
-    let mut failed = None;
-    'run: loop {
-        while let Some(s) = states.receive()? {
-            if s.flags & STATE_FINAL != 0 {
-                break 'run;
-            }
-            if s.header.seq == steps {
-                // Past its episode the time feature exceeds 1: never seen.
-                eprintln!(
-                    "testbed-policy: warning: the run has passed the policy's episode of \
-                     {steps} steps (env.steps); it acts on times it never saw"
-                );
-            }
-            let started_wall_ns = monotonic_ns();
-            let started = Instant::now();
-            let r = references.take(&mut link, s.header.t_ns)?;
-            let (mut cmd, mut diag, err) = law.step(&s, r.as_ref());
-            if let Some(e) = err {
-                // Zero torque with the fault flag went out; the run stops
-                // with the reason, as a Python controller's exception does.
-                failed = Some(e);
-            }
-            let compute_ns = started.elapsed().as_nanos() as u64;
-            let wall_ns = monotonic_ns();
-            cmd.header.wall_ns = wall_ns;
-            cmd.compute_ns = compute_ns;
-            cmd.started_wall_ns = started_wall_ns;
-            cmd.stale_references = references.stale_count();
-            diag.header.wall_ns = wall_ns;
-            diag.compute_ns = compute_ns;
-            commands.send(cmd)?;
-            diagnostics.send(diag)?;
-            if let Some(e) = failed {
-                return Err(e.into());
-            }
-            handled += 1;
-            // The launcher and STOP are checked every 256 states and on a
-            // timeout: the check also sends the heartbeat it expects.
-            if handled.is_multiple_of(256) {
-                link.check()?;
-            }
+    let served = serve(&mut link, mode, config.reference_period(), |s, r| {
+        if s.header.seq == steps {
+            // Past its episode the time feature exceeds 1: never seen.
+            eprintln!(
+                "testbed-policy: warning: the run has passed the policy's episode of \
+                 {steps} steps (env.steps); it acts on times it never saw"
+            );
         }
-        if !states.wait_event(Duration::from_millis(100))? {
-            link.check()?;
-        }
+        // A failed step publishes zero torque with the fault flag; the run
+        // then stops with the reason, as a Python controller's exception does.
+        law.step(s, r)
+    });
+    match served {
+        Ok(()) => Ok(()),
+        Err(ServeError::Node(e)) => Err(e.into()),
+        Err(ServeError::Step(e)) => Err(e.into()),
     }
-    link.done_and_wait_for_stop(handled)?;
-    Ok(())
 }

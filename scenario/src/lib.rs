@@ -5,7 +5,10 @@
 //! part: `[plant]` and `[initial]` to the plant, `[reference]` and
 //! `[envelope]` to the trajectory, `[controller]` to the controller.
 //! Every key is optional and defaults to the paper's value; unknown keys,
-//! NaN and out-of-range values are errors naming the key.
+//! NaN and out-of-range values are errors naming the key. [`stepper`] is
+//! the one loop body a plan runs in process (`sim`, the Gym environment):
+//! here, under the role crates, so that a law or the environment needs no
+//! run stack.
 //!
 //! ```
 //! let s = scenario::Scenario::from_toml_str("[controller]\nk1 = 20.0\n", "inline").unwrap();
@@ -26,6 +29,7 @@ mod probe;
 mod randomise;
 mod robot;
 mod seed;
+pub mod stepper;
 pub mod sweep_file;
 
 use controller::{ControllerError, ControllerParams};
