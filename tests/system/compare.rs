@@ -259,7 +259,16 @@ fn a_faulted_run_is_a_failure_everywhere() {
         "--laws",
         &laws(&[LawName::Nac, LawName::NacNoShift]),
     ];
-    let c = json(&ok(testbed().args(args).arg("--json")));
+    // Every run of nac-no-shift failed: the table has no result for it, so
+    // compare exits 1 (#60 item 4), the outputs written all the same.
+    let failed = |extra: &[&str]| {
+        let out = testbed().args(args).args(extra).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains("every run of nac-no-shift failed"), "{err}");
+        out
+    };
+    let c = json(&failed(&["--json"]));
     let laws = c["laws"].as_array().unwrap();
     let why = laws[1]["runs"][0]["failed"].as_str().unwrap_or_default();
     assert!(why.contains("fault steps"), "{why}");
@@ -273,7 +282,7 @@ fn a_faulted_run_is_a_failure_everywhere() {
                 .as_f64()
                 .is_none_or(f64::is_infinite)
     );
-    let table = String::from_utf8(ok(testbed().args(args).arg("--csv").arg(&csv)).stdout).unwrap();
+    let table = String::from_utf8(failed(&["--csv", csv.to_str().unwrap()]).stdout).unwrap();
     assert!(
         table.contains("FAILED") && table.contains("nac-no-shift seed 0"),
         "{table}"
@@ -290,7 +299,7 @@ fn a_faulted_run_is_a_failure_everywhere() {
     );
     // The figures say so too: a grey "FAILED" bar, a "FAILED" panel title.
     let fig = dir.path().join("fig");
-    ok(testbed().args(args).arg("--plots").arg(&fig));
+    failed(&["--plots", fig.to_str().unwrap()]);
     for f in [
         "compare_bars.svg",
         "compare_error_ratio.svg",
