@@ -3,7 +3,7 @@
 //! [`bench`](mod@bench) measures the testbed itself.
 //!
 //! Where it sits: above [`launcher`] (each experiment's runs go through
-//! [`launcher::sim`] or [`launcher::run`]) and below the `testbed` CLI
+//! [`run_stack::sim`] or [`run_stack::run`]) and below the `testbed` CLI
 //! (`launch/`), which parses arguments and prints what these return. The
 //! Python module (`python/inprocess`) calls [`compare`] the same way.
 //! Each folder keeps its types at the bottom (`types.rs`), so no file

@@ -28,7 +28,7 @@ fn plan(duration: f64, set: &[&str]) -> Plan {
 /// The states (q) and torques of `testbed sim` on `plan`, one per step.
 fn sim_rows(plan: &Plan) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
     let (mut q, mut tau) = (Vec::new(), Vec::new());
-    launcher::sim::run(plan, |r| {
+    run_stack::sim::run(plan, |r| {
         q.push(r.q.to_vec());
         tau.push(r.tau.to_vec());
         Ok(())

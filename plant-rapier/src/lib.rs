@@ -1,15 +1,17 @@
-//! The simulated arm: a Rapier multibody (f64) built from a URDF.
+//! The simulated arm, from a URDF or MJCF file, on one of two engines: the
+//! articulated RK4 engine (the equations of motion in joint coordinates,
+//! the default) or a Rapier multibody (f64); see [`EngineName`].
 //!
 //! Where it sits: at the start and the end of each period. The core is the
-//! checked [`ArmModel`], the Rapier [`Plant`] and the [`Rig`] around it with
+//! checked [`ArmModel`], the [`Plant`] on either engine and the [`Rig`] around it with
 //! what a real arm adds that the controller does not know (friction, a
 //! payload, the disturbance d(t), saturation, sensor noise and quantisation,
 //! actuation delay, lost commands; see [`PlantConfig`]). [`PlantMachine`]
 //! is its step machine in wire messages (command → joint state), driven by
 //! the plant node ([`node`], the clock of a multi-process run) and by
 //! `testbed sim`. The arm's description is [`arm_model`]'s; the controller
-//! never sees the Rapier side (its model-based reference laws evaluate the
-//! same URDF with `arm_model::dynamics`, not with Rapier).
+//! never sees the engine (its model-based reference laws evaluate the same
+//! URDF with `arm_model::dynamics`, not with the plant's engine).
 //!
 //! ```
 //! use plant_rapier::{ArmModel, Plant, PlantConfig, TWO_LINK_URDF};

@@ -3,7 +3,7 @@
 //! in, acting on the observation the Gymnasium environment builds.
 //!
 //! Where it sits in the data flow: the controller node `testbed-policy
-//! FILE.onnx` (`policy/bin/testbed_policy.rs`, run by `testbed run
+//! FILE.onnx` (`policy/node/src/main.rs`, run by `testbed run
 //! --controller-cmd` and `testbed compare --controller-cmd`) receives the
 //! joint state and the reference sample over the bus like any controller
 //! node, and hands them to [`PolicyLaw::step`]. Every `decimation` plant

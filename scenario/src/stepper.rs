@@ -1,6 +1,6 @@
 //! The one loop body of an in-process run: state k → the reference sample
 //! due at its time → a command → the plant steps one period → state k+1.
-//! `testbed sim` (`launcher::sim`) and the Gym environment (`gym-env`) both
+//! `testbed sim` (`run_stack::sim`) and the Gym environment (`gym-env`) both
 //! step through it, so a zero residual in the environment is `sim`, bit for
 //! bit. The node processes of a lockstep run step the same three machines,
 //! one per process, in the same order.

@@ -371,18 +371,22 @@ fn randomised_trials_differ_per_seed_and_repeat_per_seed() {
         "{raw} {holm}"
     );
     // #26 item 5: the findings, by their rules, in the JSON.
-    let findings = cmp["findings"].as_array().unwrap();
-    assert_eq!(findings[0]["verdict"], "holds", "{findings:?}");
-    assert!(findings[5]["claim"].as_str().unwrap().contains("vs pd"));
+    let findings = &cmp["findings"];
+    let kept = finding(findings, "nac keeps |e| < k_c after T_c");
+    assert_eq!(kept["verdict"], "holds", "{findings:?}");
+    let effort = finding(
+        findings,
+        "nac uses less effort after T_c (vs pd, effort_beyond_gravity)",
+    );
     assert!(
-        findings[5]["evidence"]
+        effort["evidence"]
             .as_str()
             .unwrap()
             .contains("Wilcoxon signed-rank p = ")
     );
     // #50: the effect is paired, seed by seed.
     assert!(
-        findings[5]["evidence"]
+        effort["evidence"]
             .as_str()
             .unwrap()
             .contains("median per-seed difference nac − pd")
@@ -544,12 +548,16 @@ fn breaches_are_a_fact_and_the_findings_count_every_law_alike() {
             .iter()
             .all(|p| p["law"] == "nac")
     );
-    let f = c["findings"].as_array().unwrap();
-    assert_eq!(f[0]["verdict"], "holds", "{f:?}");
-    let evidence = f[0]["evidence"].as_str().unwrap();
+    let f = &c["findings"];
+    let kept = finding(f, "nac keeps |e| < k_c after T_c");
+    assert_eq!(kept["verdict"], "holds", "{f:?}");
+    let evidence = kept["evidence"].as_str().unwrap();
     assert!(evidence.contains("ctc: kept 0, left 6"), "{evidence}");
-    assert!(f[4]["claim"].as_str().unwrap().contains("vs ctc"));
-    let evidence = f[4]["evidence"].as_str().unwrap();
+    let vs_ctc = finding(
+        f,
+        "nac keeps the envelope on seeds where a law without a barrier leaves it (vs ctc)",
+    );
+    let evidence = vs_ctc["evidence"].as_str().unwrap();
     assert!(
         evidence.starts_with("nac kept it and ctc left it on 6 seeds, the reverse on 0"),
         "{evidence}"
@@ -564,7 +572,7 @@ fn breaches_are_a_fact_and_the_findings_count_every_law_alike() {
         .and_then(|t| t.parse().ok())
         .unwrap();
     let want = if holm < 0.05 { "holds" } else { "not-shown" };
-    assert_eq!(f[4]["verdict"], want, "{evidence}");
+    assert_eq!(vs_ctc["verdict"], want, "{evidence}");
 }
 
 /// #37 item 3: identical seeds are one run (a note, no paired test); one
@@ -599,10 +607,13 @@ fn what_the_seeds_cannot_say_is_not_said() {
         "nac,pd",
         "--json",
     ])));
-    let f = one["findings"].as_array().unwrap();
-    assert_eq!(f[5]["verdict"], "not-shown", "{:?}", f[5]);
+    let effort = finding(
+        &one["findings"],
+        "nac uses less effort after T_c (vs pd, effort_beyond_gravity)",
+    );
+    assert_eq!(effort["verdict"], "not-shown", "{effort:?}");
     assert!(
-        f[5]["evidence"]
+        effort["evidence"]
             .as_str()
             .unwrap()
             .contains("one draw of random effects (sensor noise)")
@@ -684,4 +695,16 @@ fn a_law_set_reaches_its_law_only() {
         err.contains("mpc, seed 0") && err.contains("controller.mpc_step = -1"),
         "{err}"
     );
+}
+
+/// The one finding of `claim`, by its text as `compare` prints it (a
+/// comparative claim with its "(vs LAW…)"), never by its position.
+fn finding<'a>(findings: &'a serde_json::Value, claim: &str) -> &'a serde_json::Value {
+    let all = findings.as_array().expect("findings is an array");
+    let mut hits = all.iter().filter(|f| f["claim"] == claim);
+    let hit = hits
+        .next()
+        .unwrap_or_else(|| panic!("no finding claims {claim:?}: {findings}"));
+    assert!(hits.next().is_none(), "two findings claim {claim:?}");
+    hit
 }

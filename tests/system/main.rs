@@ -7,20 +7,18 @@
     reason = "test code: a broken expectation should fail loudly"
 )]
 
+mod bad_input;
 mod compare;
-mod false_success;
-mod hardening;
-mod hardening3;
-mod hardening4;
-mod hostile_runs;
-mod leftovers;
 mod light_arms;
 mod live;
 mod liveness;
+mod log_integrity;
 mod log_replay;
 mod many_joints;
 mod mjcf_arms;
+mod outputs;
 mod policy_onnx;
+mod process_tree;
 mod python;
 mod python_in_process;
 mod realtime_integrity;
@@ -33,4 +31,5 @@ mod slurm;
 mod sweep;
 mod trajectories;
 mod util;
+mod verdicts;
 mod workflow;

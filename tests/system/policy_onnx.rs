@@ -19,7 +19,7 @@ fn python() -> &'static str {
 fn node(policy: &Path) -> String {
     format!(
         "{} {}",
-        env!("CARGO_BIN_EXE_testbed-policy"),
+        crate::util::bin("testbed-policy").display(),
         policy.display()
     )
 }

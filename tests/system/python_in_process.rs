@@ -19,7 +19,7 @@ fn python() -> &'static str {
 fn python_in_process_module_passes_its_tests() {
     let out = Command::new(python())
         .args(["-m", "unittest", "discover", "-v", "-s", "tests"])
-        .env("TESTBED_BIN", env!("CARGO_BIN_EXE_testbed"))
+        .env("TESTBED_BIN", crate::util::bin("testbed"))
         .current_dir(repo_root().join("python/inprocess"))
         .output()
         .unwrap();

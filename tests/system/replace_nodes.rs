@@ -86,7 +86,7 @@ fn an_example_controller_replaces_the_controller_node() {
         .collect::<Vec<_>>(),
         "controller",
     );
-    let mut pd = Command::new(env!("CARGO_BIN_EXE_example-pd-controller"))
+    let mut pd = Command::new(crate::util::bin("example-pd-controller"))
         .args(&argv)
         .spawn()
         .unwrap();
@@ -210,7 +210,7 @@ fn the_rust_template_declares_its_law_and_parameters() {
     let out = crate::util::ok(
         crate::util::testbed()
             .args(["run", "--mode", "lockstep", "--json", "--controller-cmd"])
-            .arg(env!("CARGO_BIN_EXE_example-pd-controller"))
+            .arg(crate::util::bin("example-pd-controller"))
             .arg("--scenario")
             .arg(&s)
             .arg("--runs-dir")

@@ -451,7 +451,8 @@ fn refused_realtime_scheduling_is_said_and_the_run_goes_on() {
     if is_root() {
         cmd.args(["--bounding-set", "-sys_nice"]);
     }
-    cmd.args(["--inh-caps", "-sys_nice", env!("CARGO_BIN_EXE_testbed")])
+    cmd.args(["--inh-caps", "-sys_nice"])
+        .arg(crate::util::bin("testbed"))
         .args(["run", "--duration", "0.5", "--json", "--runs-dir"])
         .arg(dir.path())
         .current_dir(crate::util::repo_root());

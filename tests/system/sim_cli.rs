@@ -244,9 +244,9 @@ fn the_docs_generated_numbers_are_current() {
     let out = std::process::Command::new("python3")
         .arg("docs/regenerate.py")
         .args(["--check", "--skip", "robustness.md", "--skip", "tuned.md"])
-        .env("TESTBED", env!("CARGO_BIN_EXE_testbed"))
+        .env("TESTBED", crate::util::bin("testbed"))
         // learnt.md runs the shipped ONNX policy as a compare row.
-        .env("TESTBED_POLICY", env!("CARGO_BIN_EXE_testbed-policy"))
+        .env("TESTBED_POLICY", crate::util::bin("testbed-policy"))
         .current_dir(crate::util::repo_root())
         .output()
         .unwrap();

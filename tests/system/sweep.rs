@@ -166,7 +166,7 @@ fn a_diverging_run_is_recorded_and_the_sweep_goes_on() {
     assert!(text.contains("\"status\":\"diverged\""), "{text}");
     let csv = dir.path().join("r.csv");
     let figs = dir.path().join("fig");
-    Command::new(env!("CARGO_BIN_EXE_testbed"))
+    Command::new(crate::util::bin("testbed"))
         .args(["sweep", "report"])
         .arg(&out)
         .arg("--csv")

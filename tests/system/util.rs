@@ -3,9 +3,29 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// A binary of the workspace (`testbed`, `testbed-policy`,
+/// `example-pd-controller`), each its own package's: cargo builds them into
+/// the folder above this test's own (target/<profile>/deps/system-…) when
+/// the suite runs as `cargo nextest run --workspace` (each package has a
+/// test of its own, which is what makes cargo build its binary).
+pub fn bin(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("the test binary's own path");
+    let dir = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("a test binary lives in target/<profile>/deps");
+    let path = dir.join(name);
+    assert!(
+        path.is_file(),
+        "{} is not built: run the suite as `cargo nextest run --workspace` (or `cargo build --bin {name}` first)",
+        path.display()
+    );
+    path
+}
+
 /// The built `testbed` binary.
 pub fn testbed() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_testbed"));
+    let mut c = Command::new(bin("testbed"));
     c.current_dir(repo_root());
     c
 }
@@ -252,7 +272,7 @@ pub fn run_with_controller_script(dir: &Path, before: &str) -> (std::process::Ex
         &script,
         format!(
             "#!/bin/sh\n{before}\nexec {} \"$@\"\n",
-            env!("CARGO_BIN_EXE_example-pd-controller")
+            crate::util::bin("example-pd-controller").display()
         ),
     )
     .unwrap();

@@ -12,9 +12,9 @@ use std::time::Instant;
 
 use scenario::Plan;
 
-use launcher::mode::Mode;
-use launcher::run::{self};
-use launcher::sim::{self, StepCosts};
+use run_stack::mode::Mode;
+use run_stack::run::{self};
+use run_stack::sim::{self, StepCosts};
 
 pub mod controller;
 pub mod parts;

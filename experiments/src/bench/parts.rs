@@ -7,9 +7,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use analysis::timing::{Percentiles, TimingStats};
 use bus::clock;
-use launcher::mode::Mode;
-use launcher::node::placement::{self, Placement};
-use launcher::run::{self, RunOptions};
+use run_stack::mode::Mode;
+use run_stack::node::placement::{self, Placement};
+use run_stack::run::{self, RunOptions};
 use scenario::{Overrides, Plan};
 use wire::NodeKind;
 

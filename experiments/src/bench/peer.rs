@@ -13,8 +13,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::bench::parts::{load, stack};
 use crate::bench::types::{BenchError, BenchOptions, Machine, machine, median};
-use launcher::mode::Mode;
-use launcher::node::configs;
+use run_stack::mode::Mode;
+use run_stack::node::configs;
 
 /// MuJoCo substeps per control period (RK4): the loop a user would write.
 pub const PEER_SUBSTEPS: u32 = 4;

@@ -19,8 +19,8 @@ use bus::{Bus, RunPrefix};
 use wire::{Command, Delivery, JointState, STATE_FINAL};
 
 use crate::bench::types::{BenchError, PingPong};
-use launcher::mode::Mode;
-use launcher::node::placement::{self, Placement};
+use run_stack::mode::Mode;
+use run_stack::node::placement::{self, Placement};
 use wire::NodeKind;
 
 /// The hidden subcommand the other process runs.

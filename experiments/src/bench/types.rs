@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use analysis::timing::Percentiles;
-use launcher::node::placement;
-use launcher::run::RunError;
-use launcher::sim;
+use run_stack::node::placement;
+use run_stack::run::RunError;
+use run_stack::sim;
 use serde::Serialize;
 
 /// What to measure.

@@ -27,7 +27,7 @@ pub(crate) fn external_row(
     for s in 0..opts.seeds {
         let p = plan_for(plan, law, s, opts.tuning, &opts.law_sets)?;
         let seed = p.scenario.seed;
-        let run = launcher::run::run(launcher::run::RunOptions {
+        let run = run_stack::run::run(run_stack::run::RunOptions {
             plan: p,
             mode: wire::Mode::Lockstep,
             csv: None,

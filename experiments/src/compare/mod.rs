@@ -2,7 +2,7 @@
 //! on every core, scored on BASELINES.md's metrics.
 //!
 //! Each run is exactly `testbed sim --law L` with the scenario's seed + s:
-//! the same plan ([`plan_for`]), the same loop ([`launcher::sim`]), the same
+//! the same plan ([`plan_for`]), the same loop ([`run_stack::sim`]), the same
 //! summary, so a row can be checked against a single run bit for bit.
 
 use analysis::law_info::LawInfo;

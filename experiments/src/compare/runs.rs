@@ -3,7 +3,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use analysis::summary::SummaryBuilder;
-use launcher::sim::{self, StepCosts};
+use run_stack::sim::{self, StepCosts};
 use scenario::Plan;
 
 use crate::compare::scores::scored;

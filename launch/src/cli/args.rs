@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::NodeName;
-use launcher::mode::Mode;
+use run_stack::mode::Mode;
 
 #[derive(Debug, Args)]
 pub(crate) struct ScenarioArgs {
@@ -52,7 +52,7 @@ pub(crate) struct RunArgs {
     #[command(flatten)]
     pub(crate) common: ScenarioArgs,
     /// Timing mode: realtime or lockstep.
-    #[arg(long, value_parser = launcher::mode::parse, default_value = "realtime")]
+    #[arg(long, value_parser = run_stack::mode::parse, default_value = "realtime")]
     pub(crate) mode: Mode,
     /// Control rate in Hz instead of the scenario's rate_hz.
     #[arg(long, value_name = "HZ")]
@@ -116,7 +116,7 @@ fn parse_external_law(s: &str) -> Result<(String, String), String> {
     let (name, cmd) = s
         .split_once('=')
         .ok_or_else(|| format!("{s:?} is not NAME=CMD (e.g. pid=\"python3 my.py\")"))?;
-    if !launcher::run::external::is_law_name(name) {
+    if !run_stack::run::external::is_law_name(name) {
         return Err(format!(
             "{name:?} is not a row name (1 to 40 of a-z, 0-9, '-', '_')"
         ));
@@ -125,9 +125,9 @@ fn parse_external_law(s: &str) -> Result<(String, String), String> {
 }
 
 /// A run folder's name: one path component of printable characters
-/// (`launcher::run::run_name_problem`).
+/// (`run_stack::run::run_name_problem`).
 fn parse_run_name(s: &str) -> Result<String, String> {
-    match launcher::run::run_name_problem(s) {
+    match run_stack::run::run_name_problem(s) {
         None => Ok(s.to_string()),
         Some(why) => {
             let shown: String = s.chars().take(40).collect();

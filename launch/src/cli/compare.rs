@@ -81,7 +81,7 @@ pub(crate) fn compare(args: CompareArgs) -> Result<ExitCode> {
             );
         }
         let command = super::args::command_words(cmd)?;
-        launcher::run::spawn::check_program(&command)
+        run_stack::run::spawn::check_program(&command)
             .with_context(|| format!("--controller-cmd {label}={cmd}"))?;
         external.push(compare::ExternalSpec {
             label: label.clone(),

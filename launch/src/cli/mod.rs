@@ -18,7 +18,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 
-use launcher::node::{self, NodeArgs};
+use run_stack::node::{self, NodeArgs};
 use scenario::Overrides;
 use wire::NodeKind;
 
@@ -90,7 +90,7 @@ enum Command {
         prefix: String,
         /// Where to run (as lockstep's controller).
         #[command(flatten)]
-        placement: launcher::node::placement::Placement,
+        placement: run_stack::node::placement::Placement,
     },
     /// Analyse a run's log: the same summary as `run`, CSV, figures, verification.
     ///
@@ -120,7 +120,11 @@ enum Command {
     Tune(TuneArgs),
     /// List the shipped scenarios and what each one demonstrates (on
     /// standard output).
-    Scenarios,
+    Scenarios {
+        /// One JSON array instead: each scenario's name, file and text.
+        #[arg(long)]
+        json: bool,
+    },
     /// Write the wire contract for another language, generated from the
     /// Rust types (today: Python ctypes structures for the package in python/).
     Bindings {
@@ -238,8 +242,13 @@ pub fn run() -> Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Command::Scenarios => {
-            write_stdout(&scenarios::scenario_list())?;
+        Command::Scenarios { json } => {
+            let text = if json {
+                scenarios::scenario_json()?
+            } else {
+                scenarios::scenario_list()
+            };
+            write_stdout(&text)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Robot {
@@ -319,7 +328,7 @@ pub(crate) fn print_report(report: &Report, json: bool) -> Result<()> {
 /// (more only queue; twenty thousand once kept a run from ending for over
 /// a minute), said on stderr when the request is cut.
 pub(crate) fn worker_threads(requested: Option<usize>) -> Option<usize> {
-    let cpus = launcher::node::placement::cpu_count();
+    let cpus = run_stack::node::placement::cpu_count();
     let cap = 4 * cpus;
     match requested {
         Some(n) if n > cap => {

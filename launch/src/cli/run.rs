@@ -4,7 +4,7 @@ use std::io::IsTerminal;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
-use launcher::run::{self, RunError, RunOptions};
+use run_stack::run::{self, RunError, RunOptions};
 
 use super::args::RunArgs;
 use super::{EXIT_INTERRUPTED, load, print_report};

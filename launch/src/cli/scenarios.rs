@@ -21,3 +21,19 @@ pub(crate) fn scenario_list() -> String {
     out.push_str("Run one with `testbed sim --scenario NAME` or `testbed run --scenario NAME`.\n");
     out
 }
+
+/// The same list as JSON, for scripts (docs/regenerate.py takes its
+/// scenario rows from it): `[{"name", "path", "about"}, …]`.
+pub(crate) fn scenario_json() -> anyhow::Result<String> {
+    let list: Vec<serde_json::Value> = scenario::SHIPPED
+        .iter()
+        .map(|s| {
+            serde_json::json!({
+                "name": s.name,
+                "path": s.path().display().to_string(),
+                "about": s.about(),
+            })
+        })
+        .collect();
+    Ok(serde_json::to_string_pretty(&list)? + "\n")
+}

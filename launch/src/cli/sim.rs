@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use analysis::{csv_out, summary::SummaryBuilder};
 use anyhow::{Context, Result};
-use launcher::sim as in_process;
+use run_stack::sim as in_process;
 
 use super::args::SimArgs;
 use super::{load, print_report};

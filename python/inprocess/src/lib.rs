@@ -5,7 +5,7 @@
 //! environment's core, one arm or many stepped in one call.
 //!
 //! Where it sits: beside the `testbed` binary, on the same libraries:
-//! `sim` is [`launcher::sim`], the environment is the `gym-env` crate, so
+//! `sim` is [`run_stack::sim`], the environment is the `gym-env` crate, so
 //! a run from Python has the same bits; this crate only converts. No I/O, no
 //! IPC; nothing here may panic across the boundary: every error becomes a
 //! Python exception that names its cause.

@@ -116,10 +116,10 @@ pub fn sim<'py>(
                 plan.scenario.controller.tc,
             )
             .with_gravity(&plan.robot.model);
-            let mut costs = launcher::sim::StepCosts::default();
+            let mut costs = run_stack::sim::StepCosts::default();
             let start = Instant::now();
             let mut looked = start;
-            launcher::sim::run_measured(&plan, Some(&mut costs), |r| {
+            run_stack::sim::run_measured(&plan, Some(&mut costs), |r| {
                 // Ctrl-C reaches Python only between steps: look every
                 // SIGNAL_POLL of wall time. (Every 4096 steps was over a
                 // minute where a stiff plant made a step 15 ms.)
@@ -207,7 +207,7 @@ fn compare_in(
         )));
     }
     // More threads than four per CPU only queue (the CLI's cap too).
-    let cap = 4 * launcher::node::placement::cpu_count();
+    let cap = 4 * run_stack::node::placement::cpu_count();
     let threads = threads.map(|t| t.min(cap));
     let opts = CompareOptions {
         law_sets,

@@ -21,8 +21,8 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use bus::{NodeLink, RunPrefix, read_config};
 use controller::node::{ControllerNodeConfig, ServeError, serve};
-use launcher::node::placement::Placement;
 use policy::{Policy, PolicyLaw, check_run};
+use run_stack::node::placement::Placement;
 use wire::{Mode, NodeKind};
 
 /// The law's name in the log, the summary and `replay`.
