@@ -18,6 +18,7 @@ pub mod law_info;
 pub mod own;
 pub mod percentiles;
 mod plot_error;
+pub mod plot_style;
 pub mod plots;
 pub mod record;
 pub mod report;
