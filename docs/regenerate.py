@@ -171,7 +171,8 @@ def compare_page() -> str:
         "difference between laws (`actuation_delay` even has a random effect, its dropped",
         "commands: one draw of it; see [findings.md](findings.md) and",
         "[robustness.md](robustness.md) for tests over seeds). Sums over joints,",
-        "after T_c unless marked. Per scenario two tables: the laws' textbook",
+        "after T_c unless marked; Sm(τ) is the torque's spectral smoothness over the whole run",
+        "([baselines.md §5](../baselines.md#5-metrics-every-law-is-scored-on)). Per scenario two tables: the laws' textbook",
         "gains (`as-given`) and the matching rule of",
         "[baselines.md §6](../baselines.md#6-the-matching-rule) (`--tuning matched`:",
         "every law with `pd`'s error dynamics; it changes `ctc`, `cbf-ctc`, `mpc` and `ppc`).",
@@ -188,8 +189,8 @@ def compare_page() -> str:
 
 def compare_table(c: dict) -> list[str]:
     lines = [
-        "| law | envelope | IAE | max \\|e\\| | violation (whole run) | effort after T_c | beyond gravity | ∫τ̇² | breaches | actor peak \\|τ\\| | failed |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| law | envelope | IAE | max \\|e\\| | violation (whole run) | effort after T_c | beyond gravity | ∫τ̇² | Sm(τ) | breaches | actor peak \\|τ\\| | failed |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for law in c["laws"]:
         name_ = law["law"]["law"] + (" (URDF)" if law["law"]["model_based"] else "")
@@ -200,13 +201,13 @@ def compare_table(c: dict) -> list[str]:
         failed = f"**failed**: {why}" if why else "no"
         if why:
             # A failed run's metrics count as the worst: shown as such.
-            lines.append(f"| {name_} | {kept} | – | – | – | – | – | – | – | – | {failed} |")
+            lines.append(f"| {name_} | {kept} | – | – | – | – | – | – | – | – | – | {failed} |")
             continue
         lines.append(
             f"| {name_} | {kept} | {g(m['iae'])} | {g(m['max_abs_error'], 3)} | "
             f"{g(m['violation_s'], 3)} s | {g(m['effort_after_tc'])} | "
             f"{g(m['effort_beyond_gravity'])} | {g(m['torque_rate'], 3)} | "
-            f"{int(m['breaches'])} | {g(m['peak_actor_torque'], 3)} | {failed} |"
+            f"{g(m['torque_smoothness'], 3)} | {int(m['breaches'])} | {g(m['peak_actor_torque'], 3)} | {failed} |"
         )
     return lines
 

@@ -22,6 +22,7 @@ pub mod plot_style;
 pub mod plots;
 pub mod record;
 pub mod report;
+pub mod smoothness;
 pub mod stats;
 pub mod summary;
 pub mod timing;

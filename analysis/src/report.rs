@@ -403,13 +403,14 @@ fn metric_lines(out: &mut String, m: &ArmMetrics, compute: &Percentiles) {
     );
     let _ = writeln!(
         out,
-        "effort: int tau^2 {:.3} ({:.3} after T_c{}), torque rate int dtau^2 {:.1}, peak |tau| {:.2}, \
-         saturated {:.3} s; breaches {}",
+        "effort: int tau^2 {:.3} ({:.3} after T_c{}), torque rate int dtau^2 {:.1}, spectral \
+         smoothness {}, peak |tau| {:.2}, saturated {:.3} s; breaches {}",
         m.effort,
         m.effort_after_tc,
         m.effort_beyond_gravity_after_tc
             .map_or_else(String::new, |e| format!("; {e:.3} beyond the gravity hold")),
         m.torque_rate,
+        opt(m.torque_smoothness, 4),
         m.peak_abs_torque,
         m.saturated_s,
         m.breaches

@@ -8,6 +8,7 @@ use serde::Serialize;
 use wire::Effects;
 
 use crate::record::StepRecord;
+use crate::smoothness::SmoothnessBuilder;
 
 /// Per-joint results.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -46,6 +47,10 @@ pub struct JointSummary {
     /// Torque rate ∫τ̇² dt with τ̇ the change between steps over Δt (the
     /// first step's rise from rest excluded), N² m² / s.
     pub torque_rate_integral: f64,
+    /// CAPS's spectral smoothness of τ over the run, the amplitude-weighted
+    /// mean frequency 2/(n f_s) Σ M_i f_i ([`crate::smoothness`]), N m;
+    /// lower is smoother (None: no step).
+    pub torque_smoothness: Option<f64>,
 }
 
 /// The whole run.
@@ -115,6 +120,8 @@ pub struct ArmMetrics {
     pub energy_after_tc: f64,
     /// Σ ∫τ̇² dt.
     pub torque_rate: f64,
+    /// Σ over joints of the torque's spectral smoothness (CAPS's Sm), N m.
+    pub torque_smoothness: Option<f64>,
     /// max |τ| over joints and steps.
     pub peak_abs_torque: f64,
     /// Time with some torque clipped at its effort limit, s.
@@ -167,6 +174,7 @@ pub struct SummaryBuilder {
     any_violation_after: f64,
     prev_tau: Option<Vec<f64>>,
     torque_rate: Vec<f64>,
+    smoothness: SmoothnessBuilder,
     peak_actor: f64,
     actor_effort: f64,
     energy_after: f64,
@@ -212,6 +220,7 @@ impl SummaryBuilder {
             any_violation_after: 0.0,
             prev_tau: None,
             torque_rate: vec![0.0; n],
+            smoothness: SmoothnessBuilder::new(n, dt),
             peak_actor: 0.0,
             actor_effort: 0.0,
             energy_after: 0.0,
@@ -262,6 +271,7 @@ impl SummaryBuilder {
         let after = r.t >= self.tc;
         self.after_tc += u64::from(after);
         self.add_baseline_metrics(r, after);
+        self.smoothness.add(&r.tau[..self.names.len()]);
         if let (true, Some(d)) = (after, self.gravity.as_mut()) {
             let g = d.gravity(r.q);
             self.effort_beyond_gravity += r
@@ -341,6 +351,7 @@ impl SummaryBuilder {
     pub fn finish(&self) -> Summary {
         let any_after = self.after_tc > 0;
         let when = |v: f64| any_after.then_some(v);
+        let smoothness = self.smoothness.finish();
         let joints: Vec<JointSummary> = (0..self.names.len())
             .map(|i| JointSummary {
                 name: self.names[i].clone(),
@@ -359,6 +370,7 @@ impl SummaryBuilder {
                 violation_s: self.violation[i],
                 violation_after_tc_s: self.violation_after[i],
                 torque_rate_integral: self.torque_rate[i],
+                torque_smoothness: smoothness[i],
             })
             .collect();
         let metrics = self.arm_metrics(&joints, any_after);
@@ -418,6 +430,10 @@ impl SummaryBuilder {
                 .map(|_| self.effort_beyond_gravity),
             energy_after_tc: self.energy_after,
             torque_rate: sum(|j| j.torque_rate_integral),
+            torque_smoothness: joints
+                .iter()
+                .map(|j| j.torque_smoothness)
+                .sum::<Option<f64>>(),
             peak_abs_torque: joints.iter().map(|j| j.max_abs_torque).fold(0.0, nan_max),
             saturated_s: self.saturated as f64 * self.dt,
             breaches: self.breached,

@@ -9,13 +9,15 @@ use scenario::stepper::Stepper;
 
 use crate::options::{self, ActionMode, ERROR_CAP, EnvError, EnvOptions};
 use crate::render::{Picture, Projection};
+use crate::smoothing::ActionShaper;
 
 /// What a step returns besides the observation.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Outcome {
     /// The mean over the step's plant periods of −mean_i min((e_i/k_c,i)²,
-    /// [`ERROR_CAP`]) − effort_weight · mean_i a_i², e the true error after
-    /// the period; an early end (a breach outside safe mode, or a state
+    /// [`ERROR_CAP`]) − effort_weight · mean_i a_i² − action_rate_weight ·
+    /// mean_i (a_i − a_i,prev)², e the true error after the period, a the
+    /// clipped actions of this step and the last; an early end (a breach outside safe mode, or a state
     /// that is not finite) adds the worst reward of every step it skips.
     pub reward: f64,
     /// 1 when, at or after T_c, a joint's error was at or past its
@@ -54,8 +56,12 @@ pub struct ArmEnv {
     base: Option<ControllerMachine>,
     /// The torque commanded in the last plant period.
     tau: Vec<f64>,
-    /// The action's torque, clip(a) · span · scale, held over a step.
+    /// The action's torque, clip(a) · span · scale, before smoothing.
     add: Vec<f64>,
+    /// Spreads `add` over the step's plant periods.
+    shaper: ActionShaper,
+    /// The last decision's clipped action (zero before the first).
+    last_action: Vec<f64>,
     /// The current episode's seed.
     seed: u64,
     picture: Option<Picture>,
@@ -72,6 +78,7 @@ impl ArmEnv {
         let velocity = options::velocity_scale(&plan);
         let seed = plan.scenario.seed;
         let (stepper, base) = episode(&plan, &opts)?;
+        let shaper = ActionShaper::new(opts.smoothing, opts.decimation, plan.dt(), n);
         Ok(Self {
             undrawn: plan.undrawn.clone(),
             plan,
@@ -83,6 +90,8 @@ impl ArmEnv {
             base,
             tau: vec![0.0; n],
             add: vec![0.0; n],
+            shaper,
+            last_action: vec![0.0; n],
             seed,
             picture: None,
         })
@@ -154,6 +163,8 @@ impl ArmEnv {
         self.plan = plan;
         self.seed = seed;
         self.tau.fill(0.0);
+        self.shaper.reset();
+        self.last_action.fill(0.0);
         self.observe(obs);
         Ok(())
     }
@@ -166,7 +177,7 @@ impl ArmEnv {
     /// Length of the observation: e, ė, q, q̇, q_d, q̇_d, k_c, t / T
     /// (errors and velocities scaled unless `scale_obs` is off).
     pub fn obs_dim(&self) -> usize {
-        obs_dim(self.n)
+        obs_dim_with(self.n, self.opts.observe_action)
     }
 
     /// Torque per unit of action, per joint.
@@ -227,7 +238,16 @@ impl ArmEnv {
             ActionMode::Residual(_) => self.opts.residual_scale,
         };
         let effort = crate::action_torque(action, span, &self.scale, &mut self.add);
-        let effort = self.opts.effort_weight * effort / self.n as f64;
+        self.shaper.decide(&self.add);
+        let mut rate = 0.0;
+        for (last, a) in self.last_action.iter_mut().zip(action) {
+            let a = a.clamp(-1.0, 1.0);
+            rate += (a - *last) * (a - *last);
+            *last = a;
+        }
+        // + 0.0 when the rate's weight is 0: the effort term keeps its bits.
+        let effort = self.opts.effort_weight * effort / self.n as f64
+            + self.opts.action_rate_weight * rate / self.n as f64;
         let (mut reward, mut periods, mut cost, mut breached) = (0.0, 0u32, 0.0, false);
         let mut finite = true;
         while periods < self.opts.decimation && self.stepper.k() < self.stepper.steps() {
@@ -235,9 +255,10 @@ impl ArmEnv {
                 Some(base) => self.stepper.command(base).0,
                 None => self.stepper.zero_command(),
             };
-            for i in 0..self.n {
+            let add = self.shaper.period_torque();
+            for (i, add) in add.iter().enumerate() {
                 // x + 0.0 is x: a zero residual leaves the law's torque's bits.
-                command.tau[i] += self.add[i];
+                command.tau[i] += add;
                 self.tau[i] = command.tau[i];
             }
             let stepped = self.stepper.advance(&command);
@@ -263,7 +284,7 @@ impl ArmEnv {
         // Every decision this early end skips is charged the worst reward
         // a step can have, so ending never pays more than staying.
         let skipped = self.decisions_left() as f64;
-        let worst = -(ERROR_CAP + self.opts.effort_weight);
+        let worst = -(ERROR_CAP + self.opts.effort_weight + 4.0 * self.opts.action_rate_weight);
         if !finite {
             return Outcome {
                 reward: worst * (1.0 + skipped),
@@ -327,6 +348,9 @@ impl ArmEnv {
             &self.velocity,
             obs,
         );
+        if self.opts.observe_action {
+            crate::observe_action(&self.last_action, obs);
+        }
     }
 
     /// A picture of the arm now (dark) over its reference pose (light), as
@@ -365,6 +389,12 @@ struct Judged {
 /// Length of the observation of an arm with `n` joints.
 pub fn obs_dim(n: usize) -> usize {
     7 * n + 1
+}
+
+/// Length of the observation of an arm with `n` joints, the last action
+/// included when `observe_action`.
+pub fn obs_dim_with(n: usize, observe_action: bool) -> usize {
+    obs_dim(n) + if observe_action { n } else { 0 }
 }
 
 /// The stepper and base law of an episode of `plan`, at its first state.

@@ -6,6 +6,8 @@ use arm_model::dynamics::Dynamics;
 use controller::LawName;
 use scenario::Plan;
 
+use crate::smoothing::Smoothing;
+
 /// Plant periods per decision by default: 20 periods of the paper's 1 kHz
 /// plant are a 50 Hz policy (at 1 kHz the default discount sees 0.1 s and
 /// the constraint starts 2 000 decisions in).
@@ -78,6 +80,16 @@ pub struct EnvOptions {
     /// Scale the observation: errors over k_c, velocities over the
     /// velocity scale (default: true; false gives the raw quantities).
     pub scale_obs: bool,
+    /// How a decision's torque is spread over its plant periods (default:
+    /// held, [`Smoothing::Hold`]).
+    pub smoothing: Smoothing,
+    /// Weight of the action-rate term mean_i (a_i − a_i,prev)² of the
+    /// reward, a the clipped actions of this decision and the last
+    /// (default: 0).
+    pub action_rate_weight: f64,
+    /// The last clipped action ends the observation (default: false): a
+    /// ramp or a low-pass makes the torque depend on it.
+    pub observe_action: bool,
 }
 
 impl Default for EnvOptions {
@@ -91,6 +103,9 @@ impl Default for EnvOptions {
             decimation: DEFAULT_DECIMATION,
             safe: false,
             scale_obs: true,
+            smoothing: Smoothing::Hold,
+            action_rate_weight: 0.0,
+            observe_action: false,
         }
     }
 }
@@ -176,6 +191,14 @@ impl EnvOptions {
             return Err(EnvError::option(
                 "effort_weight",
                 self.effort_weight,
+                "must be a number from 0 to 1e6",
+            ));
+        }
+        if !(self.action_rate_weight.is_finite() && (0.0..=1e6).contains(&self.action_rate_weight))
+        {
+            return Err(EnvError::option(
+                "action_rate_weight",
+                self.action_rate_weight,
                 "must be a number from 0 to 1e6",
             ));
         }

@@ -42,7 +42,15 @@ pub fn observe(
     obs[7 * n] = k as f64 / steps as f64;
 }
 
-/// The torque an action adds, held over a decision: clip(a_i, −1, 1) ·
+/// Writes the last clipped action after [`observe`]'s entries (the
+/// observation of [`crate::obs_dim_with`] with `observe_action`).
+pub fn observe_action(last: &[f64], obs: &mut [f64]) {
+    let at = 7 * last.len() + 1;
+    obs[at..at + last.len()].copy_from_slice(last);
+}
+
+/// The torque a decision's action adds (spread over its periods by an
+/// [`crate::ActionShaper`]): clip(a_i, −1, 1) ·
 /// `span` · `scale_i`, with `span` 1 when the action is the torque and the
 /// residual scale when it is added to a base law's. Returns Σ clip(a_i)²,
 /// the reward's effort term before its weight.

@@ -1,8 +1,8 @@
 //! The policy as a controller law: joint state and reference sample in,
 //! command and diagnostics out, acting as the Gymnasium environment does
 //! (a new action every `decimation` plant periods on the environment's
-//! observation, held in between, added to the base law's torque every
-//! period). No clock, no I/O: the node binary is the shell around it.
+//! observation, held, ramped or low-pass filtered in between as the
+//! record says, added to the base law's torque every period). No clock, no I/O: the node binary is the shell around it.
 
 use controller::node::ControllerNodeConfig;
 use controller::{ControllerError, ControllerMachine};
@@ -17,8 +17,12 @@ pub struct PolicyLaw {
     base: Option<ControllerMachine>,
     obs: Vec<f64>,
     action: Vec<f64>,
-    /// The action's torque, held between decisions.
-    held: Vec<f64>,
+    /// The decision's torque, before smoothing.
+    target: Vec<f64>,
+    /// The last decision's clipped action (zero before the first).
+    last_action: Vec<f64>,
+    /// Spreads `target` over the decision's periods, as the environment.
+    shaper: gym_env::ActionShaper,
 }
 
 impl PolicyLaw {
@@ -37,10 +41,14 @@ impl PolicyLaw {
                 Some(c.machine()?)
             }
         };
+        // Plan::dt's expression: the low-pass's factor to the bit.
+        let dt = config.period_ns as f64 / 1e9;
         Ok(Self {
             obs: vec![0.0; r.obs_dim],
             action: vec![0.0; r.dof],
-            held: vec![0.0; r.dof],
+            target: vec![0.0; r.dof],
+            last_action: vec![0.0; r.dof],
+            shaper: gym_env::ActionShaper::new(r.smoothing, r.decimation, dt, r.dof),
             base,
             policy,
         })
@@ -81,34 +89,42 @@ impl PolicyLaw {
                     &r.velocity_scale,
                     &mut self.obs,
                 );
+                if r.observe_action {
+                    gym_env::observe_action(&self.last_action, &mut self.obs);
+                }
                 match self.policy.act(&self.obs, &mut self.action) {
                     Ok(()) => {
                         gym_env::action_torque(
                             &self.action,
                             r.span(),
                             &r.torque_scale,
-                            &mut self.held,
+                            &mut self.target,
                         );
+                        self.shaper.decide(&self.target);
+                        for (last, a) in self.last_action.iter_mut().zip(&self.action) {
+                            *last = a.clamp(-1.0, 1.0);
+                        }
                     }
                     Err(e) => {
-                        self.held.fill(0.0);
+                        self.shaper.reset();
                         err = Some(e);
                     }
                 }
             }
+            let add = self.shaper.period_torque();
             if err.is_some() {
                 cmd.tau = [0.0; wire::MAX_DOF];
                 cmd.fault = wire::Fault::NonFiniteOutput.code();
             } else {
-                for i in 0..n {
-                    // The environment's order: the law's torque, then +=
-                    // the held action's (x + 0.0 is x).
-                    cmd.tau[i] += self.held[i];
+                // The environment's order: the law's torque, then += the
+                // action's (x + 0.0 is x).
+                for (t, a) in cmd.tau.iter_mut().zip(add) {
+                    *t += a;
                 }
             }
             diag.tau = cmd.tau;
             diag.fault = cmd.fault;
-            diag.tau_feedback = joints(&self.held);
+            diag.tau_feedback = joints(add);
         }
         (cmd, diag, err)
     }

@@ -37,6 +37,11 @@ pub struct EnvRecord {
     pub base_law: Option<controller::LawName>,
     /// The residual's span as a fraction of the torque scale (default 0.2).
     pub residual_scale: f64,
+    /// How a decision's torque is spread over its periods (default: held,
+    /// files from before smoothing).
+    pub smoothing: gym_env::Smoothing,
+    /// Whether the last action ends the observation (default: false).
+    pub observe_action: bool,
     /// The training scenario's control period, ns (None: not recorded).
     pub period_ns: Option<u64>,
     /// The training scenario's `[controller]` table (None: not recorded).
@@ -77,15 +82,40 @@ impl EnvRecord {
                 format!("{dof} joints; the testbed takes at most {}", wire::MAX_DOF),
             ));
         }
-        if obs_dim != gym_env::obs_dim(dof) {
+        let observe_action = match take("observe_action") {
+            None => false,
+            Some(Value::Bool(b)) => b,
+            Some(v) => return Err(bad("observe_action", format!("{v} is not true or false"))),
+        };
+        let want = gym_env::obs_dim_with(dof, observe_action);
+        if obs_dim != want {
+            let with = if observe_action {
+                ", its last action observed,"
+            } else {
+                ""
+            };
             return Err(bad(
                 "obs_dim",
-                format!(
-                    "{obs_dim}; an arm of {dof} joints has {}",
-                    gym_env::obs_dim(dof)
-                ),
+                format!("{obs_dim}; an arm of {dof} joints{with} has {want}"),
             ));
         }
+        let tau_s = match take("smoothing_tau_s") {
+            None | Some(Value::Null) => f64::NAN,
+            Some(v) => v
+                .as_f64()
+                .ok_or_else(|| bad("smoothing_tau_s", format!("{v} is not a number")))?,
+        };
+        let smoothing = match take("smoothing") {
+            None | Some(Value::Null) => gym_env::Smoothing::Hold,
+            Some(Value::String(name)) => gym_env::Smoothing::parse(&name, tau_s).map_err(|e| {
+                let field = match &e {
+                    gym_env::EnvError::Option { name, .. } => name.clone(),
+                    _ => "smoothing".into(),
+                };
+                bad(&field, e.to_string())
+            })?,
+            Some(v) => return Err(bad("smoothing", format!("{v} is not a smoothing's name"))),
+        };
         let numbers = |key: &str, v: Value, positive: bool| -> Result<Vec<f64>, PolicyError> {
             let need = if positive { "positive " } else { "finite " };
             let list = v
@@ -169,6 +199,8 @@ impl EnvRecord {
             velocity_scale,
             base_law,
             residual_scale,
+            smoothing,
+            observe_action,
             period_ns,
             controller,
             rest: map,
@@ -216,6 +248,22 @@ mod tests {
     }
 
     #[test]
+    fn a_smoothed_record_with_its_last_action_observed_is_read() {
+        let mut m: Map<String, Value> = serde_json::from_str(GOOD).unwrap();
+        for (k, v) in [
+            ("smoothing", r#""low-pass""#),
+            ("smoothing_tau_s", "0.05"),
+            ("observe_action", "true"),
+            ("obs_dim", "17"),
+        ] {
+            m.insert(k.into(), serde_json::from_str(v).unwrap());
+        }
+        let r = EnvRecord::parse(&Value::Object(m).to_string(), Path::new("p.onnx")).unwrap();
+        assert_eq!(r.smoothing, gym_env::Smoothing::LowPass { tau_s: 0.05 });
+        assert!(r.observe_action);
+    }
+
+    #[test]
     fn an_old_record_reads_as_1_khz_raw_torque() {
         let r = EnvRecord::parse(
             r#"{"dof": 1, "obs_dim": 8, "steps": 10, "torque_scale": [1.0]}"#,
@@ -223,6 +271,10 @@ mod tests {
         )
         .unwrap();
         assert_eq!((r.decimation, r.scale_obs, r.span()), (1, false, 1.0));
+        assert_eq!(
+            (r.smoothing, r.observe_action),
+            (gym_env::Smoothing::Hold, false)
+        );
     }
 
     #[test]
@@ -249,6 +301,12 @@ mod tests {
         assert_eq!(field_of(&with("decimation", "4294967295")), "decimation");
         assert_eq!(field_of(&with("decimation", "4001")), "decimation");
         assert_eq!(field_of(&with("scale_obs", "1")), "scale_obs");
+        assert_eq!(field_of(&with("smoothing", "\"spline\"")), "smoothing");
+        assert_eq!(
+            field_of(&with("smoothing", "\"low-pass\"")),
+            "smoothing_tau_s"
+        );
+        assert_eq!(field_of(&with("observe_action", "true")), "obs_dim");
         assert_eq!(field_of(r#"{"obs_dim": 8}"#), "dof");
         assert_eq!(field_of("[1]"), "");
     }

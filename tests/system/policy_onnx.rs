@@ -36,7 +36,7 @@ fn fixture() -> std::path::PathBuf {
 const EPISODE: &str = "
 import json, sys, gymnasium, numpy as np, testbed
 from testbed.policy import LinearPolicy, env_record
-kw = dict(scenario='paper', episode_s=0.5, base_law='pd')
+kw = dict(scenario='paper', episode_s=0.5, base_law='pd', **json.loads(sys.argv[3]))
 env = gymnasium.make(testbed.ENV_ID, **kw)
 core = env.unwrapped.core
 rng = np.random.default_rng(7)
@@ -53,15 +53,17 @@ for _ in range(core.decisions):
 json.dump({'q': qs, 'decimation': core.decimation, 'actions': actions}, open(sys.argv[2], 'w'))
 ";
 
-#[test]
-fn onnx_policy_in_lockstep_is_the_env_episode_and_a_row_of_compare() {
-    let dir = tempfile::tempdir().unwrap();
-    let policy = dir.path().join("policy.onnx");
-    let episode = dir.path().join("episode.json");
+/// Exports EPISODE's policy with the env options `kw` (JSON) to `dir`,
+/// runs it in lockstep, and checks the run's q after each decision is its
+/// env episode's; returns the policy file.
+fn lockstep_is_the_env_episode(dir: &Path, kw: &str) -> std::path::PathBuf {
+    let policy = dir.join("policy.onnx");
+    let episode = dir.join("episode.json");
     let out = Command::new(python())
         .args(["-c", EPISODE])
         .arg(&policy)
         .arg(&episode)
+        .arg(kw)
         .output()
         .unwrap();
     assert!(
@@ -71,11 +73,11 @@ fn onnx_policy_in_lockstep_is_the_env_episode_and_a_row_of_compare() {
     );
     let env: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&episode).unwrap()).unwrap();
-    let csv = dir.path().join("run.csv");
+    let csv = dir.join("run.csv");
     let out = testbed()
         .args(["run", "--mode", "lockstep", "--duration", "0.5", "--json"])
         .arg("--runs-dir")
-        .arg(dir.path())
+        .arg(dir)
         .arg("--csv")
         .arg(&csv)
         .args(["--controller-cmd", &node(&policy)])
@@ -126,8 +128,15 @@ fn onnx_policy_in_lockstep_is_the_env_episode_and_a_row_of_compare() {
         "q differs by up to {worst:e} ({differing} values not bit for bit)"
     );
     eprintln!(
-        "lockstep against the env: {differing} values differ in their bits, max |Δq| {worst:e}"
+        "lockstep against the env ({kw}): {differing} values differ in their bits, max |Δq| {worst:e}"
     );
+    policy
+}
+
+#[test]
+fn onnx_policy_in_lockstep_is_the_env_episode_and_a_row_of_compare() {
+    let dir = tempfile::tempdir().unwrap();
+    let policy = lockstep_is_the_env_episode(dir.path(), "{}");
 
     let out = testbed()
         .args(["compare", "--scenario", "paper", "--duration", "0.5"])
@@ -155,6 +164,24 @@ fn onnx_policy_in_lockstep_is_the_env_episode_and_a_row_of_compare() {
     let run = &row["runs"][0];
     assert_eq!(run["summary"]["steps"], 500, "{run}");
     assert!(run["summary"]["finite"].as_bool().unwrap(), "{run}");
+}
+
+/// #59 item 1: the node ramps the torque and observes the last action as
+/// the environment does (the smoothing's own bits are pinned in-process
+/// by policy/tests/smoothing.rs; here numpy and tract may sum W·obs in
+/// another order).
+#[test]
+fn a_ramped_policy_observing_its_last_action_in_lockstep_is_the_env_episode() {
+    let dir = tempfile::tempdir().unwrap();
+    lockstep_is_the_env_episode(
+        dir.path(),
+        r#"{"smoothing": "ramp", "observe_action": true, "action_rate_weight": 0.1}"#,
+    );
+    let dir = tempfile::tempdir().unwrap();
+    lockstep_is_the_env_episode(
+        dir.path(),
+        r#"{"smoothing": "low-pass", "smoothing_tau_s": 0.005}"#,
+    );
 }
 
 #[test]

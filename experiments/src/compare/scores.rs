@@ -71,6 +71,9 @@ pub const METRICS: &[Metric] = &[
     m("torque_rate", "N² m²/s", true, |r| {
         Some(r.summary.metrics.torque_rate)
     }),
+    m("torque_smoothness", "N m", true, |r| {
+        r.summary.metrics.torque_smoothness
+    }),
     m("peak_torque", "N m", true, |r| {
         Some(r.summary.metrics.peak_abs_torque)
     }),

@@ -219,7 +219,7 @@ fn tradeoff(args: &CompareArgs, plan: &scenario::Plan, opts: &CompareOptions) ->
 }
 
 /// Columns of the table: (metric, heading, decimals).
-const COLUMNS: [(&str, &str, usize); 14] = [
+const COLUMNS: [(&str, &str, usize); 15] = [
     ("iae", "IAE", 4),
     ("ise", "ISE", 6),
     ("itae", "ITAE", 3),
@@ -230,6 +230,7 @@ const COLUMNS: [(&str, &str, usize); 14] = [
     ("effort_after_tc", "eff>Tc", 1),
     ("effort_beyond_gravity", "eff-G>Tc", 1),
     ("torque_rate", "int dtau^2", 0),
+    ("torque_smoothness", "Sm tau", 3),
     ("saturated_s", "sat[s]", 3),
     ("breaches", "breach", 0),
     ("peak_actor_torque", "actor|tau|", 4),

@@ -32,9 +32,11 @@ RENDER_MODES = ["rgb_array"]
 RENDER_SIZE = 480
 
 
-def observation_names(dof: int) -> list:
-    """The observation's entries by name: e0, e1, …, kc{n-1}, time_fraction."""
-    return [f"{p}{i}" for p in OBSERVATION for i in range(dof)] + ["time_fraction"]
+def observation_names(dof: int, observe_action: bool = False) -> list:
+    """The observation's entries by name: e0, e1, …, kc{n-1}, time_fraction,
+    then a0, …, a{n-1} (the last action) with `observe_action`."""
+    names = [f"{p}{i}" for p in OBSERVATION for i in range(dof)] + ["time_fraction"]
+    return names + ([f"a{i}" for i in range(dof)] if observe_action else [])
 
 
 def _spaces(core):
@@ -103,18 +105,23 @@ class ArmTrackingEnv(gymnasium.Env):
     `base_law` (None: the action is the torque; a law's name: a residual on
     it), `residual_scale` (0.2), `torque_scale` (default derived from the
     arm), `effort_weight` (0.01), `breach_factor` (2; None: never end
-    early), `safe` (False), `scale_obs` (True), `render_mode` (None or
-    "rgb_array").
+    early), `safe` (False), `scale_obs` (True), `smoothing` ("hold";
+    "ramp" or "low-pass"), `smoothing_tau_s` (0.02, the low-pass's),
+    `action_rate_weight` (0), `observe_action` (False), `render_mode` (None
+    or "rgb_array").
 
     - action: n numbers in [-1, 1] (clipped), float32; τ_i = a_i · scale_i,
-      or τ = τ_law + a_i · residual_scale · scale_i, held `decimation`
-      plant periods.
+      or τ = τ_law + a_i · residual_scale · scale_i, over `decimation`
+      plant periods: held, ramped from the last decision's torque, or
+      low-pass filtered (`smoothing`).
     - observation: float64, 7n + 1 numbers: e/k_c, ė/v, q, q̇/v, q_d,
       q̇_d/v, k_c, t / T, v the velocity scale (`scale_obs=False`: e, ė, q,
-      q̇, q_d, q̇_d, k_c, t / T unscaled; `observation_names`).
+      q̇, q_d, q̇_d, k_c, t / T unscaled; `observation_names`), then the
+      last clipped action with `observe_action` (8n + 1).
     - reward: the mean over the held periods of −mean_i min((e_i/k_c,i)²,
-      100) − effort_weight · mean_i a_i²; an early end adds the worst reward
-      (−100 − effort_weight) for every decision it skips.
+      100) − effort_weight · mean_i a_i² − action_rate_weight · mean_i
+      (a_i − a_i,prev)²; an early end adds the worst reward (−100 −
+      effort_weight − 4 · action_rate_weight) for every decision it skips.
     - info["cost"]: 1.0 when, at or after T_c, some |e_i| ≥ k_c,i after a
       held period; else 0.
     - terminated: the state is not finite, or (not safe) some |e_i| >

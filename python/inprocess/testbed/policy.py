@@ -82,8 +82,21 @@ class LinearPolicy:
         dof, obs_dim, steps = env["dof"], env["obs_dim"], env["steps"]
         if not all(isinstance(x, int) and x >= 1 for x in (dof, obs_dim, steps)):
             raise ValueError(f"{where}: env.dof, env.obs_dim and env.steps must be integers ≥ 1")
-        if obs_dim != 7 * dof + 1:
-            raise ValueError(f"{where}: env.obs_dim = {obs_dim}; an arm of {dof} joints has {7 * dof + 1}")
+        observe_action = env.get("observe_action", False)
+        if not isinstance(observe_action, bool):
+            raise ValueError(f"{where}: env.observe_action must be true or false")
+        want = 7 * dof + 1 + (dof if observe_action else 0)
+        if obs_dim != want:
+            with_action = ", its last action observed," if observe_action else ""
+            raise ValueError(f"{where}: env.obs_dim = {obs_dim}; an arm of {dof} joints{with_action} has {want}")
+        smoothing = env.get("smoothing", "hold")
+        if smoothing not in ("hold", "ramp", "low-pass"):
+            raise ValueError(f"{where}: env.smoothing = {smoothing!r}; it must be hold, ramp or low-pass")
+        tau = env.get("smoothing_tau_s")
+        if smoothing == "low-pass" and not (isinstance(tau, (int, float)) and not isinstance(tau, bool)
+                                            and 0 < tau <= 1e3):
+            raise ValueError(f"{where}: env.smoothing_tau_s = {tau!r}; a low-pass needs a time constant "
+                             "in seconds above 0 and at most 1000")
         scale = np.asarray(env["torque_scale"])
         if scale.shape != (dof,) or not np.issubdtype(scale.dtype, np.number):
             raise ValueError(f"{where}: env.torque_scale must be {dof} numbers")
@@ -220,6 +233,8 @@ def env_record(env) -> dict:
     record = {"dof": core.dof, "obs_dim": core.obs_dim, "steps": core.steps,
               "torque_scale": core.torque_scale.tolist(), "decimation": core.decimation,
               "scale_obs": core.scale_obs, "velocity_scale": core.velocity_scale.tolist(),
+              "smoothing": core.smoothing, "smoothing_tau_s": core.smoothing_tau_s,
+              "observe_action": core.observe_action,
               # What `policy_node` checks against the run it is put in.
               "period_ns": round(core.plant_dt * 1e9)}
     if tomllib is not None:

@@ -280,6 +280,48 @@ class RlReady(unittest.TestCase):
         _, term, _ = rollout(plain, 0, lambda o: np.ones(2))
         self.assertTrue(term, "outside safe mode the same breach ends the episode")
 
+    def test_smoothing_observing_the_action_and_its_rate_in_the_reward(self):
+        """#59 item 1: a ramp or a low-pass in place of the held action,
+        the last action at the observation's end, an action-rate term."""
+        kw = {"duration": 0.5, "base_law": "pd"}
+        held = gymnasium.make(ENV, **kw)
+        for smoothing in ["ramp", "low-pass"]:
+            env = gymnasium.make(ENV, smoothing=smoothing, observe_action=True, **kw)
+            core = env.unwrapped.core
+            self.assertEqual((core.smoothing, core.observe_action), (smoothing, True))
+            self.assertEqual(core.smoothing_tau_s, 0.02 if smoothing == "low-pass" else None)
+            self.assertEqual(env.observation_space.shape, (17,))
+            self.assertEqual(testbed.observation_names(2, True)[-2:], ["a0", "a1"])
+            obs, _ = env.reset(seed=0)
+            self.assertTrue(np.array_equal(obs[15:], [0.0, 0.0]))
+            held.reset(seed=0)
+            a = np.array([0.5, -2.0], np.float32)
+            obs, *_ = env.step(a)
+            # The clipped action, as the policy gave it.
+            self.assertTrue(np.array_equal(obs[15:], [0.5, -1.0]))
+            held.step(a)
+            # The shaping itself is pinned in Rust (gym-env's smoothing
+            # tests, policy/tests/smoothing.rs); here: it acts.
+            self.assertFalse(np.array_equal(env.unwrapped.core.true_state[0],
+                                            held.unwrapped.core.true_state[0]))
+        # The rate term: a constant action pays it once, from rest.
+        base = gymnasium.make(ENV, **kw)
+        rated = gymnasium.make(ENV, action_rate_weight=1.0, **kw)
+        for e in (base, rated):
+            e.reset(seed=0)
+        ones = np.ones(2, np.float32)
+        r0, r1 = base.step(ones)[1], rated.step(ones)[1]
+        self.assertAlmostEqual(r0 - r1, 1.0, places=12)
+        r0, r1 = base.step(ones)[1], rated.step(ones)[1]
+        self.assertEqual(r0, r1)
+        for bad, what in [({"smoothing": "spline"}, "smoothing = spline: must be one of"),
+                          ({"smoothing": "low-pass", "smoothing_tau_s": 0.0}, "smoothing_tau_s = 0: must be"),
+                          ({"action_rate_weight": -1.0}, "action_rate_weight = -1: must be")]:
+            with self.assertRaisesRegex(testbed.TestbedError, what):
+                gymnasium.make(ENV, **bad)
+        with self.assertRaisesRegex(TypeError, "observe_action: expected True or False"):
+            gymnasium.make(ENV, observe_action=1)
+
     def test_reset_options_set_the_start(self):
         env = gymnasium.make(ENV)
         env.reset(seed=0, options={"initial_q": [0.3, -0.2], "initial_qd": [0.0, 0.1]})

@@ -10,8 +10,12 @@ use pyo3::types::{PyBool, PyDict};
 
 use crate::convert::{ScenarioArgs, err, read_into};
 
+/// The low-pass's time constant when `smoothing_tau_s` is not given, s:
+/// one decision at the default decimation of a 1 kHz plant.
+const DEFAULT_SMOOTHING_TAU_S: f64 = 0.02;
+
 /// The keyword options both classes take, in the order the docs list them.
-const KEYWORDS: [&str; 12] = [
+const KEYWORDS: [&str; 16] = [
     "robot",
     "set",
     "episode_s",
@@ -24,6 +28,10 @@ const KEYWORDS: [&str; 12] = [
     "decimation",
     "safe",
     "scale_obs",
+    "smoothing",
+    "smoothing_tau_s",
+    "action_rate_weight",
+    "observe_action",
 ];
 
 /// Extracts `v` (not None) as a `T`, or a TypeError naming `key` and
@@ -51,6 +59,7 @@ pub(super) fn load(
     let mut opts = EnvOptions::default();
     let (mut robot, mut set, mut episode_s, mut duration) = (None, None, None, None);
     let mut base_law: Option<String> = None;
+    let (mut smoothing, mut smoothing_tau_s) = ("hold".to_string(), DEFAULT_SMOOTHING_TAU_S);
     for (k, v) in kwargs.into_iter().flatten() {
         let key: String = take("keyword", &k, "a string")?;
         if !KEYWORDS.contains(&key.as_str()) {
@@ -61,7 +70,9 @@ pub(super) fn load(
         }
         let none = v.is_none();
         // A bool is an int to Python: refused where a number is meant.
-        if v.is_instance_of::<PyBool>() && !matches!(key.as_str(), "safe" | "scale_obs") {
+        if v.is_instance_of::<PyBool>()
+            && !matches!(key.as_str(), "safe" | "scale_obs" | "observe_action")
+        {
             return Err(PyTypeError::new_err(format!(
                 "{key}: expected a number, got bool"
             )));
@@ -94,10 +105,15 @@ pub(super) fn load(
             }
             "safe" => opts.safe = take(&key, &v, "True or False")?,
             "scale_obs" => opts.scale_obs = take(&key, &v, "True or False")?,
+            "smoothing" => smoothing = take(&key, &v, "\"hold\", \"ramp\" or \"low-pass\"")?,
+            "smoothing_tau_s" => smoothing_tau_s = take(&key, &v, "a number of seconds")?,
+            "action_rate_weight" => opts.action_rate_weight = take(&key, &v, "a number")?,
+            "observe_action" => opts.observe_action = take(&key, &v, "True or False")?,
             // None for an option whose default is "not given".
             _ => {}
         }
     }
+    opts.smoothing = gym_env::Smoothing::parse(&smoothing, smoothing_tau_s).map_err(err)?;
     let length = match (episode_s, duration) {
         (Some(e), Some(d)) => {
             return Err(PyValueError::new_err(format!(

@@ -206,6 +206,31 @@ impl EnvCore {
         self.env.options().scale_obs
     }
 
+    /// How a decision's torque is spread over its periods: "hold", "ramp"
+    /// or "low-pass".
+    #[getter]
+    fn smoothing(&self) -> &'static str {
+        self.env.options().smoothing.name()
+    }
+
+    /// The low-pass's time constant, s (None for "hold" and "ramp").
+    #[getter]
+    fn smoothing_tau_s(&self) -> Option<f64> {
+        self.env.options().smoothing.tau_s()
+    }
+
+    /// The last action ends the observation.
+    #[getter]
+    fn observe_action(&self) -> bool {
+        self.env.options().observe_action
+    }
+
+    /// Weight of the reward's action-rate term.
+    #[getter]
+    fn action_rate_weight(&self) -> f64 {
+        self.env.options().action_rate_weight
+    }
+
     /// The current episode's seed.
     #[getter]
     fn seed(&self) -> u64 {
