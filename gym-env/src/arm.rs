@@ -175,7 +175,8 @@ impl ArmEnv {
     }
 
     /// Length of the observation: e, ė, q, q̇, q_d, q̇_d, k_c, t / T
-    /// (errors and velocities scaled unless `scale_obs` is off).
+    /// (errors and velocities scaled unless `scale_obs` is off), then the
+    /// last clipped action with `observe_action`.
     pub fn obs_dim(&self) -> usize {
         obs_dim_with(self.n, self.opts.observe_action)
     }

@@ -202,6 +202,9 @@ impl EnvOptions {
                 "must be a number from 0 to 1e6",
             ));
         }
+        if let Some(tau) = self.smoothing.tau_s() {
+            Smoothing::parse("low-pass", tau)?;
+        }
         if let Some(f) = self.breach_factor
             && !(f.is_finite() && (1.0..=1e6).contains(&f))
         {

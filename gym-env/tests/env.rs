@@ -391,3 +391,44 @@ fn the_picture_shows_the_arm_and_moves_with_it() {
     assert_ne!(first, later, "the arm moved");
     assert!(env.render(4, 90).is_err(), "a picture too small is refused");
 }
+
+/// #59 item 1: a reset forgets the last episode's ramp and last action,
+/// so an episode is the same however many came before it; a bad low-pass
+/// built in Rust is refused as Python's is.
+#[test]
+fn a_smoothed_episode_is_the_same_after_another_and_a_bad_low_pass_is_refused() {
+    let p = plan(0.3, &[]);
+    let opts = EnvOptions {
+        action: ActionMode::Residual(p.scenario.controller.law),
+        smoothing: gym_env::Smoothing::Ramp,
+        observe_action: true,
+        decimation: 7,
+        ..EnvOptions::default()
+    };
+    let mut env = ArmEnv::new(p.clone(), opts.clone()).unwrap();
+    let mut obs = vec![0.0; env.obs_dim()];
+    let mut episode = |env: &mut ArmEnv| {
+        env.reset(3, &mut obs).unwrap();
+        let mut out = bits(&obs);
+        for k in 0..env.decisions() {
+            let a = [(k as f64 * 0.7).sin(), (k as f64 * 1.3).cos()];
+            env.step(&a, &mut obs);
+            out.extend(bits(&obs));
+        }
+        out
+    };
+    let first = episode(&mut env);
+    // 300 periods at 7 a decision: the last decision is 6 periods long.
+    assert_eq!(env.decisions(), 43);
+    assert_eq!(episode(&mut env), first);
+    for tau_s in [0.0, -1.0, f64::NAN] {
+        let bad = EnvOptions {
+            smoothing: gym_env::Smoothing::LowPass { tau_s },
+            ..opts.clone()
+        };
+        match ArmEnv::new(p.clone(), bad) {
+            Err(EnvError::Option { name, .. }) => assert_eq!(name, "smoothing_tau_s"),
+            other => panic!("τ = {tau_s}: {:?}", other.map(|_| ())),
+        }
+    }
+}

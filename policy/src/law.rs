@@ -107,11 +107,16 @@ impl PolicyLaw {
                     }
                     Err(e) => {
                         self.shaper.reset();
+                        self.last_action.fill(0.0);
                         err = Some(e);
                     }
                 }
             }
-            let add = self.shaper.period_torque();
+        }
+        // Every plant period, with or without a reference sample: the
+        // shaper counts periods as the environment's does.
+        let add = self.shaper.period_torque();
+        if reference.is_some() {
             if err.is_some() {
                 cmd.tau = [0.0; wire::MAX_DOF];
                 cmd.fault = wire::Fault::NonFiniteOutput.code();

@@ -9,9 +9,10 @@
 //! node, and hands them to [`PolicyLaw::step`]. Every `decimation` plant
 //! periods that builds the observation with [`gym_env::observe`] (the
 //! environment's own function), runs the network ([`Policy::act`]) and
-//! turns its action into a held torque with [`gym_env::action_torque`];
-//! every period it adds that torque to the base law's, as the environment
-//! does. No Python is in the loop.
+//! turns its action into a torque with [`gym_env::action_torque`];
+//! every period it adds that torque, held, ramped or low-pass filtered by
+//! [`gym_env::ActionShaper`] as the record says, to the base law's, as the
+//! environment does. No Python is in the loop.
 //!
 //! The policy's record is the ONNX model's `metadata_props` entry
 //! [`ENV_KEY`] (`testbed.env`), a JSON object: the `env` dict of

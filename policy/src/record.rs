@@ -19,7 +19,7 @@ const DEFAULT_RESIDUAL_SCALE: f64 = 0.2;
 pub struct EnvRecord {
     /// Controlled joints.
     pub dof: usize,
-    /// Observation length, 7 · dof + 1.
+    /// Observation length, 7 · dof + 1 (8 · dof + 1 with `observe_action`).
     pub obs_dim: usize,
     /// Plant periods in a training episode.
     pub steps: u64,

@@ -10,12 +10,13 @@ loop:
         --set controller.k2=3.75 --laws nac,pd --controller-cmd ppo="target/release/testbed-policy runs/ppo_arm.onnx"
 
 Needs torch (with Stable-Baselines3) and onnx; the tests do not run it.
-The environment is rebuilt with train_sb3.py's settings (KWARGS) to read
-its record (`testbed.policy.env_record`): pass the same settings you
-trained with.
+The environment is rebuilt with the settings train_sb3.py saved beside
+the model (MODEL.env.json; `--defaults`: train_sb3.py's KWARGS, for a
+model from before that file) to read its record (`testbed.policy.env_record`).
 """
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -34,12 +35,23 @@ def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("model", help="the SB3 PPO file (.zip)")
     p.add_argument("out", help="the ONNX file to write")
+    p.add_argument("--defaults", action="store_true",
+                   help="no MODEL.env.json: the model was trained with train_sb3.py's KWARGS "
+                        "(a policy from before the file was written)")
     a = p.parse_args()
 
     import onnx
     import torch
     from stable_baselines3 import PPO
 
+    saved = Path(a.model.removesuffix(".zip") + ".env.json")
+    if saved.exists():
+        kwargs = json.loads(saved.read_text())
+    elif a.defaults:
+        kwargs = KWARGS
+    else:
+        sys.exit(f"export_sb3_onnx: {saved} is missing (train_sb3.py writes it beside the model); "
+                 "--defaults exports with train_sb3.py's KWARGS, for a model trained without options")
     model = PPO.load(a.model, device="cpu")
     policy = model.policy
 
@@ -55,10 +67,10 @@ def main():
             latent = self.policy.mlp_extractor.forward_actor(features)
             return torch.clamp(self.policy.action_net(latent), -1.0, 1.0)
 
-    env = gymnasium.make(testbed.ENV_ID, **KWARGS)
+    env = gymnasium.make(testbed.ENV_ID, **kwargs)
     core = env.unwrapped.core
-    record = dict(KWARGS, **env_record(env))
-    record["set"] = [f"{k}={v}" for k, v in KWARGS.get("set", {}).items()]
+    record = dict(kwargs, **env_record(env))
+    record["set"] = [f"{k}={v}" for k, v in kwargs.get("set", {}).items()]
     obs = torch.zeros((1, core.obs_dim), dtype=torch.float32)
     # The TorchScript exporter (dynamo=False) needs no onnxscript.
     torch.onnx.export(Mean(policy).eval(), (obs,), a.out, input_names=["obs"],

@@ -8,6 +8,15 @@ on held-out seeds beside the zero residual (pd alone).
     pip install stable-baselines3          # or: bash python/setup-train-venv.sh
     python python/examples/train_sb3.py --out runs/ppo_arm                # 400 000 decisions, minutes
     python python/examples/train_sb3.py --timesteps 2048 --eval-seeds 1   # a smoke run
+    python python/examples/train_sb3.py --smooth --out runs/ppo_smooth    # ramped, rate-penalised
+
+`--smooth` trains the residual as a control engineer would deploy it: the
+torque ramped across each decision rather than stepped (`smoothing="ramp"`),
+the last action observed, and an action-rate term in the reward
+(`action_rate_weight`, Isaac Lab's arm-reach task penalises the same);
+`--smoothing`, `--action-rate-weight` and `--observe-action` set them one
+by one, `--base-law` the law under the residual. The settings are saved
+beside the model (`OUT.env.json`), where export_sb3_onnx.py reads them.
 
 PPO's settings (HYPER) differ from SB3's defaults where those waste a
 short budget: 2 048 decisions a rollout (8 arms x 256) rather than 16 384,
@@ -21,7 +30,9 @@ docs/results.md has what it learns and the commands that measure it.
 """
 
 import argparse
+import json
 import time
+from pathlib import Path
 
 import gymnasium
 import numpy as np
@@ -32,6 +43,24 @@ import testbed
 #: paper's), and a residual on it spanning 0.2 of the torque scale.
 KWARGS = {"scenario": "paper_randomised", "base_law": "pd",
           "set": {"controller.k1": 3.75, "controller.k2": 3.75}}
+
+#: `--smooth`'s action-rate weight: a full swing of the action (2) every
+#: decision costs 4 × 0.05 = 0.2 a step, a fifth of an error at the envelope.
+SMOOTH_RATE_WEIGHT = 0.05
+
+
+def env_kwargs(a) -> dict:
+    """KWARGS with the command line's smoothing and base law."""
+    kw = dict(KWARGS, base_law=a.base_law)
+    smoothing = "ramp" if a.smooth and a.smoothing is None else (a.smoothing or "hold")
+    rate = SMOOTH_RATE_WEIGHT if a.smooth and a.action_rate_weight is None else (a.action_rate_weight or 0.0)
+    if smoothing != "hold":
+        kw["smoothing"] = smoothing
+    if rate:
+        kw["action_rate_weight"] = rate
+    if a.observe_action or a.smooth:
+        kw["observe_action"] = True
+    return kw
 
 #: PPO's settings (see above); everything else is SB3's default.
 HYPER = {"n_steps": 256, "batch_size": 256, "gamma": 0.98,
@@ -62,7 +91,14 @@ def main():
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--eval-seeds", type=int, default=20)
     p.add_argument("--out", default="runs/ppo_arm")
+    p.add_argument("--base-law", default="pd", help="the law under the residual (default pd)")
+    p.add_argument("--smooth", action="store_true",
+                   help=f"ramp, observe the last action, action-rate weight {SMOOTH_RATE_WEIGHT}")
+    p.add_argument("--smoothing", choices=["hold", "ramp", "low-pass"])
+    p.add_argument("--action-rate-weight", type=float)
+    p.add_argument("--observe-action", action="store_true")
     a = p.parse_args()
+    kwargs = env_kwargs(a)
     import torch
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecMonitor
@@ -70,7 +106,7 @@ def main():
     from testbed.sb3 import ArmTrackingSB3VecEnv, silent_logger
 
     torch.set_num_threads(1)
-    venv = ArmTrackingSB3VecEnv(a.n_envs, **KWARGS)
+    venv = ArmTrackingSB3VecEnv(a.n_envs, **kwargs)
     venv.seed(a.seed)
     model = PPO("MlpPolicy", VecMonitor(venv), seed=a.seed, verbose=0, **HYPER)
     model.set_logger(silent_logger())
@@ -78,7 +114,8 @@ def main():
     model.learn(total_timesteps=a.timesteps)
     print(f"trained {a.timesteps} decisions in {time.perf_counter() - start:.0f} s")
     model.save(a.out)
-    env = gymnasium.make(testbed.ENV_ID, **KWARGS)
+    Path(a.out.removesuffix(".zip") + ".env.json").write_text(json.dumps(kwargs, indent=1) + "\n")
+    env = gymnasium.make(testbed.ENV_ID, **kwargs)
     seeds = range(HELD_OUT, HELD_OUT + a.eval_seeds)
     zero = np.zeros(env.action_space.shape, np.float32)
     base = evaluate(env, lambda o: zero, seeds)

@@ -230,7 +230,7 @@ const COLUMNS: [(&str, &str, usize); 15] = [
     ("effort_after_tc", "eff>Tc", 1),
     ("effort_beyond_gravity", "eff-G>Tc", 1),
     ("torque_rate", "int dtau^2", 0),
-    ("torque_smoothness", "Sm tau", 3),
+    ("torque_smoothness", "Sm tau", 5),
     ("saturated_s", "sat[s]", 3),
     ("breaches", "breach", 0),
     ("peak_actor_torque", "actor|tau|", 4),
@@ -259,7 +259,8 @@ pub(crate) fn table(c: &Comparison) -> String {
     );
     let _ = writeln!(
         out,
-        "metrics after T_c unless marked; sums over joints; model: URDF = the law uses the URDF's M, C, G\n"
+        "metrics after T_c unless marked (Sm tau: the torque's spectral smoothness over the whole run); \
+         sums over joints; model: URDF = the law uses the URDF's M, C, G\n"
     );
     let _ = write!(
         out,

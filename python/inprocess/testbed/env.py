@@ -1,7 +1,7 @@
 """The Gymnasium environments: `testbed/ArmTracking-v0` and its vector form.
 
-A step is one decision of the agent: its action is held for `decimation`
-plant periods (default 20 of the paper's 1 ms: a 50 Hz policy) and becomes
+A step is one decision of the agent: its action acts for `decimation`
+plant periods (held, ramped or low-pass filtered: `smoothing`) (default 20 of the paper's 1 ms: a 50 Hz policy) and becomes
 the joint torques, or a residual on a built-in law; the arm (the testbed's
 plant, with every effect the scenario turns on) steps, and the environment
 returns the next observation, a tracking reward, and, in `info["cost"]`,
@@ -186,7 +186,7 @@ class ArmTrackingVecEnv(gymnasium.vector.VectorEnv):
 
     The same arguments and contract as `ArmTrackingEnv`, batched: actions
     of shape (num_envs, n) (any memory order), observations (num_envs,
-    7n + 1), rewards, terminated and truncated of shape (num_envs,), and
+    7n + 1, or 8n + 1 with `observe_action`), rewards, terminated and truncated of shape (num_envs,), and
     `info["cost"]`. An arm whose episode ended resets on the next step
     (Gymnasium's NEXT_STEP autoreset: that step ignores its action and
     returns its first observation, reward 0). `reset(seed=s, options=…)`

@@ -89,7 +89,7 @@ class LinearPolicy:
         if obs_dim != want:
             with_action = ", its last action observed," if observe_action else ""
             raise ValueError(f"{where}: env.obs_dim = {obs_dim}; an arm of {dof} joints{with_action} has {want}")
-        smoothing = env.get("smoothing", "hold")
+        smoothing = env.get("smoothing") or "hold"
         if smoothing not in ("hold", "ramp", "low-pass"):
             raise ValueError(f"{where}: env.smoothing = {smoothing!r}; it must be hold, ramp or low-pass")
         tau = env.get("smoothing_tau_s")

@@ -65,7 +65,7 @@ class PolicyController(tc.Controller):
         self.decimation = int(env.get("decimation", 1))
         self.scale_obs = bool(env.get("scale_obs", False))
         self.velocity = np.asarray(env.get("velocity_scale", np.ones(self.n)), dtype=np.float64)
-        if env.get("smoothing", "hold") != "hold" or env.get("observe_action", False):
+        if (env.get("smoothing") or "hold") != "hold" or env.get("observe_action", False):
             # One implementation of the smoothing: the Rust node's, which
             # is the environment's own code (gym_env::ActionShaper).
             raise ValueError(f"env.smoothing = {env.get('smoothing', 'hold')!r}, env.observe_action = "

@@ -321,6 +321,11 @@ class RlReady(unittest.TestCase):
                 gymnasium.make(ENV, **bad)
         with self.assertRaisesRegex(TypeError, "observe_action: expected True or False"):
             gymnasium.make(ENV, observe_action=1)
+        with self.assertRaisesRegex(ValueError, "smoothing_tau_s = 0.05: only smoothing=\"low-pass\""):
+            gymnasium.make(ENV, smoothing="ramp", smoothing_tau_s=0.05)
+        # What the core says is what it takes back.
+        core = gymnasium.make(ENV, smoothing="ramp").unwrapped.core
+        gymnasium.make(ENV, smoothing=core.smoothing, smoothing_tau_s=core.smoothing_tau_s)
 
     def test_reset_options_set_the_start(self):
         env = gymnasium.make(ENV)

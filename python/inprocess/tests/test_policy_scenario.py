@@ -119,3 +119,27 @@ class PolicyScenario(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class SmoothedRecord(unittest.TestCase):
+    """#59 item 1: the record carries the smoothing; the Rust node plays it,
+    the Python node refuses it rather than play a held action."""
+
+    def test_the_record_carries_the_smoothing_and_the_python_node_refuses_it(self):
+        from testbed.policy_node import PolicyController
+        env = paper_env(smoothing="low-pass", smoothing_tau_s=0.01, observe_action=True)
+        self.assertEqual((env["smoothing"], env["smoothing_tau_s"], env["observe_action"]),
+                         ("low-pass", 0.01, True))
+        self.assertEqual(env["obs_dim"], 17)
+        policy = LinearPolicy.zeros(2, 17, env)
+        policy.check()
+        with self.assertRaisesRegex(ValueError, "this Python node plays held actions"):
+            PolicyController(policy)
+        with self.assertRaisesRegex(ValueError, "env.obs_dim = 15; an arm of 2 joints, its last action observed,"):
+            LinearPolicy.zeros(2, 15, dict(env, obs_dim=15)).check()
+        with self.assertRaisesRegex(ValueError, "env.smoothing_tau_s = None"):
+            LinearPolicy.zeros(2, 17, dict(env, smoothing_tau_s=None)).check()
+        # A held record is played by either node.
+        held = paper_env()
+        self.assertEqual((held["smoothing"], held["observe_action"]), ("hold", False))
+        PolicyController(LinearPolicy.zeros(2, 15, held))

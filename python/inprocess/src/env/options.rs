@@ -59,7 +59,7 @@ pub(super) fn load(
     let mut opts = EnvOptions::default();
     let (mut robot, mut set, mut episode_s, mut duration) = (None, None, None, None);
     let mut base_law: Option<String> = None;
-    let (mut smoothing, mut smoothing_tau_s) = ("hold".to_string(), DEFAULT_SMOOTHING_TAU_S);
+    let (mut smoothing, mut smoothing_tau_s) = ("hold".to_string(), None::<f64>);
     for (k, v) in kwargs.into_iter().flatten() {
         let key: String = take("keyword", &k, "a string")?;
         if !KEYWORDS.contains(&key.as_str()) {
@@ -105,15 +105,26 @@ pub(super) fn load(
             }
             "safe" => opts.safe = take(&key, &v, "True or False")?,
             "scale_obs" => opts.scale_obs = take(&key, &v, "True or False")?,
-            "smoothing" => smoothing = take(&key, &v, "\"hold\", \"ramp\" or \"low-pass\"")?,
-            "smoothing_tau_s" => smoothing_tau_s = take(&key, &v, "a number of seconds")?,
+            "smoothing" if !none => {
+                smoothing = take(&key, &v, "\"hold\", \"ramp\" or \"low-pass\"")?
+            }
+            "smoothing_tau_s" if !none => {
+                smoothing_tau_s = Some(take(&key, &v, "a number of seconds")?)
+            }
             "action_rate_weight" => opts.action_rate_weight = take(&key, &v, "a number")?,
             "observe_action" => opts.observe_action = take(&key, &v, "True or False")?,
             // None for an option whose default is "not given".
             _ => {}
         }
     }
-    opts.smoothing = gym_env::Smoothing::parse(&smoothing, smoothing_tau_s).map_err(err)?;
+    if let (Some(tau), false) = (smoothing_tau_s, smoothing == "low-pass") {
+        return Err(PyValueError::new_err(format!(
+            "smoothing_tau_s = {tau}: only smoothing=\"low-pass\" takes a time constant \
+             (smoothing is {smoothing:?})"
+        )));
+    }
+    let tau = smoothing_tau_s.unwrap_or(DEFAULT_SMOOTHING_TAU_S);
+    opts.smoothing = gym_env::Smoothing::parse(&smoothing, tau).map_err(err)?;
     let length = match (episode_s, duration) {
         (Some(e), Some(d)) => {
             return Err(PyValueError::new_err(format!(
