@@ -3,6 +3,7 @@ with SB3 and torch (as test_sb3.py finds or makes it): train_sb3.py,
 export_sb3_onnx.py on what it saved, and train_lagrangian.py. Never
 skipped: without such an environment this test fails and says why."""
 
+import json
 import os
 import re
 import subprocess
@@ -31,8 +32,10 @@ class ShippedExamples(unittest.TestCase):
     def test_train_sb3_and_its_onnx_export_run(self):
         python = sb3_python()
         with tempfile.TemporaryDirectory() as d:
+            # --smooth: the shipped smooth policy's settings, which the
+            # export must carry into the record (#59 item 1).
             out = run_example(python, "train_sb3.py", "--timesteps", "1024", "--n-envs", "4",
-                              "--eval-seeds", "1", "--out", "ppo", cwd=d)
+                              "--eval-seeds", "1", "--out", "ppo", "--smooth", cwd=d)
             self.assertRegex(out, r"pd alone: +mean return -?\d+\.\d+, constraint cost \d+ steps")
             self.assertRegex(out, r"PPO on pd: +mean return -?\d+\.\d+, constraint cost \d+ steps")
             self.assertTrue((Path(d) / "ppo.zip").is_file(), out)
@@ -42,6 +45,18 @@ class ShippedExamples(unittest.TestCase):
             self.assertIsNotNone(m, out)
             self.assertLess(float(m.group(1)), 1e-6, out)
             self.assertGreater((Path(d) / "ppo.onnx").stat().st_size, 1000)
+            import onnx
+            props = {p.key: p.value for p in onnx.load(str(Path(d) / "ppo.onnx")).metadata_props}
+            record = json.loads(props["testbed.env"])
+            self.assertEqual((record["smoothing"], record["observe_action"], record["obs_dim"]),
+                             ("ramp", True, 17))
+            # Without the settings file the export refuses rather than guess.
+            (Path(d) / "ppo.env.json").unlink()
+            env = dict(os.environ, PYTHONPATH=str(HERE.parent))
+            bad = subprocess.run([python, str(EXAMPLES / "export_sb3_onnx.py"), "ppo.zip", "x.onnx"],
+                                 cwd=d, env=env, capture_output=True, text=True, timeout=600)
+            self.assertNotEqual(bad.returncode, 0)
+            self.assertIn("ppo.env.json is missing", bad.stderr)
 
     def test_train_lagrangian_moves_lambda_with_the_cost(self):
         python = sb3_python()
