@@ -7,8 +7,9 @@
 //! Where it sits in the data flow: a [`scenario::Plan`] comes in (loaded by
 //! the caller); each step drives [`scenario::stepper::Stepper`], the loop
 //! body `testbed sim` uses, for `decimation` plant periods with the action
-//! held (or ramped, or low-pass filtered: [`Smoothing`]); the PyO3 module (`python/inprocess`, `testbed._native`) only
-//! converts Python values to and from these types, and `testbed/env.py`
+//! held (or ramped, or low-pass filtered: [`Smoothing`]); the PyO3
+//! module (`python/inprocess`, `testbed._native`) only converts Python
+//! values to and from these types, and `testbed/env.py`
 //! wraps that as `gymnasium.Env` and `gymnasium.vector.VectorEnv`. With a
 //! zero residual on the scenario's own law and `decimation = 1` the states
 //! are `testbed sim`'s, bit for bit.
@@ -45,10 +46,10 @@ mod vector;
 
 pub use arm::{ArmEnv, Outcome, ResetOptions, obs_dim, obs_dim_with};
 pub use options::{
-    ActionMode, DEFAULT_DECIMATION, DEFAULT_EPISODE_S, ERROR_CAP, EnvError, EnvOptions,
+    ActionMode, DEFAULT_DECIMATION, DEFAULT_EPISODE_S, ERROR_CAP, EnvError, EnvOptions, Smoothing,
     check_episode_s,
 };
 pub use policy_io::{action_torque, observe, observe_action};
 pub use render::{Picture, Projection};
-pub use smoothing::{ActionShaper, Smoothing};
+pub use smoothing::ActionShaper;
 pub use vector::{ArmEnvs, Autoreset, MAX_ENVS, MAX_THREADS, SeedStream, default_threads};

@@ -6,8 +6,6 @@ use arm_model::dynamics::Dynamics;
 use controller::LawName;
 use scenario::Plan;
 
-use crate::smoothing::Smoothing;
-
 /// Plant periods per decision by default: 20 periods of the paper's 1 kHz
 /// plant are a 50 Hz policy (at 1 kHz the default discount sees 0.1 s and
 /// the constraint starts 2 000 decisions in).
@@ -51,6 +49,67 @@ pub enum ActionMode {
     /// A residual on a built-in law: τ = τ_law + clip(a_i, −1, 1) ·
     /// residual_scale · scale_i.
     Residual(LawName),
+}
+
+/// How the torque of a decision is spread over its plant periods.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Smoothing {
+    /// Each period adds the decision's torque: a zero-order hold.
+    Hold,
+    /// A ramp from the torque the last decision reached to the new one,
+    /// reached at the decision's last period: a first-order hold, one
+    /// decision late, with no step.
+    Ramp,
+    /// Each period moves the torque a fraction 1 − exp(−dt/τ) towards the
+    /// decision's: a first-order low-pass of time constant τ, s.
+    LowPass {
+        /// The time constant τ, s.
+        tau_s: f64,
+    },
+}
+
+impl Smoothing {
+    /// The names [`Smoothing::parse`] takes.
+    pub const NAMES: [&'static str; 3] = ["hold", "ramp", "low-pass"];
+
+    /// The smoothing named `name` (one of [`Smoothing::NAMES`]), with
+    /// `tau_s` the low-pass's time constant (checked only for it).
+    pub fn parse(name: &str, tau_s: f64) -> Result<Self, EnvError> {
+        match name {
+            "hold" => Ok(Self::Hold),
+            "ramp" => Ok(Self::Ramp),
+            "low-pass" if tau_s.is_finite() && tau_s > 0.0 && tau_s <= 1e3 => {
+                Ok(Self::LowPass { tau_s })
+            }
+            "low-pass" => Err(EnvError::option(
+                "smoothing_tau_s",
+                tau_s,
+                "must be a time constant in seconds above 0 and at most 1000",
+            )),
+            _ => Err(EnvError::option(
+                "smoothing",
+                name,
+                format!("must be one of {}", Self::NAMES.join(", ")),
+            )),
+        }
+    }
+
+    /// Its name, as [`Smoothing::parse`] takes it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Hold => "hold",
+            Self::Ramp => "ramp",
+            Self::LowPass { .. } => "low-pass",
+        }
+    }
+
+    /// The low-pass's time constant, s (None for the others).
+    pub fn tau_s(&self) -> Option<f64> {
+        match self {
+            Self::LowPass { tau_s } => Some(*tau_s),
+            Self::Hold | Self::Ramp => None,
+        }
+    }
 }
 
 /// How an environment is made, beyond its scenario.
